@@ -1,0 +1,22 @@
+#pragma once
+// The triangle mesh value type every layer exchanges: plain Eigen arrays, no topology.
+// OpenMesh is used for reading, writing and topology checks only (DESIGN.md, practical notes).
+
+#include <Eigen/Core>
+
+namespace mcf {
+
+/// Vertex positions, one row per vertex (n x 3).
+using Positions = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+/// Triangles as vertex indices, one row per face (m x 3), counter-clockwise seen from outside.
+using Triangles = Eigen::Matrix<int, Eigen::Dynamic, 3>;
+
+struct TriangleMesh {
+  Positions vertices;
+  Triangles faces;
+
+  Eigen::Index num_vertices() const { return vertices.rows(); }
+  Eigen::Index num_faces() const { return faces.rows(); }
+};
+
+}  // namespace mcf

@@ -1,0 +1,33 @@
+#pragma once
+// One mesh-spec string names any mesh wherever a mesh is expected:
+//   sphere:vertices=40000[,radius=1]   icosphere:level=6   torus[:R=1,r=0.3,...]   spiral
+//   dumbbell   rounded_cylinder   open_cylinder   catenoid
+//   cgal:armadillo   cgal:armadillo@faces=832000   path/to/file.off[@faces=N]
+// "@faces=N" subdivides 1-to-4 until at least N faces.
+
+#include "datasets/mesh.h"
+#include "datasets/validate.h"
+
+#include <optional>
+#include <string>
+
+namespace mcf {
+
+struct MeshSource {
+  TriangleMesh mesh;
+  std::string spec;           ///< as given
+  std::string kind;           ///< "sphere", "icosphere", "cgal", "file", ...
+  bool analytic = false;      ///< generated shape (keeps its size); real models are unit-cube scaled
+  std::optional<double> sphere_radius;  ///< set for sphere and icosphere (centre at the origin)
+  MeshReport report;          ///< validation report (validate_mesh has passed)
+};
+
+/// Parses the spec, builds/loads, scales real models to the unit cube, subdivides to @faces,
+/// validates. Throws MeshError naming the spec (and file) on any problem, including an unknown
+/// generator or parameter.
+MeshSource load_mesh_spec(const std::string& spec);
+
+/// Human-readable list of the supported specs (for --help).
+std::string mesh_spec_help();
+
+}  // namespace mcf

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Fails if a layer includes a header of a layer above it (DESIGN.md "Layers").
+root=${1:-$(dirname "$0")/..}
+order=(datasets bases solvers flows bench tools)
+# solvers sits beside bases (neither may include the other).
+declare -A forbidden=(
+  [datasets]="bases solvers flows bench tools"
+  [bases]="solvers flows bench tools"
+  [solvers]="datasets bases flows bench tools"
+  [flows]="bench tools"
+  [bench]="tools"
+  [tools]=""
+)
+bad=0
+for layer in "${order[@]}"; do
+  for up in ${forbidden[$layer]}; do
+    if hits=$(grep -rnE "#include +\"$up/" "$root/$layer" --include='*.h' --include='*.cpp' 2>/dev/null); then
+      echo "layering violation: $layer includes $up:"; echo "$hits"; bad=1
+    fi
+  done
+done
+[ $bad = 0 ] && echo "layering ok"
+exit $bad

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Installs the Debian packages mcfbench needs, only those that are missing, and extracts the
+# real-model archive of libcgal-demo without pulling in its Qt dependencies.
+# Does nothing (and needs no network) when everything is already present.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev
+  libsuitesparse-dev libopenblas-dev     # CHOLMOD on OpenBLAS (the reference BLAS is 3-4x slower)
+  libtbb-dev
+  libopenmesh-dev
+  nlohmann-json3-dev
+  libcli11-dev
+  libbenchmark-dev
+  libgtest-dev
+  python3-matplotlib python3-numpy
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing missing Debian packages: ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+fi
+
+# Real meshes: libcgal-demo's data.tar.gz. Installing the package pulls in Qt, so download the
+# .deb and unpack it into a cache instead (DESIGN.md, practical notes).
+cache="${MCFBENCH_CACHE:-$HOME/.cache/mcfbench}"
+archive=/usr/share/doc/libcgal-dev/data.tar.gz
+if [ ! -f "$archive" ] && [ ! -f "$cache/cgal-demo/usr/share/doc/libcgal-dev/data.tar.gz" ]; then
+  echo "setup: fetching libcgal-demo's data.tar.gz into $cache/cgal-demo" >&2
+  mkdir -p "$cache/cgal-demo"
+  tmp=$(mktemp -d)
+  ( cd "$tmp" && { apt-get download libcgal-demo >/dev/null 2>&1 || { $SUDO apt-get update -qq && apt-get download libcgal-demo >/dev/null; }; } \
+      && dpkg -x libcgal-demo_*.deb "$cache/cgal-demo" )
+  rm -rf "$tmp"
+fi

@@ -1,0 +1,62 @@
+#pragma once
+// One interface for every linear solver (DESIGN.md "Layers": a basis and a solver only meet
+// through the system they exchange). A solver is given a sparse symmetric positive-definite
+// matrix, optionally with a multigrid hierarchy, and solves several right-hand sides at once.
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mcf {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+enum class SolveStatus {
+  converged,          ///< reached the tolerance (or a direct solve succeeded)
+  max_iterations,     ///< stopped at the iteration cap; the answer is the last iterate
+  not_positive_definite,  ///< the matrix is not SPD (the flow turned singular); not an abort
+  numerical_issue,    ///< NaN/inf met during the solve
+  failed              ///< anything else; see message
+};
+
+const char* to_string(SolveStatus s);
+
+struct SolveReport {
+  SolveStatus status = SolveStatus::converged;
+  int iterations = 0;                 ///< cycles (multigrid), CG iterations (PCG), 1 (direct)
+  double relative_residual = 0.0;     ///< max over right-hand sides of ||b - A x|| / ||b||
+  std::vector<double> residuals;      ///< relative residual after each iteration / cycle
+  std::string message;
+  bool ok() const { return status == SolveStatus::converged || status == SolveStatus::max_iterations; }
+};
+
+/// Multigrid hierarchy as plain arrays (levels ordered coarsest first; the finest level is the
+/// system's own). prolongations[l] maps level l to level l+1, so there are levels-1 of them.
+/// colours[l][i] in 0..7 is the Gauss-Seidel colour of function i on level l: functions of the
+/// same colour never couple (octree parity colouring, DESIGN.md "Multigrid").
+struct HierarchyView {
+  const std::vector<SparseMatrix>* prolongations = nullptr;
+  const std::vector<std::vector<std::uint8_t>>* colours = nullptr;
+  bool empty() const { return prolongations == nullptr || prolongations->empty(); }
+};
+
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+  virtual std::string name() const = 0;
+
+  /// Sets (or updates) the matrix A (full symmetric storage, compressed). A solver detects
+  /// whether the sparsity pattern is unchanged and then reuses its symbolic work.
+  /// Returns a report whose status is not_positive_definite when a factorization fails.
+  virtual SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) = 0;
+
+  /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers
+  /// use it; direct solvers ignore it) and the solution on exit.
+  virtual SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
+};
+
+}  // namespace mcf
