@@ -38,9 +38,9 @@ using IoMesh = OpenMesh::TriMesh_ArrayKernelT<IoTraits>;
 void silence_openmesh() {
   static std::once_flag once;
   std::call_once(once, [] {
-    OpenMesh::omerr().disable();
-    OpenMesh::omlog().disable();
-    OpenMesh::omout().disable();
+    ::omerr().disable();
+    ::omlog().disable();
+    ::omout().disable();
   });
 }
 
