@@ -39,6 +39,8 @@ class CholmodSolver final : public LinearSolver {
   int factorizations() const { return factorizations_; }
   /// True if the last set_matrix produced a usable factor.
   bool factorized() const { return factor_ok_; }
+  /// True once a factor exists and CHOLMOD chose the supernodal form (always, as configured).
+  bool is_supernodal() const { return factor_ != nullptr && factor_->is_super != 0; }
   /// Nonzeros in the factor L (0 before the first factorization); useful for memory reports.
   std::int64_t factor_nonzeros() const;
 

@@ -27,19 +27,17 @@ void for_chunks(Index n, F&& f) {
   });
 }
 
-// Four independent accumulators in a fixed pattern: fast, and the order is a function of the
-// chunk bounds only.
+// Eight independent accumulators in a fixed pattern: the lanes map onto SIMD registers without
+// any reassociation (so no -ffast-math is needed and the order is a function of the chunk
+// bounds only), and they break the add-latency chain of a single running sum.
 double chunk_dot(const double* u, const double* v, Index b, Index e) {
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  constexpr int L = 8;
+  double s[L] = {};
   Index i = b;
-  for (; i + 4 <= e; i += 4) {
-    s0 += u[i] * v[i];
-    s1 += u[i + 1] * v[i + 1];
-    s2 += u[i + 2] * v[i + 2];
-    s3 += u[i + 3] * v[i + 3];
-  }
-  for (; i < e; ++i) s0 += u[i] * v[i];
-  return (s0 + s1) + (s2 + s3);
+  for (; i + L <= e; i += L)
+    for (int j = 0; j < L; ++j) s[j] += u[i + j] * v[i + j];
+  for (int j = 0; i < e; ++i, ++j) s[j] += u[i] * v[i];
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
 // Combines per-chunk partials (chunk-major, k per chunk) serially in chunk order.
@@ -98,6 +96,33 @@ void PcgSolver::set_preconditioner(Preconditioner preconditioner) {
   external_ = std::move(preconditioner);
 }
 
+namespace {
+
+// Rows [b, e) of Y = A X for a compile-time number of columns K: one pass over each row's
+// entries feeds all K sums (the flows' x, y, z). The per-(row, column) summation order is the
+// entry order, whatever K and the threading.
+template <int K>
+void spmv_rows(const int* outer, const int* inner, const double* val, const MatrixXd& X,
+               MatrixXd& Y, Index b, Index e) {
+  const double* x[K];
+  double* y[K];
+  for (int c = 0; c < K; ++c) {
+    x[c] = X.col(c).data();
+    y[c] = Y.col(c).data();
+  }
+  for (Index i = b; i < e; ++i) {
+    double s[K] = {};
+    for (int p = outer[i]; p < outer[i + 1]; ++p) {
+      const double v = val[p];
+      const int j = inner[p];
+      for (int c = 0; c < K; ++c) s[c] += v * x[c][j];
+    }
+    for (int c = 0; c < K; ++c) y[c][i] = s[c];
+  }
+}
+
+}  // namespace
+
 void PcgSolver::multiply(const MatrixXd& X, MatrixXd& Y) const {
   const Index n = A_.rows(), k = X.cols();
   Y.resize(n, k);
@@ -107,6 +132,13 @@ void PcgSolver::multiply(const MatrixXd& X, MatrixXd& Y) const {
   // A is symmetric, so column i of the column-major storage is row i: each output row is
   // an independent gather with a fixed summation order (deterministic, no write conflicts).
   for_chunks(n, [&](Index, Index b, Index e) {
+    switch (k) {
+      case 1: spmv_rows<1>(outer, inner, val, X, Y, b, e); return;
+      case 2: spmv_rows<2>(outer, inner, val, X, Y, b, e); return;
+      case 3: spmv_rows<3>(outer, inner, val, X, Y, b, e); return;
+      case 4: spmv_rows<4>(outer, inner, val, X, Y, b, e); return;
+      default: break;
+    }
     for (Index c = 0; c < k; ++c) {
       const double* x = X.col(c).data();
       double* y = Y.col(c).data();

@@ -22,6 +22,8 @@ TEST(CholmodSolver, MatchesDenseOnLaplacian3d) {
   const SolveReport r = s.solve(B, Xc);
   ASSERT_EQ(r.status, SolveStatus::converged) << r.message;
   EXPECT_EQ(r.iterations, 1);
+  EXPECT_TRUE(s.is_supernodal());
+  EXPECT_GT(s.factor_nonzeros(), A.nonZeros() / 2);
   EXPECT_LT(relative_difference(Xc, Xd), 1e-8);
   ASSERT_EQ(r.residuals.size(), 1u);
   EXPECT_EQ(r.residuals[0], r.relative_residual);

@@ -78,7 +78,9 @@ TEST(PcgSolver, NegativeDefiniteIsReported) {
     PcgSolver pcg(tight(p));
     const SolveReport s = pcg.set_matrix(N);
     // Jacobi and IC see the negative diagonal at once; plain CG meets p^T A p < 0.
-    if (p != PcgPreconditioner::none) EXPECT_EQ(s.status, SolveStatus::not_positive_definite);
+    if (p != PcgPreconditioner::none) {
+      EXPECT_EQ(s.status, SolveStatus::not_positive_definite);
+    }
     Eigen::MatrixXd X;
     EXPECT_EQ(pcg.solve(B, X).status, SolveStatus::not_positive_definite);
   }
