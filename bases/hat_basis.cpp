@@ -2,6 +2,8 @@
 
 #include "datasets/validate.h"
 
+#include <Eigen/Geometry>
+
 #include <tbb/parallel_for.h>
 
 #include <chrono>

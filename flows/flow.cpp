@@ -1,6 +1,8 @@
 #include "flows/flow.h"
 
 #include "datasets/validate.h"
+
+#include <Eigen/Geometry>
 #include "flows/integrator.h"
 #include "flows/reduced_system.h"
 #include "flows/registry.h"

@@ -120,6 +120,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
 
       namespace fs = std::filesystem;
       const fs::path out(args->out);
+      fs::create_directories(out);
       Progress progress("step", config.steps);
       FlowObserver observer;
       observer.on_step = [&](int step, double, const Positions& V) {
