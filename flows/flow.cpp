@@ -226,6 +226,12 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
       stop(step, "collapsed area (" + std::to_string(area) + ")");
       break;
     }
+    if (area > 1e3 * area0) {
+      // MCF, cMCF and heat flow never increase the area: this is an unstable (explicit) step.
+      steps.push_back(record);
+      stop(step, "diverged: area grew to " + std::to_string(area / area0) + "x the initial area");
+      break;
+    }
     double step_difference = 0;
     if (config.normalize_area) {
       const Normalization n = unit_area_normalization(V_new, F);

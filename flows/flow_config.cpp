@@ -26,7 +26,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   }
   {
     auto s = r.child("solver");
-    c.solver.name = s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid"});
+    c.solver.name = s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "dense"});
     c.solver.tolerance = s.get_number("tolerance", c.solver.tolerance, -1, 1);
     c.solver.max_iterations = int(s.get_integer("max_iterations", c.solver.max_iterations, 1, 100000000));
     c.solver.preconditioner =

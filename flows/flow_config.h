@@ -17,7 +17,7 @@ struct OctreeConfig {
 };
 
 struct SolverConfig {
-  std::string name = "cholmod";          ///< cholmod | pcg | multigrid
+  std::string name = "cholmod";          ///< cholmod | pcg | multigrid | dense (LLT reference, small systems)
   double tolerance = -1;                 ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
   int max_iterations = 1000;             ///< PCG iteration cap
   std::string preconditioner = "jacobi"; ///< PCG: none | jacobi | ichol | multigrid

@@ -2,6 +2,7 @@
 
 #include "bases/hat_basis.h"
 #include "solvers/cholmod_solver.h"
+#include "solvers/dense_reference.h"
 #include "solvers/pcg_solver.h"
 
 #include <stdexcept>
@@ -16,6 +17,7 @@ std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& 
 
 std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config) {
   if (config.name == "cholmod") return std::make_unique<CholmodSolver>();
+  if (config.name == "dense") return std::make_unique<DenseLltSolver>();
   if (config.name == "pcg") {
     PcgOptions o;
     o.relative_tolerance = config.tolerance;
