@@ -7,6 +7,8 @@
 #include "datasets/mesh_error.h"
 #include "datasets/subdivide.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +20,7 @@
 #include <sstream>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 namespace mcf {
 namespace {
@@ -59,6 +61,9 @@ std::string lower_extension(const std::string& path) {
 struct FileCounts {
   long long vertices = -1;   // -1: unknown for this format
   long long triangles = -1;  // after fan triangulation; -1: unknown
+  // Coordinates parsed in double precision (ASCII OFF/OBJ): OpenMesh's readers go through
+  // floats, which would round every coordinate of an exactly written file.
+  std::vector<double> coords;
 };
 
 // Strips '#' comments and surrounding blanks.
@@ -112,6 +117,7 @@ FileCounts scan_off(const std::string& path) {
       double x = std::strtod(p, &end);
       if (end == p) fail(path, "vertex " + std::to_string(v) + ": cannot parse coordinates '" + line + "'");
       if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate ('" + line + "')");
+      counts.coords.push_back(x);
       p = end;
     }
     ++v;
@@ -157,6 +163,7 @@ FileCounts scan_obj(const std::string& path) {
         double x = std::strtod(p, &end);
         if (end == p) fail(path, "vertex " + std::to_string(counts.vertices) + ": cannot parse '" + line + "'");
         if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(counts.vertices) + " has a non-finite coordinate ('" + line + "')");
+        counts.coords.push_back(x);
         p = end;
       }
       ++counts.vertices;
@@ -169,6 +176,7 @@ FileCounts scan_obj(const std::string& path) {
       counts.triangles += k - 2;
     }
   }
+  if (counts.vertices == 0 && counts.triangles == 0) fail(path, "no vertex or face records (not an OBJ file?)");
   return counts;
 }
 
@@ -259,6 +267,12 @@ TriangleMesh read_mesh(const std::string& path) {
     const auto& p = om.point(vh);
     mesh.vertices.row(vh.idx()) << p[0], p[1], p[2];
   }
+  // Prefer our double-precision parse, after checking it is the same vertex sequence.
+  if (nv > 0 && static_cast<long long>(expected.coords.size()) == 3 * nv) {
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> exact(expected.coords.data(), nv, 3);
+    const double scale = std::max(1.0, exact.cwiseAbs().maxCoeff());
+    if ((exact - mesh.vertices).cwiseAbs().maxCoeff() <= 1e-5 * scale) mesh.vertices = exact;
+  }
   mesh.faces.resize(nf, 3);
   for (auto fh : om.faces()) {
     int c = 0;
@@ -269,6 +283,32 @@ TriangleMesh read_mesh(const std::string& path) {
   }
   return mesh;
 }
+
+namespace {
+
+// OFF and OBJ are written here rather than by OpenMesh, whose writers round coordinates to
+// float: with 17 significant digits an ASCII file reproduces every double exactly.
+bool write_ascii_exact(const fs::path& file, const TriangleMesh& mesh, bool obj) {
+  std::FILE* out = std::fopen(file.c_str(), "wb");
+  if (!out) return false;
+  std::vector<char> buffer(1 << 20);
+  std::setvbuf(out, buffer.data(), _IOFBF, buffer.size());
+  if (obj) std::fprintf(out, "# %lld vertices, %lld faces\n", static_cast<long long>(mesh.num_vertices()),
+                        static_cast<long long>(mesh.num_faces()));
+  else std::fprintf(out, "OFF\n%lld %lld 0\n", static_cast<long long>(mesh.num_vertices()),
+                    static_cast<long long>(mesh.num_faces()));
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v)
+    std::fprintf(out, obj ? "v %.17g %.17g %.17g\n" : "%.17g %.17g %.17g\n", mesh.vertices(v, 0), mesh.vertices(v, 1),
+                 mesh.vertices(v, 2));
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
+    if (obj) std::fprintf(out, "f %d %d %d\n", mesh.faces(f, 0) + 1, mesh.faces(f, 1) + 1, mesh.faces(f, 2) + 1);
+    else std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
+  }
+  const bool ok = std::ferror(out) == 0;
+  return std::fclose(out) == 0 && ok;
+}
+
+}  // namespace
 
 void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) {
   silence_openmesh();
@@ -304,8 +344,10 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) 
   fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
                         std::to_string(counter++) + target.extension().string());
-  // 17 significant digits: ASCII files round-trip doubles exactly.
-  if (!OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17)) {
+  const bool written = (ext == ".off" || ext == ".obj")
+                           ? write_ascii_exact(tmp, mesh, ext == ".obj")
+                           : OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17);
+  if (!written) {
     std::error_code ec;
     fs::remove(tmp, ec);
     fail(path, "OpenMesh could not write the file (folder missing or not writable?)");
