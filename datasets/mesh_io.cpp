@@ -8,6 +8,7 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -230,6 +231,21 @@ FileCounts scan_stl(const std::string& path) {
   return counts;
 }
 
+// STL has no vertex list to count against; OpenMesh merges equal corners, so two loaded vertices
+// at exactly the same position mean it split a vertex to add a non-manifold face.
+void check_no_split_vertices(const std::string& path, const IoMesh& om) {
+  std::vector<std::array<double, 3>> points;
+  points.reserve(om.n_vertices());
+  for (auto vh : om.vertices()) {
+    const auto& p = om.point(vh);
+    points.push_back({p[0], p[1], p[2]});
+  }
+  std::sort(points.begin(), points.end());
+  if (std::adjacent_find(points.begin(), points.end()) != points.end())
+    fail(path, "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
+               "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
+}
+
 }  // namespace
 
 TriangleMesh read_mesh(const std::string& path) {
@@ -253,9 +269,16 @@ TriangleMesh read_mesh(const std::string& path) {
 
   const long long nv = static_cast<long long>(om.n_vertices());
   const long long nf = static_cast<long long>(om.n_faces());
+  // OpenMesh adds a face around a non-manifold ("complex") edge or vertex by duplicating its
+  // vertices, so more vertices than the file has means exactly that.
+  if (expected.vertices >= 0 && nv > expected.vertices)
+    fail(path, "non-manifold mesh: OpenMesh had to duplicate " + std::to_string(nv - expected.vertices) +
+                   " vertices to add faces around complex edges or vertices (an edge in more than two "
+                   "faces, or inconsistently oriented faces)");
   if (expected.vertices >= 0 && nv != expected.vertices)
     fail(path, "the file declares " + std::to_string(expected.vertices) + " vertices but " +
                    std::to_string(nv) + " were read");
+  if (ext == ".stl") check_no_split_vertices(path, om);
   if (expected.triangles >= 0 && nf < expected.triangles)
     fail(path, "only " + std::to_string(nf) + " of the file's " + std::to_string(expected.triangles) +
                    " triangles could be added: the mesh has non-manifold (complex) edges, repeated "

@@ -103,9 +103,14 @@ TEST(MeshIo, NonManifoldEdge) {
   TempDir dir;
   // Edge (0,1) is shared by three triangles.
   const std::string verts = "0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n";
-  expect_error_naming(dir.write("fin.off", "OFF\n5 3 0\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"), "fin.off");
+  expect_error_naming(dir.write("fin.off", "OFF\n5 3 0\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"), "non-manifold");
   expect_error_naming(dir.write("fin.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\n"
                                            "f 1 2 3\nf 2 1 4\nf 1 2 5\n"));
+  expect_error_naming(dir.write("fin.stl", "solid fin\n"
+                                           "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+                                           "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 0 0 0\nvertex 0 -1 0\nendloop\nendfacet\n"
+                                           "facet normal 0 1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+                                           "endsolid fin\n"), "non-manifold");
   expect_error_naming(dir.write("fin.ply",
                                 "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
                                 "property float z\nelement face 3\nproperty list uchar int vertex_indices\n"
