@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -139,6 +140,42 @@ TEST(Generators, RoundedCylinderIsClosed) {
   expect_closed(m, 0, "capsule");
   const double exact = 4 * kPi * 0.25 + 2 * kPi * 0.5 * 2.0;
   EXPECT_NEAR(surface_area(m), exact, 0.01 * exact);
+}
+
+// Smallest corner angle in degrees: no slivers that would spoil the finite elements. Surfaces of
+// revolution have pole fans (about 360/n_around degrees at the pole), hence the low bound.
+double min_angle_degrees(const TriangleMesh& m) {
+  double lo = 180;
+  for (Eigen::Index f = 0; f < m.num_faces(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3d a = m.vertices.row(m.faces(f, c)), b = m.vertices.row(m.faces(f, (c + 1) % 3)),
+                            d = m.vertices.row(m.faces(f, (c + 2) % 3));
+      const double cosine = std::clamp((b - a).normalized().dot((d - a).normalized()), -1.0, 1.0);
+      lo = std::min(lo, std::acos(cosine) * 180 / kPi);
+    }
+  return lo;
+}
+
+TEST(Generators, NoSlivers) {
+  EXPECT_GT(min_angle_degrees(make_sphere(20000)), 50);
+  EXPECT_GT(min_angle_degrees(make_icosphere(4)), 50);
+  EXPECT_GT(min_angle_degrees(make_torus()), 30);
+  EXPECT_GT(min_angle_degrees(make_cubical_spiral()), 30);
+  EXPECT_GT(min_angle_degrees(make_open_cylinder()), 40);
+  EXPECT_GT(min_angle_degrees(make_catenoid()), 35);
+  EXPECT_GT(min_angle_degrees(make_dumbbell(64)), 5);
+  EXPECT_GT(min_angle_degrees(make_rounded_cylinder(0.5, 2.0, 64)), 5);
+}
+
+TEST(Generators, SpiralFacesPointAwayFromTheAxis) {
+  const TriangleMesh m = make_cubical_spiral(2, 32, 2);
+  for (Eigen::Index f = 0; f < m.num_faces(); ++f) {
+    const Eigen::Vector3d a = m.vertices.row(m.faces(f, 0)), b = m.vertices.row(m.faces(f, 1)),
+                          c = m.vertices.row(m.faces(f, 2));
+    Eigen::Vector3d centroid = (a + b + c) / 3;
+    centroid.z() = 0;
+    ASSERT_GT((b - a).cross(c - a).dot(centroid), 0) << f;
+  }
 }
 
 }  // namespace

@@ -139,6 +139,20 @@ TEST(MeshIo, QuadsAreFanTriangulated) {
   const TriangleMesh m = read_mesh(path);
   EXPECT_EQ(m.num_faces(), 2);
   EXPECT_NEAR(surface_area(m), 1.0, 1e-12);
+  const auto obj = dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 2 3 4\nf 2 1 5\n");
+  const TriangleMesh o = read_mesh(obj);
+  EXPECT_EQ(o.num_faces(), 3);
+  EXPECT_EQ(o.num_vertices(), 5);
+}
+
+TEST(MeshIo, AsciiKeepsDoublesExactly) {
+  TempDir dir;
+  TriangleMesh m = make_icosphere(1);
+  m.vertices *= 1.0 / 3.0;  // not representable in float
+  for (const char* name : {"x.off", "x.obj"}) {
+    write_mesh(dir.file(name), m);
+    EXPECT_EQ(read_mesh(dir.file(name)).vertices, m.vertices) << name;
+  }
 }
 
 // Round trip of a torus (irrational coordinates) through every format.
