@@ -7,6 +7,8 @@
 #include "datasets/mesh_error.h"
 #include "datasets/subdivide.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -95,6 +97,64 @@ TriangleMesh revolve(const std::vector<double>& rho, const std::vector<double>& 
     m.vertices.row(p) << 0, 0, z.back();
     const int base = (rings - 1) * n_around;
     for (int i = 0; i < n_around; ++i) faces.push_back({base + i, base + (i + 1) % n_around, p});
+  }
+  m.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f) m.faces.row(f) << faces[f][0], faces[f][1], faces[f][2];
+  return m;
+}
+
+// Closed surface of revolution (rho is 0 at both ends: two poles) with the vertex count of each
+// ring proportional to its radius (at least 6, `max_around` at the widest ring), so triangles
+// stay near-equilateral everywhere: a fixed count would leave slivers in the pole fans and
+// crowd a thin neck. Neighbouring rings are stitched by a zipper that always advances on the
+// ring whose next vertex comes first in angle; rings are staggered by half a step.
+TriangleMesh revolve_closed(const std::vector<double>& rho, const std::vector<double>& z, int max_around) {
+  const int K = static_cast<int>(rho.size()) - 1;
+  const double rho_max = *std::max_element(rho.begin(), rho.end());
+  std::vector<int> count(K + 1, 1), start(K + 1, 0);
+  std::vector<double> offset(K + 1, 0.0);
+  int total = 0;
+  for (int k = 0; k <= K; ++k) {
+    if (k > 0 && k < K) count[k] = std::max(6, static_cast<int>(std::lround(max_around * rho[k] / rho_max)));
+    offset[k] = (k % 2) * kPi / count[k];
+    start[k] = total;
+    total += count[k];
+  }
+  TriangleMesh m;
+  m.vertices.resize(total, 3);
+  for (int k = 0; k <= K; ++k)
+    for (int i = 0; i < count[k]; ++i) {
+      const double th = offset[k] + 2 * kPi * i / count[k];
+      m.vertices.row(start[k] + i) << rho[k] * std::cos(th), rho[k] * std::sin(th), z[k];
+    }
+  m.vertices.row(0) << 0, 0, z.front();
+  m.vertices.row(start[K]) << 0, 0, z.back();
+  std::vector<std::array<int, 3>> faces;
+  for (int k = 0; k < K; ++k) {
+    const int nl = count[k], nu = count[k + 1];
+    auto L = [&](int i) { return start[k] + i % nl; };
+    auto U = [&](int u) { return start[k + 1] + u % nu; };
+    if (nl == 1) {  // bottom pole fan
+      for (int u = 0; u < nu; ++u) faces.push_back({L(0), U(u + 1), U(u)});
+      continue;
+    }
+    if (nu == 1) {  // top pole fan
+      for (int i = 0; i < nl; ++i) faces.push_back({L(i), L(i + 1), U(0)});
+      continue;
+    }
+    auto angle_l = [&](int i) { return offset[k] + 2 * kPi * i / nl; };
+    auto angle_u = [&](int u) { return offset[k + 1] + 2 * kPi * u / nu; };
+    int i = 0, u = 0;
+    while (i < nl || u < nu) {
+      // (L_i, L_i+1, U_u) and (L_i, U_u+1, U_u) are the two halves of the outward grid quad.
+      if (u == nu || (i < nl && angle_l(i + 1) < angle_u(u + 1))) {
+        faces.push_back({L(i), L(i + 1), U(u)});
+        ++i;
+      } else {
+        faces.push_back({L(i), U(u + 1), U(u)});
+        ++u;
+      }
+    }
   }
   m.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t f = 0; f < faces.size(); ++f) m.faces.row(f) << faces[f][0], faces[f][1], faces[f][2];
@@ -284,7 +344,7 @@ TriangleMesh make_dumbbell(int resolution) {
   rho.front() = rho.back() = 0.0;
   std::vector<double> r2, z2;
   resample_by_arclength(rho, z, rows_for(profile_length(rho, z), 1.0, resolution), r2, z2);
-  return revolve(r2, z2, resolution);
+  return revolve_closed(r2, z2, resolution);
 }
 
 TriangleMesh make_rounded_cylinder(double radius, double length, int resolution) {
@@ -307,7 +367,7 @@ TriangleMesh make_rounded_cylinder(double radius, double length, int resolution)
   rho.front() = rho.back() = 0.0;
   std::vector<double> r2, z2;
   resample_by_arclength(rho, z, rows_for(profile_length(rho, z), radius, resolution), r2, z2);
-  return revolve(r2, z2, resolution);
+  return revolve_closed(r2, z2, resolution);
 }
 
 TriangleMesh make_open_cylinder(double radius, double length, int n_around, int n_along) {

@@ -26,10 +26,12 @@ TriangleMesh make_torus(double R = 1.0, double r = 0.3, int n_major = 96, int n_
 TriangleMesh make_cubical_spiral(int turns = 3, int segments_per_turn = 128, int profile_segments = 8);
 /// Dumbbell: two spheres joined by a thin neck (closed, genus 0). Surface of revolution about z:
 /// unit spheres centred at z = ±1.5 joined by a smooth neck of radius 0.25; `resolution`
-/// vertices around, rings spaced to keep triangles near-equilateral on the spheres.
+/// vertices around the widest rings, fewer on narrower rings (proportional to the radius, at
+/// least 6) so triangles stay near-equilateral at the neck and the poles.
 TriangleMesh make_dumbbell(int resolution = 64);
 /// Closed cylinder with rounded (hemispherical) caps: the straight part spans
-/// z in [-length/2, length/2]; `resolution` vertices around. Genus 0.
+/// z in [-length/2, length/2]; `resolution` vertices around the cylinder, fewer on the cap
+/// rings (as for the dumbbell). Genus 0.
 TriangleMesh make_rounded_cylinder(double radius = 0.5, double length = 2.0, int resolution = 64);
 /// Open cylinder (two boundary loops), axis z, z in [-length/2, length/2], faces oriented away
 /// from the axis.

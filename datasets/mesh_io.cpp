@@ -8,10 +8,12 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +21,7 @@
 #include <sstream>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 namespace mcf {
 namespace {
@@ -59,6 +62,9 @@ std::string lower_extension(const std::string& path) {
 struct FileCounts {
   long long vertices = -1;   // -1: unknown for this format
   long long triangles = -1;  // after fan triangulation; -1: unknown
+  // Coordinates parsed in double precision (ASCII OFF/OBJ): OpenMesh's readers go through
+  // floats, which would round every coordinate of an exactly written file.
+  std::vector<double> coords;
 };
 
 // Strips '#' comments and surrounding blanks.
@@ -112,6 +118,7 @@ FileCounts scan_off(const std::string& path) {
       double x = std::strtod(p, &end);
       if (end == p) fail(path, "vertex " + std::to_string(v) + ": cannot parse coordinates '" + line + "'");
       if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate ('" + line + "')");
+      counts.coords.push_back(x);
       p = end;
     }
     ++v;
@@ -157,6 +164,7 @@ FileCounts scan_obj(const std::string& path) {
         double x = std::strtod(p, &end);
         if (end == p) fail(path, "vertex " + std::to_string(counts.vertices) + ": cannot parse '" + line + "'");
         if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(counts.vertices) + " has a non-finite coordinate ('" + line + "')");
+        counts.coords.push_back(x);
         p = end;
       }
       ++counts.vertices;
@@ -169,6 +177,7 @@ FileCounts scan_obj(const std::string& path) {
       counts.triangles += k - 2;
     }
   }
+  if (counts.vertices == 0 && counts.triangles == 0) fail(path, "no vertex or face records (not an OBJ file?)");
   return counts;
 }
 
@@ -222,6 +231,21 @@ FileCounts scan_stl(const std::string& path) {
   return counts;
 }
 
+// STL has no vertex list to count against; OpenMesh merges equal corners, so two loaded vertices
+// at exactly the same position mean it split a vertex to add a non-manifold face.
+void check_no_split_vertices(const std::string& path, const IoMesh& om) {
+  std::vector<std::array<double, 3>> points;
+  points.reserve(om.n_vertices());
+  for (auto vh : om.vertices()) {
+    const auto& p = om.point(vh);
+    points.push_back({p[0], p[1], p[2]});
+  }
+  std::sort(points.begin(), points.end());
+  if (std::adjacent_find(points.begin(), points.end()) != points.end())
+    fail(path, "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
+               "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
+}
+
 }  // namespace
 
 TriangleMesh read_mesh(const std::string& path) {
@@ -245,9 +269,16 @@ TriangleMesh read_mesh(const std::string& path) {
 
   const long long nv = static_cast<long long>(om.n_vertices());
   const long long nf = static_cast<long long>(om.n_faces());
+  // OpenMesh adds a face around a non-manifold ("complex") edge or vertex by duplicating its
+  // vertices, so more vertices than the file has means exactly that.
+  if (expected.vertices >= 0 && nv > expected.vertices)
+    fail(path, "non-manifold mesh: OpenMesh had to duplicate " + std::to_string(nv - expected.vertices) +
+                   " vertices to add faces around complex edges or vertices (an edge in more than two "
+                   "faces, or inconsistently oriented faces)");
   if (expected.vertices >= 0 && nv != expected.vertices)
     fail(path, "the file declares " + std::to_string(expected.vertices) + " vertices but " +
                    std::to_string(nv) + " were read");
+  if (ext == ".stl") check_no_split_vertices(path, om);
   if (expected.triangles >= 0 && nf < expected.triangles)
     fail(path, "only " + std::to_string(nf) + " of the file's " + std::to_string(expected.triangles) +
                    " triangles could be added: the mesh has non-manifold (complex) edges, repeated "
@@ -259,6 +290,12 @@ TriangleMesh read_mesh(const std::string& path) {
     const auto& p = om.point(vh);
     mesh.vertices.row(vh.idx()) << p[0], p[1], p[2];
   }
+  // Prefer our double-precision parse, after checking it is the same vertex sequence.
+  if (nv > 0 && static_cast<long long>(expected.coords.size()) == 3 * nv) {
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> exact(expected.coords.data(), nv, 3);
+    const double scale = std::max(1.0, exact.cwiseAbs().maxCoeff());
+    if ((exact - mesh.vertices).cwiseAbs().maxCoeff() <= 1e-5 * scale) mesh.vertices = exact;
+  }
   mesh.faces.resize(nf, 3);
   for (auto fh : om.faces()) {
     int c = 0;
@@ -269,6 +306,32 @@ TriangleMesh read_mesh(const std::string& path) {
   }
   return mesh;
 }
+
+namespace {
+
+// OFF and OBJ are written here rather than by OpenMesh, whose writers round coordinates to
+// float: with 17 significant digits an ASCII file reproduces every double exactly.
+bool write_ascii_exact(const fs::path& file, const TriangleMesh& mesh, bool obj) {
+  std::FILE* out = std::fopen(file.c_str(), "wb");
+  if (!out) return false;
+  std::vector<char> buffer(1 << 20);
+  std::setvbuf(out, buffer.data(), _IOFBF, buffer.size());
+  if (obj) std::fprintf(out, "# %lld vertices, %lld faces\n", static_cast<long long>(mesh.num_vertices()),
+                        static_cast<long long>(mesh.num_faces()));
+  else std::fprintf(out, "OFF\n%lld %lld 0\n", static_cast<long long>(mesh.num_vertices()),
+                    static_cast<long long>(mesh.num_faces()));
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v)
+    std::fprintf(out, obj ? "v %.17g %.17g %.17g\n" : "%.17g %.17g %.17g\n", mesh.vertices(v, 0), mesh.vertices(v, 1),
+                 mesh.vertices(v, 2));
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
+    if (obj) std::fprintf(out, "f %d %d %d\n", mesh.faces(f, 0) + 1, mesh.faces(f, 1) + 1, mesh.faces(f, 2) + 1);
+    else std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
+  }
+  const bool ok = std::ferror(out) == 0;
+  return std::fclose(out) == 0 && ok;
+}
+
+}  // namespace
 
 void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) {
   silence_openmesh();
@@ -304,8 +367,10 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) 
   fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
                         std::to_string(counter++) + target.extension().string());
-  // 17 significant digits: ASCII files round-trip doubles exactly.
-  if (!OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17)) {
+  const bool written = (ext == ".off" || ext == ".obj")
+                           ? write_ascii_exact(tmp, mesh, ext == ".obj")
+                           : OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17);
+  if (!written) {
     std::error_code ec;
     fs::remove(tmp, ec);
     fail(path, "OpenMesh could not write the file (folder missing or not writable?)");

@@ -3,6 +3,8 @@
 
 #include "datasets/validate.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
