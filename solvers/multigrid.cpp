@@ -140,7 +140,7 @@ inline void transpose_add_rows(const Csc& M, const double* v, double* y, std::si
 SparseMatrix symbolic_product(const SparseMatrix& Xm, const SparseMatrix& Ym) {
   const Csc X(Xm), Y(Ym);
   const int m = X.rows, q = Y.cols;
-  std::vector<std::vector<int>> cols(std::size_t(q));
+  std::vector<std::vector<int>> cols(static_cast<std::size_t>(q));
   tbb::enumerable_thread_specific<std::vector<int>> marks([m] { return std::vector<int>(std::size_t(m), -1); });
   tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
     auto& mark = marks.local();
