@@ -11,6 +11,17 @@
 // post-smoothing sweeps colours 7..0 (serial fallback: rows n-1..0). Within one colour the
 // functions are independent, so their order does not change the result. With pre_smooth ==
 // post_smooth the cycle, started from zero, is a symmetric operator (precondition()).
+//
+// Layout and cost: right-hand sides are interleaved (row-major n x k) in preallocated per-level
+// buffers, all columns are relaxed in the same sweep (chunks of up to 4 columns). Per cycle on
+// level l: pre + post sweeps, one residual, restriction b_c = Pᵀ r (gather over P's columns),
+// prolongation x += P x_c (gather over the columns of the stored Pᵀ). The Galerkin product is
+// two-stage, R = A_{l+1} P then A_l = Pᵀ R, with both patterns built once (symbolic_builds());
+// later set_matrix calls only recompute values, column-parallel with thread-local dense
+// accumulators, then symmetrize A_l exactly. Measured on a 65^3 grid (7.2M nonzeros, 3 columns,
+// 1 thread, shared noisy machine): one W-cycle (5+5 sweeps, 6 levels) ~ 11.8-13.5 Eigen SpMVs
+// (A * X) ~ 18-22 of the solver's
+// own fused residual evaluations; a numeric set_matrix ~ 3-5 Eigen SpMVs.
 
 #include "solvers/linear_solver.h"
 
