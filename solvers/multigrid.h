@@ -20,8 +20,8 @@
 // later set_matrix calls only recompute values, column-parallel with thread-local dense
 // accumulators, then symmetrize A_l exactly. Measured on a 65^3 grid (7.2M nonzeros, 3 columns,
 // 1 thread, shared noisy machine): one W-cycle (5+5 sweeps, 6 levels) ~ 11.8-13.5 Eigen SpMVs
-// (A * X) ~ 18-22 of the solver's
-// own fused residual evaluations; a numeric set_matrix ~ 3-5 Eigen SpMVs.
+// (A * X) ~ 18-22 of the solver's own fused residual evaluations; a numeric set_matrix ~ 3-5
+// Eigen SpMVs.
 
 #include "solvers/linear_solver.h"
 
