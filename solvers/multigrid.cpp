@@ -1,0 +1,659 @@
+#include "solvers/multigrid.h"
+
+#include <Eigen/SparseCholesky>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+namespace mcf {
+
+const char* to_string(MultigridCycle c) { return c == MultigridCycle::V ? "V" : "W"; }
+
+namespace {
+
+constexpr int kGrain = 256;            // rows per TBB task
+constexpr int kSerialBelow = 2048;     // loops shorter than this run serially (same result)
+
+/// Runs f(begin, end) over [0, n), in parallel when n is large enough. Every kernel writes
+/// disjoint outputs and reads nothing that the same loop writes, so the split is irrelevant.
+template <class F>
+void for_rows(int n, F&& f) {
+  if (n < kSerialBelow) {
+    f(0, n);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain),
+                    [&](const tbb::blocked_range<int>& r) { f(r.begin(), r.end()); });
+}
+
+template <int K>
+using Cols = std::integral_constant<int, K>;
+
+/// Splits k right-hand sides into chunks of at most 4 columns (the columns are independent in
+/// every kernel, so this changes nothing but the code the compiler can unroll).
+template <class F>
+void for_column_chunks(int k, F&& f) {
+  int o = 0;
+  for (; k - o >= 4; o += 4) f(Cols<4>{}, o);
+  switch (k - o) {
+    case 1: f(Cols<1>{}, o); break;
+    case 2: f(Cols<2>{}, o); break;
+    case 3: f(Cols<3>{}, o); break;
+    default: break;
+  }
+}
+
+/// Raw view of a compressed column-major matrix.
+struct Csc {
+  int rows = 0, cols = 0;
+  const int* outer = nullptr;
+  const int* inner = nullptr;
+  const double* val = nullptr;
+  explicit Csc(const SparseMatrix& m)
+      : rows(int(m.rows())), cols(int(m.cols())), outer(m.outerIndexPtr()),
+        inner(m.innerIndexPtr()), val(m.valuePtr()) {}
+};
+
+// ---- kernels on interleaved buffers: entry (i, c) of an n x k block lives at i*s + c -------
+
+/// One Gauss-Seidel update of row i (= column i of the symmetric CSC matrix), columns o..o+K-1.
+template <int K>
+inline void gs_row(const Csc& A, const double* inv_diag, const double* b, double* x, std::size_t s,
+                   int o, int i) {
+  double acc[K];
+  const std::size_t ii = std::size_t(i) * s + o;
+  for (int c = 0; c < K; ++c) acc[c] = b[ii + c];
+  for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
+    const int j = A.inner[p];
+    if (j == i) continue;
+    const double a = A.val[p];
+    const double* xj = x + std::size_t(j) * s + o;
+    for (int c = 0; c < K; ++c) acc[c] -= a * xj[c];
+  }
+  const double d = inv_diag[i];
+  for (int c = 0; c < K; ++c) x[ii + c] = acc[c] * d;
+}
+
+/// r = b - A x (rows [begin, end)).
+template <int K>
+inline void residual_rows(const Csc& A, const double* b, const double* x, double* r, std::size_t s,
+                          int o, int begin, int end) {
+  for (int i = begin; i < end; ++i) {
+    double acc[K];
+    const std::size_t ii = std::size_t(i) * s + o;
+    for (int c = 0; c < K; ++c) acc[c] = b[ii + c];
+    for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
+      const double a = A.val[p];
+      const double* xj = x + std::size_t(A.inner[p]) * s + o;
+      for (int c = 0; c < K; ++c) acc[c] -= a * xj[c];
+    }
+    for (int c = 0; c < K; ++c) r[ii + c] = acc[c];
+  }
+}
+
+/// y = Mᵀ v restricted to output rows [begin, end) = columns of M (gather along columns).
+template <int K>
+inline void transpose_apply_rows(const Csc& M, const double* v, double* y, std::size_t s, int o,
+                                 int begin, int end) {
+  for (int J = begin; J < end; ++J) {
+    double acc[K] = {};
+    for (int p = M.outer[J]; p < M.outer[J + 1]; ++p) {
+      const double w = M.val[p];
+      const double* vi = v + std::size_t(M.inner[p]) * s + o;
+      for (int c = 0; c < K; ++c) acc[c] += w * vi[c];
+    }
+    double* yJ = y + std::size_t(J) * s + o;
+    for (int c = 0; c < K; ++c) yJ[c] = acc[c];
+  }
+}
+
+/// y += Mᵀ v (rows [begin, end) of the output).
+template <int K>
+inline void transpose_add_rows(const Csc& M, const double* v, double* y, std::size_t s, int o,
+                               int begin, int end) {
+  for (int J = begin; J < end; ++J) {
+    double acc[K] = {};
+    for (int p = M.outer[J]; p < M.outer[J + 1]; ++p) {
+      const double w = M.val[p];
+      const double* vi = v + std::size_t(M.inner[p]) * s + o;
+      for (int c = 0; c < K; ++c) acc[c] += w * vi[c];
+    }
+    double* yJ = y + std::size_t(J) * s + o;
+    for (int c = 0; c < K; ++c) yJ[c] += acc[c];
+  }
+}
+
+// ---- sparse products with a precomputed pattern ------------------------------------------
+
+/// Pattern of X * Y (sorted row indices, zero values). Parallel over the columns of Y.
+SparseMatrix symbolic_product(const SparseMatrix& Xm, const SparseMatrix& Ym) {
+  const Csc X(Xm), Y(Ym);
+  const int m = X.rows, q = Y.cols;
+  std::vector<std::vector<int>> cols(static_cast<std::size_t>(q));
+  tbb::enumerable_thread_specific<std::vector<int>> marks([m] { return std::vector<int>(std::size_t(m), -1); });
+  tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
+    auto& mark = marks.local();
+    for (int J = r.begin(); J < r.end(); ++J) {
+      auto& c = cols[std::size_t(J)];
+      for (int p = Y.outer[J]; p < Y.outer[J + 1]; ++p) {
+        const int t = Y.inner[p];
+        for (int a = X.outer[t]; a < X.outer[t + 1]; ++a) {
+          const int i = X.inner[a];
+          if (mark[std::size_t(i)] != J) {
+            mark[std::size_t(i)] = J;
+            c.push_back(i);
+          }
+        }
+      }
+      std::sort(c.begin(), c.end());
+    }
+  });
+  std::size_t nnz = 0;
+  for (const auto& c : cols) nnz += c.size();
+  SparseMatrix M(m, q);
+  M.resizeNonZeros(Eigen::Index(nnz));
+  int* outer = M.outerIndexPtr();
+  outer[0] = 0;
+  for (int J = 0; J < q; ++J) outer[J + 1] = outer[J] + int(cols[std::size_t(J)].size());
+  tbb::parallel_for(0, q, [&](int J) {
+    std::copy(cols[std::size_t(J)].begin(), cols[std::size_t(J)].end(), M.innerIndexPtr() + outer[J]);
+  });
+  std::fill(M.valuePtr(), M.valuePtr() + nnz, 0.0);
+  return M;
+}
+
+using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
+
+/// Values of M = X * Y on M's precomputed pattern. Parallel over the columns of M, each column
+/// accumulated in a fixed order in a thread-local dense accumulator: deterministic.
+void numeric_product(const SparseMatrix& Xm, const SparseMatrix& Ym, SparseMatrix& Mm, Spa& spa) {
+  const Csc X(Xm), Y(Ym);
+  const int m = X.rows;
+  const int* Mouter = Mm.outerIndexPtr();
+  const int* Minner = Mm.innerIndexPtr();
+  double* Mval = Mm.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<int>(0, Y.cols, 64), [&](const tbb::blocked_range<int>& r) {
+    auto& acc = spa.local();
+    if (acc.size() < std::size_t(m)) acc.assign(std::size_t(m), 0.0);
+    for (int J = r.begin(); J < r.end(); ++J) {
+      for (int p = Y.outer[J]; p < Y.outer[J + 1]; ++p) {
+        const int t = Y.inner[p];
+        const double w = Y.val[p];
+        for (int a = X.outer[t]; a < X.outer[t + 1]; ++a) acc[std::size_t(X.inner[a])] += X.val[a] * w;
+      }
+      for (int e = Mouter[J]; e < Mouter[J + 1]; ++e) {
+        double& v = acc[std::size_t(Minner[e])];
+        Mval[e] = v;
+        v = 0.0;
+      }
+    }
+  });
+}
+
+bool same_pattern(const SparseMatrix& a, const SparseMatrix& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
+  if (!a.isCompressed() || !b.isCompressed()) return false;
+  return std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
+         std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
+}
+
+bool same_matrix(const SparseMatrix& a, const SparseMatrix& b) {
+  return same_pattern(a, b) &&
+         std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr());
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+
+struct MultigridSolver::Impl {
+  struct Level {
+    SparseMatrix A;                    // compressed, sorted, symmetric pattern
+    std::vector<int> transpose_pos;    // entry e=(i,J) -> position of (J,i) (coarse levels)
+    std::vector<double> inv_diag;
+    bool coloured = false;
+    std::array<int, 9> colour_start{};
+    std::vector<int> colour_rows;      // rows of colour c at [colour_start[c], colour_start[c+1])
+    // Transfer to the next finer level (absent on the finest level).
+    SparseMatrix P;                    // n_{l+1} x n_l
+    SparseMatrix PT;                   // n_l x n_{l+1}
+    SparseMatrix R;                    // A_{l+1} P (pattern fixed after the symbolic build)
+    Spa spa_R, spa_A;
+    // Work buffers (interleaved n x k).
+    std::vector<double> x, b, r;
+    int n() const { return int(A.rows()); }
+  };
+
+  std::vector<Level> levels;           // coarsest first
+  std::vector<std::vector<std::uint8_t>> colours;  // as given (to detect changes)
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+  Eigen::MatrixXd coarse_rhs, coarse_sol;
+  int k = 0;                           // columns the buffers are sized for
+  bool ready = false;
+  std::int64_t symbolic_builds = 0, numeric_builds = 0;
+
+  void ensure_buffers(int cols) {
+    if (cols == k) return;
+    k = cols;
+    for (auto& L : levels) {
+      const std::size_t sz = std::size_t(L.n()) * std::size_t(k);
+      L.x.assign(sz, 0.0);
+      L.b.assign(sz, 0.0);
+      L.r.assign(sz, 0.0);
+    }
+    coarse_rhs.resize(levels.front().n(), k);
+    coarse_sol.resize(levels.front().n(), k);
+  }
+
+  void build_colours(int l, const std::vector<std::uint8_t>* given) {
+    Level& L = levels[std::size_t(l)];
+    L.coloured = false;
+    L.colour_rows.clear();
+    if (given == nullptr || int(given->size()) != L.n()) return;
+    const auto& col = *given;
+    // Validate: colours in 0..7 and no two functions of one colour couple.
+    for (int i = 0; i < L.n(); ++i)
+      if (col[std::size_t(i)] > 7) return;
+    const Csc A(L.A);
+    for (int i = 0; i < L.n(); ++i)
+      for (int p = A.outer[i]; p < A.outer[i + 1]; ++p)
+        if (A.inner[p] != i && col[std::size_t(A.inner[p])] == col[std::size_t(i)]) return;
+    std::array<int, 9> start{};
+    for (int i = 0; i < L.n(); ++i) ++start[col[std::size_t(i)] + 1u];
+    for (int c = 0; c < 8; ++c) start[std::size_t(c) + 1] += start[std::size_t(c)];
+    L.colour_start = start;
+    L.colour_rows.resize(std::size_t(L.n()));
+    auto fill = start;
+    for (int i = 0; i < L.n(); ++i) L.colour_rows[std::size_t(fill[col[std::size_t(i)]]++)] = i;
+    L.coloured = true;
+  }
+
+  void symbolic(const SparseMatrix& A, const std::vector<SparseMatrix>& P,
+                const std::vector<std::vector<std::uint8_t>>* given_colours) {
+    const std::size_t nl = P.size() + 1;
+    levels.clear();
+    levels.resize(nl);
+    levels.back().A = A;
+    levels.back().A.makeCompressed();
+    for (std::size_t l = 0; l + 1 < nl; ++l) {
+      levels[l].P = P[l];
+      levels[l].P.makeCompressed();
+      levels[l].PT = SparseMatrix(levels[l].P.transpose());
+      levels[l].PT.makeCompressed();
+    }
+    for (std::size_t l = nl - 1; l-- > 0;) {
+      Level& C = levels[l];
+      C.R = symbolic_product(levels[l + 1].A, C.P);
+      C.A = symbolic_product(C.PT, C.R);
+      // Positions of transposed entries, to symmetrize the computed values exactly.
+      const Csc M(C.A);
+      C.transpose_pos.assign(std::size_t(C.A.nonZeros()), -1);
+      tbb::parallel_for(0, M.cols, [&](int J) {
+        for (int e = M.outer[J]; e < M.outer[J + 1]; ++e) {
+          const int i = M.inner[e];
+          const int* b = M.inner + M.outer[i];
+          const int* en = M.inner + M.outer[i + 1];
+          const int* it = std::lower_bound(b, en, J);
+          if (it != en && *it == J) C.transpose_pos[std::size_t(e)] = int(it - M.inner);
+        }
+      });
+    }
+    colours.clear();
+    if (given_colours != nullptr) colours = *given_colours;
+    for (std::size_t l = 0; l < nl; ++l)
+      build_colours(int(l), l < colours.size() ? &colours[l] : nullptr);
+    k = 0;
+    ++symbolic_builds;
+  }
+
+  /// Numerical values of all levels from the finest level's values (already in place).
+  /// Returns false when a diagonal entry is negative or not finite.
+  bool numeric() {
+    for (std::size_t l = levels.size() - 1; l-- > 0;) {
+      Level& C = levels[l];
+      numeric_product(levels[l + 1].A, C.P, C.R, C.spa_R);
+      numeric_product(C.PT, C.R, C.A, C.spa_A);
+      double* v = C.A.valuePtr();
+      const Csc M(C.A);
+      tbb::parallel_for(0, M.cols, [&](int J) {
+        for (int e = M.outer[J]; e < M.outer[J + 1]; ++e) {
+          const int t = C.transpose_pos[std::size_t(e)];
+          if (M.inner[e] > J && t >= 0) {
+            const double s = 0.5 * (v[e] + v[t]);
+            v[e] = s;
+            v[t] = s;
+          }
+        }
+      });
+    }
+    bool ok = true;
+    for (auto& L : levels) {
+      const Csc A(L.A);
+      L.inv_diag.assign(std::size_t(L.n()), 0.0);
+      for (int i = 0; i < L.n(); ++i) {
+        const int* b = A.inner + A.outer[i];
+        const int* e = A.inner + A.outer[i + 1];
+        const int* it = std::lower_bound(b, e, i);
+        const double d = (it != e && *it == i) ? A.val[it - A.inner] : 0.0;
+        if (!(d >= 0.0) || !std::isfinite(d)) ok = false;
+        L.inv_diag[std::size_t(i)] = d > 0.0 ? 1.0 / d : 0.0;
+      }
+    }
+    ++numeric_builds;
+    return ok;
+  }
+
+  // ---- cycle ----
+
+  void sweep(int l, bool reverse) {
+    Level& L = levels[std::size_t(l)];
+    const Csc A(L.A);
+    const std::size_t s = std::size_t(k);
+    const double* id = L.inv_diag.data();
+    const double* b = L.b.data();
+    double* x = L.x.data();
+    for_column_chunks(k, [&](auto KC, int o) {
+      constexpr int K = decltype(KC)::value;
+      if (L.coloured) {
+        for (int ci = 0; ci < 8; ++ci) {
+          const int c = reverse ? 7 - ci : ci;
+          const int first = L.colour_start[std::size_t(c)];
+          const int count = L.colour_start[std::size_t(c) + 1] - first;
+          const int* rows = L.colour_rows.data() + first;
+          for_rows(count, [&](int bgn, int end) {
+            for (int t = bgn; t < end; ++t) gs_row<K>(A, id, b, x, s, o, rows[t]);
+          });
+        }
+      } else if (!reverse) {
+        for (int i = 0; i < A.cols; ++i) gs_row<K>(A, id, b, x, s, o, i);
+      } else {
+        for (int i = A.cols - 1; i >= 0; --i) gs_row<K>(A, id, b, x, s, o, i);
+      }
+    });
+  }
+
+  void residual(int l) {
+    Level& L = levels[std::size_t(l)];
+    const Csc A(L.A);
+    const std::size_t s = std::size_t(k);
+    for_column_chunks(k, [&](auto KC, int o) {
+      constexpr int K = decltype(KC)::value;
+      for_rows(A.cols, [&](int b, int e) { residual_rows<K>(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e); });
+    });
+  }
+
+  void coarse_solve() {
+    Level& L = levels.front();
+    const int n = L.n();
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < k; ++c) coarse_rhs(i, c) = L.b[std::size_t(i) * std::size_t(k) + std::size_t(c)];
+    coarse_sol = ldlt.solve(coarse_rhs);
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < k; ++c) L.x[std::size_t(i) * std::size_t(k) + std::size_t(c)] = coarse_sol(i, c);
+  }
+
+  void cycle(int l, const MultigridOptions& opt) {
+    if (l == 0) {
+      coarse_solve();
+      return;
+    }
+    Level& F = levels[std::size_t(l)];
+    Level& C = levels[std::size_t(l) - 1];
+    const std::size_t s = std::size_t(k);
+    for (int i = 0; i < opt.pre_smooth; ++i) sweep(l, false);
+    residual(l);
+    // Restriction: b_C = Pᵀ r_F (gather over the columns of P).
+    const Csc P(C.P), PT(C.PT);
+    for_column_chunks(k, [&](auto KC, int o) {
+      constexpr int K = decltype(KC)::value;
+      for_rows(P.cols, [&](int b, int e) { transpose_apply_rows<K>(P, F.r.data(), C.b.data(), s, o, b, e); });
+    });
+    std::fill(C.x.begin(), C.x.end(), 0.0);
+    // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
+    const int gamma = (opt.cycle == MultigridCycle::W && l - 1 > 0) ? 2 : 1;
+    for (int g = 0; g < gamma; ++g) cycle(l - 1, opt);
+    // Prolongation: x_F += P x_C (gather over the columns of Pᵀ = rows of P).
+    for_column_chunks(k, [&](auto KC, int o) {
+      constexpr int K = decltype(KC)::value;
+      for_rows(PT.cols, [&](int b, int e) { transpose_add_rows<K>(PT, C.x.data(), F.x.data(), s, o, b, e); });
+    });
+    for (int i = 0; i < opt.post_smooth; ++i) sweep(l, true);
+  }
+
+  /// max over columns of ||b - A x|| / ||b|| on the finest level (deterministic reduction).
+  double relative_residual(const Eigen::VectorXd& bnorm) {
+    Level& L = levels.back();
+    const Csc A(L.A);
+    const std::size_t s = std::size_t(k);
+    std::vector<double> rn(std::size_t(k), 0.0);
+    for_column_chunks(k, [&](auto KC, int o) {
+      constexpr int K = decltype(KC)::value;
+      using Acc = std::array<double, K>;
+      const Acc sum = tbb::parallel_deterministic_reduce(
+          tbb::blocked_range<int>(0, A.cols, 4096), Acc{},
+          [&](const tbb::blocked_range<int>& r, Acc acc) {
+            for (int i = r.begin(); i < r.end(); ++i) {
+              double res[K];
+              const std::size_t ii = std::size_t(i) * s + o;
+              for (int c = 0; c < K; ++c) res[c] = L.b[ii + c];
+              for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
+                const double a = A.val[p];
+                const double* xj = L.x.data() + std::size_t(A.inner[p]) * s + o;
+                for (int c = 0; c < K; ++c) res[c] -= a * xj[c];
+              }
+              for (int c = 0; c < K; ++c) acc[std::size_t(c)] += res[c] * res[c];
+            }
+            return acc;
+          },
+          [](Acc a, const Acc& b) {
+            for (int c = 0; c < K; ++c) a[std::size_t(c)] += b[std::size_t(c)];
+            return a;
+          });
+      for (int c = 0; c < K; ++c) rn[std::size_t(o + c)] = sum[std::size_t(c)];
+    });
+    double worst = 0.0;
+    for (int c = 0; c < k; ++c) {
+      const double r = std::sqrt(rn[std::size_t(c)]);
+      const double rel = bnorm[c] > 0.0 ? r / bnorm[c] : r;
+      if (std::isnan(rel)) return rel;
+      worst = std::max(worst, rel);
+    }
+    return worst;
+  }
+
+  void load(std::vector<double>& dst, const Eigen::MatrixXd& src) {
+    const std::size_t s = std::size_t(k);
+    for_rows(int(src.rows()), [&](int b, int e) {
+      for (int c = 0; c < k; ++c)
+        for (int i = b; i < e; ++i) dst[std::size_t(i) * s + std::size_t(c)] = src(i, c);
+    });
+  }
+  void store(const std::vector<double>& src, Eigen::MatrixXd& dst) {
+    const std::size_t s = std::size_t(k);
+    for_rows(int(dst.rows()), [&](int b, int e) {
+      for (int c = 0; c < k; ++c)
+        for (int i = b; i < e; ++i) dst(i, c) = src[std::size_t(i) * s + std::size_t(c)];
+    });
+  }
+};
+
+// ------------------------------------------------------------------------------------------
+
+MultigridSolver::MultigridSolver(MultigridOptions options)
+    : options_(options), impl_(std::make_unique<Impl>()) {}
+MultigridSolver::~MultigridSolver() = default;
+MultigridSolver::MultigridSolver(MultigridSolver&&) noexcept = default;
+MultigridSolver& MultigridSolver::operator=(MultigridSolver&&) noexcept = default;
+
+std::string MultigridSolver::name() const {
+  return std::string("multigrid-") + to_string(options_.cycle);
+}
+
+int MultigridSolver::levels() const { return impl_->ready ? int(impl_->levels.size()) : 0; }
+const SparseMatrix& MultigridSolver::level_matrix(int l) const { return impl_->levels.at(std::size_t(l)).A; }
+bool MultigridSolver::level_is_coloured(int l) const { return impl_->levels.at(std::size_t(l)).coloured; }
+std::int64_t MultigridSolver::symbolic_builds() const { return impl_->symbolic_builds; }
+std::int64_t MultigridSolver::numeric_builds() const { return impl_->numeric_builds; }
+
+SolveReport MultigridSolver::set_matrix(const SparseMatrix& A_in, HierarchyView hierarchy) {
+  SolveReport rep;
+  Impl& m = *impl_;
+  m.ready = false;
+  auto fail = [&](SolveStatus st, std::string msg) {
+    rep.status = st;
+    rep.message = std::move(msg);
+    return rep;
+  };
+  if (A_in.rows() != A_in.cols() || A_in.rows() == 0) return fail(SolveStatus::failed, "matrix is not square or empty");
+  SparseMatrix compressed;
+  const SparseMatrix* Ap = &A_in;
+  if (!A_in.isCompressed()) {
+    compressed = A_in;
+    compressed.makeCompressed();
+    Ap = &compressed;
+  }
+  const SparseMatrix& A = *Ap;
+
+  static const std::vector<SparseMatrix> kNone;
+  const std::vector<SparseMatrix>& P = hierarchy.empty() ? kNone : *hierarchy.prolongations;
+  const auto* colours = hierarchy.colours;
+  // Dimensions: P[l] maps level l to l+1; the last one maps onto A's level.
+  Eigen::Index fine = A.rows();
+  for (std::size_t l = P.size(); l-- > 0;) {
+    if (P[l].rows() != fine || P[l].cols() <= 0)
+      return fail(SolveStatus::failed, "prolongation " + std::to_string(l) + " has wrong dimensions");
+    fine = P[l].cols();
+  }
+
+  bool need_symbolic = m.levels.size() != P.size() + 1 || !same_pattern(m.levels.back().A, A);
+  for (std::size_t l = 0; !need_symbolic && l < P.size(); ++l)
+    need_symbolic = !P[l].isCompressed() || !same_matrix(m.levels[l].P, P[l]);
+  if (!need_symbolic) {
+    const std::size_t nc = colours ? colours->size() : 0;
+    need_symbolic = nc != m.colours.size() || (nc > 0 && *colours != m.colours);
+  }
+  if (need_symbolic) {
+    m.symbolic(A, P, colours);
+  } else {
+    std::copy(A.valuePtr(), A.valuePtr() + A.nonZeros(), m.levels.back().A.valuePtr());
+  }
+  const bool diag_ok = m.numeric();
+
+  if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);
+  m.ldlt.factorize(m.levels.front().A);
+  if (!diag_ok) return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
+  if (m.ldlt.info() != Eigen::Success)
+    return fail(SolveStatus::not_positive_definite, "coarsest-level factorization failed");
+  const Eigen::VectorXd D = m.ldlt.vectorD();
+  if (D.size() > 0 && !(D.minCoeff() > 0.0))
+    return fail(SolveStatus::not_positive_definite, "coarsest-level matrix is not positive definite");
+  for (std::size_t l = 1; l < m.levels.size(); ++l)
+    if (!m.levels[l].coloured)
+      rep.message += (rep.message.empty() ? "" : "; ") + std::string("level ") + std::to_string(l) +
+                     " uses serial Gauss-Seidel (no valid colouring)";
+  m.ready = true;
+  rep.iterations = 0;
+  return rep;
+}
+
+SolveReport MultigridSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
+  SolveReport rep;
+  Impl& m = *impl_;
+  if (!m.ready) {
+    rep.status = SolveStatus::failed;
+    rep.message = "set_matrix was not called or failed";
+    return rep;
+  }
+  const int n = m.levels.back().n();
+  if (B.rows() != n) {
+    rep.status = SolveStatus::failed;
+    rep.message = "right-hand side has the wrong number of rows";
+    return rep;
+  }
+  const int k = int(B.cols());
+  if (X.rows() != n || X.cols() != k) X.setZero(n, k);
+  if (k == 0) return rep;
+  m.ensure_buffers(k);
+  auto& fine = m.levels.back();
+  m.load(fine.b, B);
+  m.load(fine.x, X);
+  const Eigen::VectorXd bnorm = B.colwise().norm().transpose();
+  const int top = int(m.levels.size()) - 1;
+  const double tol = options_.tolerance;
+
+  double rel = tol > 0.0 ? m.relative_residual(bnorm) : std::numeric_limits<double>::infinity();
+  if (tol > 0.0 && rel < tol) {
+    rep.relative_residual = rel;
+    return rep;
+  }
+  rep.status = SolveStatus::max_iterations;
+  for (int c = 0; c < std::max(options_.cycles, 0); ++c) {
+    m.cycle(top, options_);
+    rel = m.relative_residual(bnorm);
+    rep.residuals.push_back(rel);
+    rep.iterations = c + 1;
+    if (!std::isfinite(rel)) {
+      rep.status = SolveStatus::numerical_issue;
+      rep.message = "NaN or infinity in the multigrid iterate";
+      break;
+    }
+    if (tol > 0.0 && rel < tol) {
+      rep.status = SolveStatus::converged;
+      break;
+    }
+  }
+  if (tol <= 0.0 && rep.status == SolveStatus::max_iterations && std::isfinite(rel))
+    rep.status = SolveStatus::converged;
+  if (rep.iterations == 0 && tol <= 0.0) {  // cycles == 0: report the warm start's residual
+    rel = m.relative_residual(bnorm);
+    rep.status = std::isfinite(rel) ? SolveStatus::converged : SolveStatus::numerical_issue;
+  }
+  rep.relative_residual = rel;
+  m.store(fine.x, X);
+  return rep;
+}
+
+void MultigridSolver::precondition(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) {
+  Impl& m = *impl_;
+  if (!m.ready) throw std::logic_error("MultigridSolver::precondition before set_matrix");
+  const int n = m.levels.back().n();
+  if (r.rows() != n) throw std::invalid_argument("MultigridSolver::precondition: wrong size");
+  const int k = int(r.cols());
+  if (z.rows() != n || z.cols() != k) z.resize(n, k);
+  if (k == 0) return;
+  m.ensure_buffers(k);
+  auto& fine = m.levels.back();
+  m.load(fine.b, r);
+  std::fill(fine.x.begin(), fine.x.end(), 0.0);
+  m.cycle(int(m.levels.size()) - 1, options_);
+  m.store(fine.x, z);
+}
+
+void MultigridSolver::gauss_seidel(int l, const Eigen::MatrixXd& B, Eigen::MatrixXd& X, int sweeps,
+                                   bool reverse) {
+  Impl& m = *impl_;
+  if (!m.ready) throw std::logic_error("MultigridSolver::gauss_seidel before set_matrix");
+  auto& L = m.levels.at(std::size_t(l));
+  if (B.rows() != L.n() || X.rows() != L.n() || X.cols() != B.cols())
+    throw std::invalid_argument("MultigridSolver::gauss_seidel: wrong size");
+  const int k = int(B.cols());
+  if (k == 0) return;
+  m.ensure_buffers(k);
+  m.load(L.b, B);
+  m.load(L.x, X);
+  for (int i = 0; i < sweeps; ++i) m.sweep(l, reverse);
+  m.store(L.x, X);
+}
+
+}  // namespace mcf

@@ -1,0 +1,551 @@
+// MultigridSolver on synthetic grid problems: a regular 3D grid of trilinear functions
+// (depth d: (2^d+1)^3 functions), A = M + dt K of the trilinear finite elements on the unit cube,
+// 1-D refinement (1/2, 1, 1/2) tensor prolongations, parity colours. Variants drop functions
+// (a spherical shell, as an octree around a surface would; or random), so P loses rows/columns.
+
+#include "solvers/multigrid.h"
+
+#include <Eigen/SparseCholesky>
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <random>
+#include <vector>
+
+namespace {
+
+using mcf::HierarchyView;
+using mcf::MultigridCycle;
+using mcf::MultigridOptions;
+using mcf::MultigridSolver;
+using mcf::SolveStatus;
+using mcf::SparseMatrix;
+using Triplets = std::vector<Eigen::Triplet<double, int>>;
+
+struct Problem {
+  SparseMatrix A;                                      // finest level
+  std::vector<SparseMatrix> P;                         // coarsest first
+  std::vector<std::vector<std::uint8_t>> colours;      // per level, coarsest first
+  HierarchyView view() const { return {&P, &colours}; }
+};
+
+int vid(int N, int i, int j, int k) { return i + (N + 1) * (j + (N + 1) * k); }
+
+double m1(int N, int a, int b) {
+  const double h = 1.0 / N;
+  if (a != b) return h / 6;
+  return (a == 0 || a == N) ? h / 3 : 2 * h / 3;
+}
+double k1(int N, int a, int b) {
+  const double h = 1.0 / N;
+  if (a != b) return -1 / h;
+  return (a == 0 || a == N) ? 1 / h : 2 / h;
+}
+
+SparseMatrix grid_matrix(int N, double dt) {
+  const int n = (N + 1) * (N + 1) * (N + 1);
+  Triplets t;
+  t.reserve(std::size_t(n) * 27);
+  for (int k = 0; k <= N; ++k)
+    for (int j = 0; j <= N; ++j)
+      for (int i = 0; i <= N; ++i)
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int a = i + di, b = j + dj, c = k + dk;
+              if (a < 0 || b < 0 || c < 0 || a > N || b > N || c > N) continue;
+              const double mx = m1(N, i, a), my = m1(N, j, b), mz = m1(N, k, c);
+              const double v = mx * my * mz + dt * (k1(N, i, a) * my * mz + mx * k1(N, j, b) * mz +
+                                                    mx * my * k1(N, k, c));
+              t.emplace_back(vid(N, i, j, k), vid(N, a, b, c), v);
+            }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+/// Prolongation from the grid with Nc cells per axis to 2 Nc.
+SparseMatrix grid_prolongation(int Nc) {
+  const int N = 2 * Nc;
+  Triplets t;
+  for (int K = 0; K <= Nc; ++K)
+    for (int J = 0; J <= Nc; ++J)
+      for (int I = 0; I <= Nc; ++I)
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int a = 2 * I + di, b = 2 * J + dj, c = 2 * K + dk;
+              if (a < 0 || b < 0 || c < 0 || a > N || b > N || c > N) continue;
+              const double w = (di ? 0.5 : 1.0) * (dj ? 0.5 : 1.0) * (dk ? 0.5 : 1.0);
+              t.emplace_back(vid(N, a, b, c), vid(Nc, I, J, K), w);
+            }
+  SparseMatrix P((N + 1) * (N + 1) * (N + 1), (Nc + 1) * (Nc + 1) * (Nc + 1));
+  P.setFromTriplets(t.begin(), t.end());
+  P.makeCompressed();
+  return P;
+}
+
+std::vector<std::uint8_t> grid_colours(int N) {
+  std::vector<std::uint8_t> c(std::size_t((N + 1) * (N + 1) * (N + 1)));
+  for (int k = 0; k <= N; ++k)
+    for (int j = 0; j <= N; ++j)
+      for (int i = 0; i <= N; ++i) c[std::size_t(vid(N, i, j, k))] = std::uint8_t((i & 1) | (j & 1) << 1 | (k & 1) << 2);
+  return c;
+}
+
+enum class Drop { none, shell, random };
+
+/// Levels of depth coarsest..depth. Drop::shell keeps the finest functions near a sphere of
+/// radius 0.3 (and the coarse functions with a kept child), Drop::random drops 15 %.
+Problem make_problem(int depth, int coarsest, double dt, Drop drop = Drop::none) {
+  const int nl = depth - coarsest + 1;
+  std::vector<SparseMatrix> Pfull;
+  std::vector<std::vector<std::uint8_t>> col;
+  for (int d = coarsest; d < depth; ++d) Pfull.push_back(grid_prolongation(1 << d));
+  for (int d = coarsest; d <= depth; ++d) col.push_back(grid_colours(1 << d));
+  SparseMatrix Afull = grid_matrix(1 << depth, dt);
+  // Kept masks, finest first.
+  std::vector<std::vector<char>> keep(static_cast<std::size_t>(nl));
+  const int N = 1 << depth;
+  keep.back().assign(std::size_t(Afull.rows()), 1);
+  if (drop != Drop::none) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> U(0, 1);
+    for (int k = 0; k <= N; ++k)
+      for (int j = 0; j <= N; ++j)
+        for (int i = 0; i <= N; ++i) {
+          const double x = double(i) / N - 0.5, y = double(j) / N - 0.5, z = double(k) / N - 0.5;
+          const double r = std::sqrt(x * x + y * y + z * z);
+          const bool kept = drop == Drop::shell ? std::abs(r - 0.3) < 2.5 / N : U(rng) > 0.15;
+          keep.back()[std::size_t(vid(N, i, j, k))] = kept;
+        }
+  }
+  for (int l = nl - 2; l >= 0; --l) {
+    const SparseMatrix& P = Pfull[std::size_t(l)];
+    keep[std::size_t(l)].assign(std::size_t(P.cols()), 0);
+    for (int J = 0; J < P.outerSize(); ++J)
+      for (SparseMatrix::InnerIterator it(P, J); it; ++it)
+        if (keep[std::size_t(l) + 1][std::size_t(it.row())]) keep[std::size_t(l)][std::size_t(J)] = 1;
+  }
+  std::vector<std::vector<int>> map(static_cast<std::size_t>(nl));
+  std::vector<int> count(static_cast<std::size_t>(nl), 0);
+  for (int l = 0; l < nl; ++l) {
+    map[std::size_t(l)].assign(keep[std::size_t(l)].size(), -1);
+    for (std::size_t i = 0; i < keep[std::size_t(l)].size(); ++i)
+      if (keep[std::size_t(l)][i]) map[std::size_t(l)][i] = count[std::size_t(l)]++;
+  }
+  auto select = [](const SparseMatrix& M, const std::vector<int>& rmap, const std::vector<int>& cmap, int nr, int nc) {
+    Triplets t;
+    for (int J = 0; J < M.outerSize(); ++J)
+      for (SparseMatrix::InnerIterator it(M, J); it; ++it)
+        if (rmap[std::size_t(it.row())] >= 0 && cmap[std::size_t(J)] >= 0)
+          t.emplace_back(rmap[std::size_t(it.row())], cmap[std::size_t(J)], it.value());
+    SparseMatrix S(nr, nc);
+    S.setFromTriplets(t.begin(), t.end());
+    S.makeCompressed();
+    return S;
+  };
+  Problem pr;
+  pr.A = select(Afull, map.back(), map.back(), count.back(), count.back());
+  for (int l = 0; l + 1 < nl; ++l)
+    pr.P.push_back(select(Pfull[std::size_t(l)], map[std::size_t(l) + 1], map[std::size_t(l)],
+                          count[std::size_t(l) + 1], count[std::size_t(l)]));
+  for (int l = 0; l < nl; ++l) {
+    std::vector<std::uint8_t> c(std::size_t(count[std::size_t(l)]));
+    for (std::size_t i = 0; i < map[std::size_t(l)].size(); ++i)
+      if (map[std::size_t(l)][i] >= 0) c[std::size_t(map[std::size_t(l)][i])] = col[std::size_t(l)][i];
+    pr.colours.push_back(std::move(c));
+  }
+  return pr;
+}
+
+Eigen::MatrixXd random_matrix(Eigen::Index n, Eigen::Index k, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> N01;
+  Eigen::MatrixXd M(n, k);
+  for (Eigen::Index c = 0; c < k; ++c)
+    for (Eigen::Index i = 0; i < n; ++i) M(i, c) = N01(rng);
+  return M;
+}
+
+double rel_diff(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return (a - b).norm() / b.norm(); }
+
+void expect_galerkin(const MultigridSolver& mg, const Problem& pr) {
+  ASSERT_EQ(mg.levels(), int(pr.P.size()) + 1);
+  SparseMatrix Af = pr.A;
+  for (int l = int(pr.P.size()) - 1; l >= 0; --l) {
+    const SparseMatrix& P = pr.P[std::size_t(l)];
+    SparseMatrix AP = Af * P;
+    SparseMatrix Ac = SparseMatrix(P.transpose()) * AP;
+    const SparseMatrix& ours = mg.level_matrix(l);
+    ASSERT_EQ(ours.rows(), Ac.rows());
+    const double err = SparseMatrix(ours - Ac).norm() / Ac.norm();
+    EXPECT_LT(err, 1e-12) << "level " << l;
+    Af = ours;  // compare the next level against the product of our own (symmetrized) operator
+  }
+}
+
+TEST(Multigrid, GalerkinMatchesBruteForceAndUpdatesNumerically) {
+  for (Drop drop : {Drop::none, Drop::shell, Drop::random}) {
+    SCOPED_TRACE(int(drop));
+    Problem pr = make_problem(4, 1, 0.05, drop);
+    MultigridSolver mg;
+    auto rep = mg.set_matrix(pr.A, pr.view());
+    ASSERT_EQ(rep.status, SolveStatus::converged) << rep.message;
+    EXPECT_EQ(mg.symbolic_builds(), 1);
+    for (int l = 0; l < mg.levels(); ++l) EXPECT_TRUE(mg.level_is_coloured(l)) << l;
+    expect_galerkin(mg, pr);
+
+    // New values, same pattern: no new symbolic build, coarse operators follow.
+    Problem pr2 = make_problem(4, 1, 0.7, drop);
+    for (Eigen::Index e = 0; e < pr2.A.nonZeros(); ++e) pr2.A.valuePtr()[e] *= 1.0 + 0.01 * double(e % 7);
+    pr2.A = SparseMatrix(0.5 * (pr2.A + SparseMatrix(pr2.A.transpose())));
+    ASSERT_EQ(pr2.A.nonZeros(), pr.A.nonZeros());
+    rep = mg.set_matrix(pr2.A, pr2.view());
+    ASSERT_EQ(rep.status, SolveStatus::converged) << rep.message;
+    EXPECT_EQ(mg.symbolic_builds(), 1);
+    EXPECT_EQ(mg.numeric_builds(), 2);
+    expect_galerkin(mg, pr2);
+  }
+}
+
+TEST(Multigrid, HierarchyChangeTriggersSymbolicBuild) {
+  Problem a = make_problem(3, 1, 0.05);
+  Problem b = make_problem(3, 1, 0.05, Drop::random);
+  MultigridSolver mg;
+  ASSERT_TRUE(mg.set_matrix(a.A, a.view()).ok());
+  ASSERT_TRUE(mg.set_matrix(a.A, a.view()).ok());
+  EXPECT_EQ(mg.symbolic_builds(), 1);
+  ASSERT_TRUE(mg.set_matrix(b.A, b.view()).ok());
+  EXPECT_EQ(mg.symbolic_builds(), 2);
+  expect_galerkin(mg, b);
+}
+
+void expect_converges_to_direct(MultigridCycle cycle, Drop drop) {
+  // The full grid at depth 5 makes the reference factorization slow: depth 4 there.
+  Problem pr = make_problem(drop == Drop::none ? 4 : 5, 1, 0.05, drop);
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt(pr.A);
+  ASSERT_EQ(ldlt.info(), Eigen::Success);
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 11);
+  const Eigen::MatrixXd Xd = ldlt.solve(B);
+
+  MultigridOptions opt;
+  opt.cycle = cycle;
+  opt.cycles = 40;
+  opt.tolerance = 1e-13;
+  MultigridSolver mg(opt);
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  const auto rep = mg.solve(B, X);
+  EXPECT_EQ(rep.status, SolveStatus::converged);
+  EXPECT_LT(rel_diff(X, Xd), 1e-8);
+  EXPECT_EQ(int(rep.residuals.size()), rep.iterations);
+  for (std::size_t i = 1; i < rep.residuals.size(); ++i) EXPECT_LT(rep.residuals[i], rep.residuals[i - 1]);
+}
+
+TEST(Multigrid, VCycleConvergesToDirectSolution) { expect_converges_to_direct(MultigridCycle::V, Drop::none); }
+TEST(Multigrid, WCycleConvergesToDirectSolution) { expect_converges_to_direct(MultigridCycle::W, Drop::none); }
+TEST(Multigrid, VCycleConvergesOnShell) { expect_converges_to_direct(MultigridCycle::V, Drop::shell); }
+TEST(Multigrid, WCycleConvergesOnShell) { expect_converges_to_direct(MultigridCycle::W, Drop::shell); }
+
+TEST(Multigrid, OneWCycleReducesResidualTenfold) {
+  for (Drop drop : {Drop::none, Drop::shell}) {
+    for (double dt : {1e-3, 0.05, 1.0}) {
+      Problem pr = make_problem(5, 1, dt, drop);
+      MultigridSolver mg;  // defaults: 1 W-cycle, 5 + 5 sweeps
+      ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+      const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 3);
+      Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+      const auto rep = mg.solve(B, X);
+      ASSERT_EQ(rep.iterations, 1);
+      EXPECT_EQ(rep.status, SolveStatus::converged);
+      EXPECT_LT(rep.relative_residual, 0.1) << "dt " << dt << " drop " << int(drop);
+      // The reported residual is the true one.
+      const double r = ((B - pr.A * X).colwise().norm().array() / B.colwise().norm().array()).maxCoeff();
+      EXPECT_NEAR(rep.relative_residual, r, 1e-12);
+    }
+  }
+}
+
+TEST(Multigrid, WarmStartAndToleranceStopEarly) {
+  Problem pr = make_problem(4, 1, 0.05, Drop::shell);
+  MultigridOptions opt;
+  opt.cycles = 50;
+  opt.tolerance = 1e-6;
+  MultigridSolver mg(opt);
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 5);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  auto rep = mg.solve(B, X);
+  EXPECT_EQ(rep.status, SolveStatus::converged);
+  EXPECT_LT(rep.iterations, 50);
+  EXPECT_LT(rep.relative_residual, 1e-6);
+  // Solving again from the solution: nothing to do.
+  rep = mg.solve(B, X);
+  EXPECT_EQ(rep.status, SolveStatus::converged);
+  EXPECT_EQ(rep.iterations, 0);
+  // An unreachable tolerance: the cap is reported.
+  opt.cycles = 2;
+  opt.tolerance = 1e-30;
+  mg.set_options(opt);
+  X.setZero();
+  rep = mg.solve(B, X);
+  EXPECT_EQ(rep.status, SolveStatus::max_iterations);
+  EXPECT_EQ(rep.iterations, 2);
+}
+
+TEST(Multigrid, WCycleNeedsNoMoreCyclesThanV) {
+  for (Drop drop : {Drop::none, Drop::shell}) {
+    Problem pr = make_problem(5, 1, 0.05, drop);
+    const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 9);
+    int its[2];
+    for (MultigridCycle c : {MultigridCycle::V, MultigridCycle::W}) {
+      MultigridOptions opt;
+      opt.cycle = c;
+      opt.cycles = 100;
+      opt.tolerance = 1e-10;
+      MultigridSolver mg(opt);
+      ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+      Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+      const auto rep = mg.solve(B, X);
+      ASSERT_EQ(rep.status, SolveStatus::converged);
+      its[c == MultigridCycle::W] = rep.iterations;
+    }
+    EXPECT_LE(its[1], its[0]) << "V " << its[0] << " W " << its[1];
+    std::cout << "[ cycles   ] to 1e-10, drop " << int(drop) << ": V " << its[0] << ", W " << its[1] << "\n";
+  }
+}
+
+TEST(Multigrid, BitwiseIdenticalForOneAndTwoThreads) {
+  Problem pr = make_problem(5, 1, 0.05, Drop::none);  // 35937 functions: parallel paths taken
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 1);
+  Eigen::MatrixXd X[2];
+  std::vector<double> res[2];
+  SparseMatrix coarse[2];
+  for (int t = 0; t < 2; ++t) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+    MultigridOptions opt;
+    opt.cycles = 3;
+    MultigridSolver mg(opt);
+    ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+    X[t] = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+    res[t] = mg.solve(B, X[t]).residuals;
+    coarse[t] = mg.level_matrix(mg.levels() - 2);
+  }
+  EXPECT_EQ((X[0] - X[1]).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(res[0], res[1]);
+  ASSERT_EQ(coarse[0].nonZeros(), coarse[1].nonZeros());
+  EXPECT_TRUE(std::equal(coarse[0].valuePtr(), coarse[0].valuePtr() + coarse[0].nonZeros(), coarse[1].valuePtr()));
+}
+
+/// Serial Gauss-Seidel over `order`, the same arithmetic as the solver's sweep.
+void reference_gs(const SparseMatrix& A, const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const std::vector<int>& order) {
+  for (int i : order) {
+    double d = 0;
+    Eigen::RowVectorXd acc = B.row(i);
+    for (SparseMatrix::InnerIterator it(A, i); it; ++it) {
+      if (it.row() == i) {
+        d = it.value();
+        continue;
+      }
+      acc -= it.value() * X.row(it.row());
+    }
+    X.row(i) = acc * (1.0 / d);
+  }
+}
+
+TEST(Multigrid, ColouredSweepEqualsSerialColourThenIndexOrder) {
+  Problem pr = make_problem(5, 2, 0.05, Drop::shell);
+  MultigridSolver mg;
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  for (int l = 0; l < mg.levels(); ++l) {
+    const SparseMatrix& A = mg.level_matrix(l);
+    ASSERT_TRUE(mg.level_is_coloured(l));
+    const auto& col = pr.colours[std::size_t(l)];
+    std::vector<int> fwd;
+    for (int c = 0; c < 8; ++c)
+      for (int i = 0; i < A.rows(); ++i)
+        if (col[std::size_t(i)] == c) fwd.push_back(i);
+    std::vector<int> rev(fwd.rbegin(), fwd.rend());
+    const Eigen::MatrixXd B = random_matrix(A.rows(), 3, 21);
+    for (bool reverse : {false, true}) {
+      Eigen::MatrixXd X = random_matrix(A.rows(), 3, 22), Xr = X;
+      mg.gauss_seidel(l, B, X, 2, reverse);
+      reference_gs(A, B, Xr, reverse ? rev : fwd);
+      reference_gs(A, B, Xr, reverse ? rev : fwd);
+      EXPECT_EQ((X - Xr).cwiseAbs().maxCoeff(), 0.0) << "level " << l;  // same arithmetic, same order
+    }
+  }
+}
+
+TEST(Multigrid, SerialFallbackWithoutColours) {
+  Problem pr = make_problem(4, 1, 0.05, Drop::shell);
+  std::vector<std::vector<std::uint8_t>> none;
+  MultigridSolver mg;
+  ASSERT_TRUE(mg.set_matrix(pr.A, {&pr.P, &none}).ok());
+  const int top = mg.levels() - 1;
+  EXPECT_FALSE(mg.level_is_coloured(top));
+  std::vector<int> fwd(std::size_t(pr.A.rows()));
+  for (int i = 0; i < int(fwd.size()); ++i) fwd[std::size_t(i)] = i;
+  std::vector<int> rev(fwd.rbegin(), fwd.rend());
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 2, 2);
+  for (bool reverse : {false, true}) {
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 2), Xr = X;
+    mg.gauss_seidel(top, B, X, 1, reverse);
+    reference_gs(mg.level_matrix(top), B, Xr, reverse ? rev : fwd);
+    EXPECT_LE((X - Xr).cwiseAbs().maxCoeff(), 1e-13 * Xr.cwiseAbs().maxCoeff());
+  }
+  // And the solver still converges.
+  MultigridOptions opt;
+  opt.cycles = 30;
+  opt.tolerance = 1e-10;
+  mg.set_options(opt);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 2);
+  EXPECT_EQ(mg.solve(B, X).status, SolveStatus::converged);
+}
+
+TEST(Multigrid, InvalidColouringFallsBackToSerial) {
+  Problem pr = make_problem(3, 1, 0.05);
+  for (auto& c : pr.colours.back()) c = 0;  // every function the same colour: couples
+  MultigridSolver mg;
+  const auto rep = mg.set_matrix(pr.A, pr.view());
+  ASSERT_TRUE(rep.ok());
+  EXPECT_FALSE(mg.level_is_coloured(mg.levels() - 1));
+  EXPECT_TRUE(mg.level_is_coloured(0));
+}
+
+TEST(Multigrid, ManyRightHandSidesMatchOneByOne) {
+  Problem pr = make_problem(4, 1, 0.05, Drop::shell);
+  MultigridOptions opt;
+  opt.cycles = 2;
+  MultigridSolver mg(opt);
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 7, 4);  // chunks of 4 + 3
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 7);
+  mg.solve(B, X);
+  for (int c = 0; c < 7; ++c) {
+    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(pr.A.rows(), 1);
+    mg.solve(B.col(c), x);
+    EXPECT_LE((X.col(c) - x).cwiseAbs().maxCoeff(), 1e-13 * x.cwiseAbs().maxCoeff()) << c;
+  }
+}
+
+void expect_symmetric_preconditioner(MultigridCycle cycle) {
+  Problem pr = make_problem(4, 1, 0.05, Drop::shell);
+  MultigridOptions opt;
+  opt.cycle = cycle;
+  MultigridSolver mg(opt);
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  for (unsigned s = 0; s < 3; ++s) {
+    const Eigen::MatrixXd u = random_matrix(pr.A.rows(), 3, 100 + s), v = random_matrix(pr.A.rows(), 3, 200 + s);
+    Eigen::MatrixXd Bu, Bv;
+    mg.precondition(u, Bu);
+    mg.precondition(v, Bv);
+    for (int c = 0; c < 3; ++c) {
+      const double a = u.col(c).dot(Bv.col(c)), b = v.col(c).dot(Bu.col(c));
+      EXPECT_LE(std::abs(a - b), 1e-10 * u.col(c).norm() * Bv.col(c).norm()) << a << " vs " << b;
+      EXPECT_GT(u.col(c).dot(Bu.col(c)), 0.0);  // positive definite
+    }
+  }
+  // precondition == one cycle of solve from zero.
+  const Eigen::MatrixXd r = random_matrix(pr.A.rows(), 3, 1);
+  Eigen::MatrixXd z, X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  mg.precondition(r, z);
+  mg.solve(r, X);
+  EXPECT_EQ((X - z).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Multigrid, PreconditionerIsSymmetricW) { expect_symmetric_preconditioner(MultigridCycle::W); }
+TEST(Multigrid, PreconditionerIsSymmetricV) { expect_symmetric_preconditioner(MultigridCycle::V); }
+
+TEST(Multigrid, SingleLevelIsADirectSolve) {
+  Problem pr = make_problem(3, 3, 0.05);
+  MultigridSolver mg;
+  ASSERT_TRUE(mg.set_matrix(pr.A).ok());
+  EXPECT_EQ(mg.levels(), 1);
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 8);
+  Eigen::MatrixXd X;
+  const auto rep = mg.solve(B, X);
+  EXPECT_EQ(rep.status, SolveStatus::converged);
+  EXPECT_LT(rep.relative_residual, 1e-12);
+}
+
+TEST(Multigrid, ReportsNotPositiveDefiniteAndFailures) {
+  Problem pr = make_problem(3, 1, 0.05);
+  MultigridSolver mg;
+  Eigen::MatrixXd X;
+  EXPECT_EQ(mg.solve(Eigen::MatrixXd::Ones(pr.A.rows(), 1), X).status, SolveStatus::failed);
+  SparseMatrix neg = -pr.A;
+  EXPECT_EQ(mg.set_matrix(neg, pr.view()).status, SolveStatus::not_positive_definite);
+  EXPECT_EQ(mg.solve(Eigen::MatrixXd::Ones(pr.A.rows(), 1), X).status, SolveStatus::failed);
+  // Indefinite but with a positive diagonal: the coarsest factorization catches it.
+  double min_diag = 1e300;
+  for (int i = 0; i < pr.A.rows(); ++i) min_diag = std::min(min_diag, pr.A.coeff(i, i));
+  SparseMatrix id(pr.A.rows(), pr.A.rows());
+  id.setIdentity();
+  const SparseMatrix shifted = pr.A - 0.9 * min_diag * id;
+  EXPECT_EQ(mg.set_matrix(shifted, pr.view()).status, SolveStatus::not_positive_definite);
+  // Wrong hierarchy dimensions.
+  std::vector<SparseMatrix> badP = {pr.P.back()};
+  Problem small = make_problem(2, 1, 0.05);
+  EXPECT_EQ(mg.set_matrix(small.A, {&badP, nullptr}).status, SolveStatus::failed);
+  // Recovers.
+  EXPECT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  // NaN in the right-hand side.
+  Eigen::MatrixXd Bn = Eigen::MatrixXd::Ones(pr.A.rows(), 1);
+  Bn(3, 0) = std::nan("");
+  X.resize(0, 0);
+  EXPECT_EQ(mg.solve(Bn, X).status, SolveStatus::numerical_issue);
+}
+
+/// Cost of one W-cycle (5+5 sweeps) in fine-level SpMVs (A * X, 3 columns, Eigen, 1 thread).
+TEST(Multigrid, WCycleCostInSpMVs) {
+  const int depth = 6;  // 65^3 = 274625 functions, 7.2M nonzeros
+  Problem pr = make_problem(depth, 1, 0.05);
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 12);
+  using clock = std::chrono::steady_clock;
+  auto best_of = [](int reps, auto&& f) {
+    double best = 1e300;
+    for (int r = 0; r < reps; ++r) {
+      const auto t0 = clock::now();
+      f();
+      best = std::min(best, std::chrono::duration<double>(clock::now() - t0).count());
+    }
+    return best;
+  };
+  for (std::size_t threads : {std::size_t(1), std::size_t(2)}) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    MultigridSolver mg;
+    ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+    Eigen::MatrixXd Y(pr.A.rows(), 3), Z, X;
+    const double spmv = best_of(7, [&] { Y.noalias() = pr.A * B; });
+    const double cycle = best_of(5, [&] { mg.precondition(B, Z); });
+    const double solve = best_of(5, [&] { X.setZero(pr.A.rows(), 3); mg.solve(B, X); });
+    const double numeric = best_of(3, [&] { mg.set_matrix(pr.A, pr.view()); });
+    // The solver's own fused residual (0 cycles: load B and X, one 3-column SpMV, norms).
+    MultigridOptions zero;
+    zero.cycles = 0;
+    mg.set_options(zero);
+    const double own = best_of(7, [&] { mg.solve(B, X); });
+    std::cout << "[ cost     ] n=" << pr.A.rows() << " nnz=" << pr.A.nonZeros() << " threads=" << threads
+              << " SpMV(3 cols, Eigen serial)=" << spmv * 1e3 << " ms; W-cycle=" << cycle * 1e3
+              << " ms (" << cycle / spmv << " SpMV); solve(1 W-cycle + residual)=" << solve * 1e3
+              << " ms (" << solve / spmv << " SpMV); numeric set_matrix=" << numeric * 1e3 << " ms ("
+              << numeric / spmv << " SpMV); own residual=" << own * 1e3 << " ms (W-cycle = " << cycle / own
+              << " own residuals)\n";
+    RecordProperty(threads == 1 ? "wcycle_over_spmv_1thread" : "wcycle_over_spmv_2threads",
+                   std::to_string(cycle / spmv));
+    EXPECT_EQ(mg.symbolic_builds(), 1);
+    if (threads == 1) {
+      EXPECT_LT(cycle / spmv, 60.0);  // generous: shared, noisy machine
+    }
+  }
+}
+
+}  // namespace
