@@ -504,48 +504,4 @@ TEST(Multigrid, ReportsNotPositiveDefiniteAndFailures) {
   EXPECT_EQ(mg.solve(Bn, X).status, SolveStatus::numerical_issue);
 }
 
-/// Cost of one W-cycle (5+5 sweeps) in fine-level SpMVs (A * X, 3 columns, Eigen, 1 thread).
-TEST(Multigrid, WCycleCostInSpMVs) {
-  const int depth = 6;  // 65^3 = 274625 functions, 7.2M nonzeros
-  Problem pr = make_problem(depth, 1, 0.05);
-  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 12);
-  using clock = std::chrono::steady_clock;
-  auto best_of = [](int reps, auto&& f) {
-    double best = 1e300;
-    for (int r = 0; r < reps; ++r) {
-      const auto t0 = clock::now();
-      f();
-      best = std::min(best, std::chrono::duration<double>(clock::now() - t0).count());
-    }
-    return best;
-  };
-  for (std::size_t threads : {std::size_t(1), std::size_t(2)}) {
-    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-    MultigridSolver mg;
-    ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
-    Eigen::MatrixXd Y(pr.A.rows(), 3), Z, X;
-    const double spmv = best_of(7, [&] { Y.noalias() = pr.A * B; });
-    const double cycle = best_of(5, [&] { mg.precondition(B, Z); });
-    const double solve = best_of(5, [&] { X.setZero(pr.A.rows(), 3); mg.solve(B, X); });
-    const double numeric = best_of(3, [&] { mg.set_matrix(pr.A, pr.view()); });
-    // The solver's own fused residual (0 cycles: load B and X, one 3-column SpMV, norms).
-    MultigridOptions zero;
-    zero.cycles = 0;
-    mg.set_options(zero);
-    const double own = best_of(7, [&] { mg.solve(B, X); });
-    std::cout << "[ cost     ] n=" << pr.A.rows() << " nnz=" << pr.A.nonZeros() << " threads=" << threads
-              << " SpMV(3 cols, Eigen serial)=" << spmv * 1e3 << " ms; W-cycle=" << cycle * 1e3
-              << " ms (" << cycle / spmv << " SpMV); solve(1 W-cycle + residual)=" << solve * 1e3
-              << " ms (" << solve / spmv << " SpMV); numeric set_matrix=" << numeric * 1e3 << " ms ("
-              << numeric / spmv << " SpMV); own residual=" << own * 1e3 << " ms (W-cycle = " << cycle / own
-              << " own residuals)\n";
-    RecordProperty(threads == 1 ? "wcycle_over_spmv_1thread" : "wcycle_over_spmv_2threads",
-                   std::to_string(cycle / spmv));
-    EXPECT_EQ(mg.symbolic_builds(), 1);
-    if (threads == 1) {
-      EXPECT_LT(cycle / spmv, 60.0);  // generous: shared, noisy machine
-    }
-  }
-}
-
 }  // namespace
