@@ -1,0 +1,21 @@
+#include "solvers/multigrid_pcg.h"
+
+namespace mcf {
+
+MultigridPcgSolver::MultigridPcgSolver(MultigridOptions cycle, PcgOptions pcg) : multigrid_(cycle), pcg_(pcg) {
+  // A preconditioner must be symmetric for CG: equal pre- and post-smoothing sweeps, and the
+  // cycle's post-smoother runs the colours in reverse (MultigridSolver::precondition).
+  cycle.post_smooth = cycle.pre_smooth;
+  multigrid_.set_options(cycle);
+  pcg.preconditioner = PcgPreconditioner::external;
+  pcg_.set_options(pcg);
+  pcg_.set_preconditioner([this](const Eigen::MatrixXd& r, Eigen::MatrixXd& z) { multigrid_.precondition(r, z); });
+}
+
+SolveReport MultigridPcgSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
+  SolveReport r = multigrid_.set_matrix(A, hierarchy);
+  if (!r.ok()) return r;
+  return pcg_.set_matrix(A, hierarchy);
+}
+
+}  // namespace mcf
