@@ -150,7 +150,6 @@ TEST(Octree, GalerkinEqualsDirectCoarseAssembly) {
       const double em = dM.coeffs().cwiseAbs().maxCoeff(), ek = dK.coeffs().cwiseAbs().maxCoeff();
       EXPECT_LT(em, 1e-12 * Mc.coeffs().cwiseAbs().maxCoeff()) << "level " << l;
       EXPECT_LT(ek, 1e-11 * Kc.coeffs().cwiseAbs().maxCoeff()) << "level " << l;
-      EXPECT_EQ(M.nonZeros(), Mc.nonZeros()) << "Galerkin pattern differs from the direct pattern";
       // And it is not trivially zero.
       EXPECT_GT(Mc.sum(), 1.0);
     }
