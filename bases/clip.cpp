@@ -132,7 +132,7 @@ std::vector<ClippedTriangle> clip_mesh(const Positions& vertices, const Triangle
   std::vector<std::vector<ClippedTriangle>> parts(static_cast<std::size_t>(nchunks));
   tbb::parallel_for(Eigen::Index(0), nchunks, [&](Eigen::Index ch) {
     auto& out = parts[static_cast<std::size_t>(ch)];
-    out.reserve(static_cast<std::size_t>(chunk) * 4);
+    out.reserve(static_cast<std::size_t>(chunk) * 16);  // virtual; avoids regrowth copies
     const Eigen::Index e = std::min(m, (ch + 1) * chunk);
     for (Eigen::Index f = ch * chunk; f < e; ++f) {
       const Eigen::Vector3d a = vertices.row(faces(f, 0)).transpose();

@@ -35,11 +35,24 @@ GridCube choose_cube(const Positions& vertices, int depth, OctreeCube cube) {
 
 namespace {
 
-int find_key(const std::vector<GridKey>& keys, int i, int j, int k, int res) {
+// res = largest valid index; rows has (res+1)^2 + 1 entries.
+int find_key(const std::vector<GridKey>& keys, const std::vector<int>& rows, int i, int j, int k, int res) {
   if (i < 0 || j < 0 || k < 0 || i > res || j > res || k > res) return -1;
   const GridKey key = grid_key(i, j, k);
-  auto it = std::lower_bound(keys.begin(), keys.end(), key);
-  return (it != keys.end() && *it == key) ? static_cast<int>(it - keys.begin()) : -1;
+  const std::size_t row = static_cast<std::size_t>(k) * static_cast<std::size_t>(res + 1) + static_cast<std::size_t>(j);
+  const auto b = keys.begin() + rows[row], e = keys.begin() + rows[row + 1];
+  auto it = e - b <= 8 ? std::find(b, e, key) : std::lower_bound(b, e, key);
+  return (it != e && *it == key) ? static_cast<int>(it - keys.begin()) : -1;
+}
+
+void fill_rows(const std::vector<GridKey>& keys, int n, std::vector<int>& rows) {
+  const std::size_t nrows = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  rows.assign(nrows + 1, 0);
+  for (GridKey key : keys) {
+    const auto ijk = grid_index(key);
+    ++rows[static_cast<std::size_t>(ijk[2]) * static_cast<std::size_t>(n) + static_cast<std::size_t>(ijk[1]) + 1];
+  }
+  for (std::size_t r = 0; r < nrows; ++r) rows[r + 1] += rows[r];
 }
 
 void sort_unique(std::vector<GridKey>& keys) {
@@ -61,6 +74,7 @@ void fill_functions(OctreeLevel& L) {
   });
   sort_unique(corners);
   L.functions = std::move(corners);
+  fill_rows(L.functions, (1 << L.depth) + 1, L.function_row_start);
   L.cell_functions.resize(nc);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
@@ -75,8 +89,16 @@ void fill_functions(OctreeLevel& L) {
 
 }  // namespace
 
-int OctreeLevel::find_cell(int i, int j, int k) const { return find_key(cells, i, j, k, (1 << depth) - 1); }
-int OctreeLevel::find_function(int i, int j, int k) const { return find_key(functions, i, j, k, 1 << depth); }
+int OctreeLevel::find_cell(int i, int j, int k) const {
+  return find_key(cells, cell_row_start, i, j, k, (1 << depth) - 1);
+}
+int OctreeLevel::find_function(int i, int j, int k) const {
+  return find_key(functions, function_row_start, i, j, k, 1 << depth);
+}
+void OctreeLevel::index_rows() {
+  fill_rows(cells, 1 << depth, cell_row_start);
+  fill_rows(functions, (1 << depth) + 1, function_row_start);
+}
 
 Eigen::Matrix<double, Eigen::Dynamic, 3> Octree::function_positions(int level) const {
   const OctreeLevel& L = levels.at(static_cast<std::size_t>(level));
@@ -98,6 +120,7 @@ Octree build_octree(const GridCube& cube, std::vector<GridKey> finest_cells, int
   sort_unique(finest_cells);
   t.levels.back().depth = cube.depth;
   t.levels.back().cells = std::move(finest_cells);
+  fill_rows(t.levels.back().cells, 1 << cube.depth, t.levels.back().cell_row_start);
   for (int l = nlev - 1; l > 0; --l) {
     OctreeLevel& fine = t.levels[static_cast<std::size_t>(l)];
     OctreeLevel& coarse = t.levels[static_cast<std::size_t>(l - 1)];
@@ -109,6 +132,7 @@ Octree build_octree(const GridCube& cube, std::vector<GridKey> finest_cells, int
     });
     sort_unique(parents);
     coarse.cells = std::move(parents);
+    fill_rows(coarse.cells, 1 << coarse.depth, coarse.cell_row_start);
     fine.cell_parent.resize(fine.cells.size());
     tbb::parallel_for(std::size_t(0), fine.cells.size(), [&](std::size_t c) {
       const auto ijk = grid_index(fine.cells[c]);

@@ -56,12 +56,17 @@ struct OctreeLevel {
   std::vector<GridKey> functions;                 ///< corners of active cells, sorted
   std::vector<std::array<int, 8>> cell_functions; ///< per cell: function index of corner c
   std::vector<int> cell_parent;                   ///< per cell: index in the next coarser level (-1 on the coarsest)
+  /// Row directories: entries of row (k,j) are [row_start[k*n+j], row_start[k*n+j+1]) with
+  /// n = 2^depth (cells) or 2^depth+1 (functions); lookups search only inside one row.
+  std::vector<int> cell_row_start, function_row_start;
 
   /// Index of a cell / function, or -1 when it is not active. Negative indices are never active.
   int find_cell(int i, int j, int k) const;
   int find_function(int i, int j, int k) const;
   Eigen::Index num_functions() const { return static_cast<Eigen::Index>(functions.size()); }
   Eigen::Index num_cells() const { return static_cast<Eigen::Index>(cells.size()); }
+  /// Fills the row directories from `cells` / `functions` (build_octree does this).
+  void index_rows();
 };
 
 struct Octree {

@@ -100,7 +100,7 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
 void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, SparseMatrix& stiffness) const {
   const OctreeLevel& L = octree_->levels[static_cast<std::size_t>(level_)];
   const GridCube& cube = octree_->cube;
-  const double h = cube.cell_size(L.depth), inv_h = 1.0 / h;
+  const double h = cube.cell_size(L.depth);
   mass = pattern_;
   stiffness = pattern_;
   double* Mv = mass.valuePtr();
@@ -125,19 +125,12 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
           const Eigen::Vector3d n = cr / len;
           const double area = 0.5 * len;
           for (int q = 0; q < nq; ++q) {
-            const auto& b = rule.points[static_cast<std::size_t>(q)];
-            double tl[3];
-            for (int a = 0; a < 3; ++a) {
-              const double x = b[0] * t.corners[0][a] + b[1] * t.corners[1][a] + b[2] * t.corners[2][a];
-              tl[a] = std::clamp((x - cell_origin[a]) * inv_h, 0.0, 1.0);
-            }
-            double v[8], g[8][3];
-            trilinear_values(tl, inv_h, v, g);
-            for (int a = 0; a < 8; ++a) {
-              const double gn = g[a][0] * n[0] + g[a][1] * n[1] + g[a][2] * n[2];
-              for (int e = 0; e < 3; ++e) g[a][e] -= gn * n[e];
-            }
-            const double w = area * rule.weights[static_cast<std::size_t>(q)];
+            CubatureSample cs;
+            sample_piece(t, n, area, cell_origin, h, rule.points[static_cast<std::size_t>(q)],
+                         rule.weights[static_cast<std::size_t>(q)], cs);
+            const double w = cs.weight;
+            const double(&v)[8] = cs.value;
+            const double(&g)[8][3] = cs.gradient;
             for (int a = 0; a < 8; ++a) {
               const double wa = w * v[a];
               for (int e = a; e < 8; ++e) {

@@ -33,6 +33,34 @@ inline void trilinear_values(const double t[3], double inv_h, double value[8], d
   }
 }
 
+/// One cubature point of a piece: weight w = area·ω, the 8 corner-function values and their 3-D
+/// gradients projected onto the piece's plane (world units), and the point's local coordinates in
+/// the cell. cell_origin is the world position of the cell's corner 0, h its size.
+struct CubatureSample {
+  double weight;
+  double local[3];
+  double value[8];
+  double gradient[8][3];
+};
+/// unit_normal = cross / |cross| of the piece, area = |cross| / 2 (pass them in to share them
+/// between the points of a piece).
+inline void sample_piece(const ClippedTriangle& t, const Eigen::Vector3d& unit_normal, double area,
+                         const double cell_origin[3], double h, const std::array<double, 3>& bary, double omega,
+                         CubatureSample& s) {
+  const double inv_h = 1.0 / h;
+  for (int a = 0; a < 3; ++a) {
+    const double x = bary[0] * t.corners[0][a] + bary[1] * t.corners[1][a] + bary[2] * t.corners[2][a];
+    const double u = (x - cell_origin[a]) * inv_h;
+    s.local[a] = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+  }
+  trilinear_values(s.local, inv_h, s.value, s.gradient);
+  for (int c = 0; c < 8; ++c) {
+    const double gn = s.gradient[c][0] * unit_normal[0] + s.gradient[c][1] * unit_normal[1] + s.gradient[c][2] * unit_normal[2];
+    for (int e = 0; e < 3; ++e) s.gradient[c][e] -= gn * unit_normal[e];
+  }
+  s.weight = area * omega;
+}
+
 /// Offset bit (0..26) of row function I relative to column function J, both corners of one cell:
 /// o = (dz+1)*9 + (dy+1)*3 + (dx+1) with d = corner(a) - corner(b).
 inline int neighbour_bit(int corner_row, int corner_col) {
