@@ -154,7 +154,17 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
   system_.reset();
   octree_ = build_octree(cube, pieces_, options_.coarsest_depth);
   piece_cells_ = locate_pieces(octree_, pieces_);
-  stencils_ = point_stencils(octree_, mesh_.vertices);
+  {
+    std::vector<char> used(static_cast<std::size_t>(mesh_.num_vertices()), 0);
+    for (Eigen::Index f = 0; f < mesh_.num_faces(); ++f)
+      for (int c = 0; c < 3; ++c) used[static_cast<std::size_t>(mesh_.faces(f, c))] = 1;
+    referenced_.clear();
+    for (std::size_t v = 0; v < used.size(); ++v)
+      if (used[v]) referenced_.push_back(static_cast<int>(v));
+    Positions pts(static_cast<Eigen::Index>(referenced_.size()), 3);
+    for (std::size_t i = 0; i < referenced_.size(); ++i) pts.row(static_cast<Eigen::Index>(i)) = mesh_.vertices.row(referenced_[i]);
+    stencils_ = point_stencils(octree_, pts);
+  }
   locked_ = boundary_functions(octree_, mesh_.vertices, mesh_.faces);
   stats_.setup_seconds["octree"] = t_octree + seconds_since(t0);
 
@@ -189,7 +199,13 @@ void RebuiltOctreeBasis::update(const Coefficients& x, bool, bool) {
 Positions RebuiltOctreeBasis::evaluate_vertices(const Coefficients& x) const {
   if (x.rows() != dimension())
     throw std::invalid_argument("RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
-  Positions all = evaluate_stencils(stencils_, x);
+  Positions all = mesh_.vertices;
+  if (static_cast<Eigen::Index>(referenced_.size()) == all.rows()) {
+    all = evaluate_stencils(stencils_, x);
+  } else {
+    const Positions ev = evaluate_stencils(stencils_, x);
+    for (std::size_t i = 0; i < referenced_.size(); ++i) all.row(referenced_[i]) = ev.row(static_cast<Eigen::Index>(i));
+  }
   if (!options_.refine_input) return all;
   last_evaluated_ = all;
   last_evaluated_build_ = build_id_;

@@ -57,6 +57,7 @@ class RebuiltOctreeBasis : public Basis {
   const SparseMatrix& mass() const override { return mass_; }
   const SparseMatrix& stiffness() const override { return stiffness_; }
   /// v = Σ_I B_I(v) x^I for the input mesh's vertices (trilinear stencils in an active finest cell).
+  /// Vertices used by no face keep the position they had at the last rebuild.
   Positions evaluate_vertices(const Coefficients& x) const override;
   /// Open surfaces: finest functions whose support meets a boundary edge (see boundary_functions).
   std::vector<int> locked_functions() const override { return locked_; }
@@ -83,7 +84,8 @@ class RebuiltOctreeBasis : public Basis {
   SparseMatrix mass_, stiffness_;
   std::vector<SparseMatrix> prolongations_;
   std::vector<std::vector<std::uint8_t>> colours_;
-  std::vector<PointStencil> stencils_;  ///< of mesh_'s vertices
+  std::vector<PointStencil> stencils_;  ///< of mesh_'s referenced vertices (see referenced_)
+  std::vector<int> referenced_;         ///< vertices used by a face; the others keep their position
   std::vector<int> locked_;
   BasisStats stats_;
   long long build_id_ = 0;

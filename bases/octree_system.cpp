@@ -245,6 +245,28 @@ std::vector<PointStencil> point_stencils(const Octree& octree, const Positions& 
     for (int k = lo[2]; cell < 0 && k <= hi[2]; ++k)
       for (int j = lo[1]; cell < 0 && j <= hi[1]; ++j)
         for (int i = lo[0]; cell < 0 && i <= hi[0]; ++i) cell = L.find_cell(i, j, k);
+    if (cell < 0) {
+      // Fallback (e.g. a vertex whose incident faces are all degenerate): the nearest active cell
+      // among the 27 around the floor cell; the clamped stencil evaluates at the closest point of it.
+      double best = 2.0;  // in cells; farther than one cell counts as "away from every piece"
+      for (int k = base[2] - 1; k <= base[2] + 1; ++k)
+        for (int j = base[1] - 1; j <= base[1] + 1; ++j)
+          for (int i = base[0] - 1; i <= base[0] + 1; ++i) {
+            const int c = L.find_cell(i, j, k);
+            if (c < 0) continue;
+            double d2 = 0.0;
+            const int idx[3] = {i, j, k};
+            for (int a = 0; a < 3; ++a) {
+              const double u = (points(v, a) - octree.cube.origin[a]) / h;
+              const double d = u < idx[a] ? idx[a] - u : (u > idx[a] + 1 ? u - idx[a] - 1 : 0.0);
+              d2 += d * d;
+            }
+            if (std::sqrt(d2) < best) {
+              best = std::sqrt(d2);
+              cell = c;
+            }
+          }
+    }
     if (cell < 0)
       throw std::runtime_error("point_stencils: point " + std::to_string(v) + " lies in no active cell");
     out[static_cast<std::size_t>(v)] = cell_stencil(octree, level, cell, points.row(v).transpose());

@@ -254,3 +254,26 @@ TEST(OctreeBasis, SemiImplicitStepOnTheSphereConverges) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(OctreeBasis, UnreferencedAndDegenerateVertices) {
+  auto mesh = test_icosphere(2, 0.3, Eigen::Vector3d(0.5, 0.5, 0.5));
+  // An unreferenced vertex far from the surface, and a degenerate (zero-area) face whose pieces
+  // are all dropped, attached to a new vertex lying on an existing edge's midpoint.
+  const Eigen::Index n = mesh.num_vertices();
+  mesh.vertices.conservativeResize(n + 2, 3);
+  mesh.vertices.row(n) << 0.05, 0.05, 0.05;
+  mesh.vertices.row(n + 1) = 0.5 * (mesh.vertices.row(mesh.faces(0, 0)) + mesh.vertices.row(mesh.faces(0, 1)));
+  const Eigen::Index m = mesh.num_faces();
+  mesh.faces.conservativeResize(m + 1, 3);
+  mesh.faces.row(m) << mesh.faces(0, 0), n + 1, mesh.faces(0, 1);
+  RebuiltOctreeBasis basis(mesh, OctreeOptions{.depth = 6});
+  const auto v = basis.evaluate_vertices(basis.initial_coefficients());
+  EXPECT_LT((v - mesh.vertices).cwiseAbs().maxCoeff(), 1e-13);
+  const auto v2 = basis.evaluate_vertices(0.5 * basis.initial_coefficients());
+  EXPECT_EQ(v2.row(n), mesh.vertices.row(n));  // unreferenced: kept
+  EXPECT_LT((v2.row(0) - 0.5 * mesh.vertices.row(0)).norm(), 1e-13);
+}
+
+}  // namespace
