@@ -113,6 +113,14 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t ci = r.begin(); ci != r.end(); ++ci) {
         const int c = cells[ci];
+        if (ci + 2 < r.end()) {  // pieces are in triangle order: prefetch a later cell's pieces
+          const auto cn = static_cast<std::size_t>(cells[ci + 2]);
+          for (int s = cell_start_[cn]; s < cell_start_[cn + 1]; ++s) {
+            const char* p = reinterpret_cast<const char*>(&pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])]);
+            __builtin_prefetch(p);
+            __builtin_prefetch(p + 64);
+          }
+        }
         double m[8][8] = {}, k[8][8] = {};
         const auto ijk = grid_index(L.cells[static_cast<std::size_t>(c)]);
         double cell_origin[3];

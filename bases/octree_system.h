@@ -75,6 +75,7 @@ inline int neighbour_bit(int corner_row, int corner_col) {
 class OctreeSystem {
  public:
   /// `level` indexes octree.levels. piece_finest_cell[p] = index of piece p's cell in the finest level.
+  /// Keeps pointers to `octree` and `pieces`: both must outlive the system and stay unchanged.
   OctreeSystem(const Octree& octree, int level, const std::vector<ClippedTriangle>& pieces,
                const std::vector<int>& piece_finest_cell);
 
