@@ -58,16 +58,23 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
     colour_cells_[static_cast<std::size_t>((ijk[0] & 1) + 2 * (ijk[1] & 1) + 4 * (ijk[2] & 1))].push_back(static_cast<int>(c));
   }
 
-  // Pattern: per column J the 27-bit mask of neighbours that share an active cell with J.
+  // Incident cells: function J is corner b of at most one cell, incident[8J+b] (-1 if none).
+  std::vector<int> incident(8 * nf, -1);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c != r.end(); ++c)
+      for (int b = 0; b < 8; ++b)
+        incident[8 * static_cast<std::size_t>(L.cell_functions[c][static_cast<std::size_t>(b)]) + static_cast<std::size_t>(b)] =
+            static_cast<int>(c);
+  });
+  // Pattern: per column J the 27-bit mask of neighbours that share an active cell with J; rows in
+  // bit order are in increasing index order (keys are (k,j,i)-lexicographic).
   mask_.assign(nf, 0u);
   std::vector<int> outer(nf + 1, 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t J = r.begin(); J != r.end(); ++J) {
-      const auto ijk = grid_index(L.functions[J]);
       std::uint32_t m = 0;
       for (int b = 0; b < 8; ++b) {
-        const auto o = corner_offset(b);
-        if (L.find_cell(ijk[0] - o[0], ijk[1] - o[1], ijk[2] - o[2]) < 0) continue;
+        if (incident[8 * J + static_cast<std::size_t>(b)] < 0) continue;
         for (int a = 0; a < 8; ++a) m |= 1u << neighbour_bit(a, b);
       }
       mask_[J] = m;
@@ -83,13 +90,17 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
   double* values = pattern_.valuePtr();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t J = r.begin(); J != r.end(); ++J) {
-      const auto ijk = grid_index(L.functions[J]);
+      int row[27];
+      for (int b = 0; b < 8; ++b) {
+        const int c = incident[8 * J + static_cast<std::size_t>(b)];
+        if (c < 0) continue;
+        for (int a = 0; a < 8; ++a)
+          row[neighbour_bit(a, b)] = L.cell_functions[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
+      }
       int s = outer[J];
       for (int o = 0; o < 27; ++o) {
         if (!(mask_[J] & (1u << o))) continue;
-        const int I = L.find_function(ijk[0] + o % 3 - 1, ijk[1] + (o / 3) % 3 - 1, ijk[2] + o / 9 - 1);
-        if (I < 0) throw std::logic_error("OctreeSystem: pattern neighbour is not an active function");
-        inner[s] = I;
+        inner[s] = row[o];
         values[s] = 0.0;
         ++s;
       }
