@@ -177,3 +177,32 @@ TEST(Octree, PatternIsSymmetricAndColoursSeparateNeighbours) {
 }
 
 }  // namespace
+
+#include <tbb/global_control.h>
+
+namespace {
+
+TEST(Octree, AssemblyIsDeterministicAcrossThreadCounts) {
+  const auto f = make_fixture(6);
+  const int finest = f.octree.num_levels() - 1;
+  mcf::SparseMatrix M1, K1, M2, K2;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    mcf::OctreeSystem sys(f.octree, finest, f.pieces, f.piece_cells);
+    sys.assemble(mcf::cubature_rule(3), M1, K1);
+  }
+  {
+    tbb::global_control many(tbb::global_control::max_allowed_parallelism, 4);
+    const auto pieces = mcf::clip_mesh(f.mesh.vertices, f.mesh.faces, f.octree.cube);
+    ASSERT_EQ(pieces.size(), f.pieces.size());
+    mcf::OctreeSystem sys(f.octree, finest, pieces, f.piece_cells);
+    sys.assemble(mcf::cubature_rule(3), M2, K2);
+  }
+  ASSERT_EQ(M1.nonZeros(), M2.nonZeros());
+  for (Eigen::Index s = 0; s < M1.nonZeros(); ++s) {
+    ASSERT_EQ(M1.valuePtr()[s], M2.valuePtr()[s]);
+    ASSERT_EQ(K1.valuePtr()[s], K2.valuePtr()[s]);
+  }
+}
+
+}  // namespace
