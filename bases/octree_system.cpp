@@ -25,8 +25,12 @@ std::vector<int> locate_pieces(const Octree& octree, const std::vector<ClippedTr
 }
 
 Octree build_octree(const GridCube& cube, const std::vector<ClippedTriangle>& pieces, int coarsest_depth) {
-  std::vector<GridKey> keys(pieces.size());
-  tbb::parallel_for(std::size_t(0), pieces.size(), [&](std::size_t p) { keys[p] = pieces[p].cell; });
+  // Fan triangles of one clipped polygon are consecutive and share a cell: dropping consecutive
+  // duplicates first shrinks the sort several times.
+  std::vector<GridKey> keys;
+  keys.reserve(pieces.size() / 2 + 1);
+  for (std::size_t p = 0; p < pieces.size(); ++p)
+    if (keys.empty() || keys.back() != pieces[p].cell) keys.push_back(pieces[p].cell);
   return build_octree(cube, std::move(keys), coarsest_depth);
 }
 
