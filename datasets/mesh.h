@@ -3,6 +3,7 @@
 // OpenMesh is used for reading, writing and topology checks only (DESIGN.md, practical notes).
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products are used everywhere meshes are
 
 namespace mcf {
 

@@ -15,7 +15,9 @@ namespace mcf {
 TriangleMesh read_mesh(const std::string& path);
 
 /// Writes a mesh; format from the extension (.off .ply .obj .stl); binary where the format has
-/// it and binary=true. Atomic: written to a temporary file in the same folder, then renamed.
+/// it and binary=true (PLY, STL; OFF and OBJ are always ASCII). OFF and OBJ keep doubles exactly
+/// (17 digits); PLY and STL go through OpenMesh and store float coordinates. Faces OpenMesh could not
+/// represent (non-manifold) are an error rather than silently dropped. Atomic: written to a temporary file in the same folder, then renamed.
 void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary = true);
 
 }  // namespace mcf

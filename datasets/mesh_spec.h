@@ -3,7 +3,10 @@
 //   sphere:vertices=40000[,radius=1]   icosphere:level=6   torus[:R=1,r=0.3,...]   spiral
 //   dumbbell   rounded_cylinder   open_cylinder   catenoid
 //   cgal:armadillo   cgal:armadillo@faces=832000   path/to/file.off[@faces=N]
-// "@faces=N" subdivides 1-to-4 until at least N faces.
+// "@faces=N" subdivides 1-to-4 until at least N faces (sphere/icosphere: new vertices are
+// projected back onto the sphere so sphere_radius stays exact).
+// Unknown generators, unknown or repeated keys and malformed numbers are errors naming the key;
+// parameters and defaults are listed by mesh_spec_help().
 
 #include "datasets/mesh.h"
 #include "datasets/validate.h"
@@ -26,6 +29,10 @@ struct MeshSource {
 /// validates. Throws MeshError naming the spec (and file) on any problem, including an unknown
 /// generator or parameter.
 MeshSource load_mesh_spec(const std::string& spec);
+
+/// Uniform scale and translation into the unit cube [0,1]^3: the longest bounding-box side
+/// becomes [0,1], the other axes are centred. What load_mesh_spec does to real models.
+void fit_unit_cube(TriangleMesh& mesh);
 
 /// Human-readable list of the supported specs (for --help).
 std::string mesh_spec_help();

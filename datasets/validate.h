@@ -19,6 +19,9 @@ struct MeshReport {
   long long euler_characteristic = 0;
   long long genus = 0;          ///< sum over components of (2 - χ_c - b_c) / 2
   double area = 0.0;
+  /// Interior edges whose two faces traverse them in the same direction (0 for a consistently
+  /// oriented mesh). Reported, not fatal: some real models are not orientable-consistent.
+  long long misoriented_edges = 0;
   bool closed() const { return boundary_loops == 0; }
 };
 
@@ -26,6 +29,9 @@ struct MeshReport {
 /// indices out of range, repeated indices in a face, degenerate (zero-area) faces or
 /// non-manifold edges (an edge shared by more than two faces). Otherwise returns the report.
 MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name);
+
+/// Unreferenced vertices do not count in χ or components. Boundary loops are the connected
+/// components of the boundary-edge graph (two holes touching at one vertex count as one).
 
 /// Vertices on a boundary loop (sorted, unique).
 std::vector<int> boundary_vertices(const TriangleMesh& mesh);

@@ -1,0 +1,83 @@
+#include "bases/hat_basis.h"
+
+#include "datasets/validate.h"
+
+#include <Eigen/Geometry>
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+
+namespace mcf {
+
+Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c) {
+  // cot of the angle at p between edges to q and r = (e1·e2) / |e1×e2|. A collapsed triangle
+  // (pinching) contributes nothing rather than inf, so the flow can report the singularity.
+  auto cot = [](const Eigen::Vector3d& e1, const Eigen::Vector3d& e2) {
+    const double cross = e1.cross(e2).norm();
+    return cross > 0.0 ? e1.dot(e2) / cross : 0.0;
+  };
+  return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
+}
+
+HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind)
+    : vertices0_(mesh.vertices), faces_(mesh.faces), mass_kind_(mass_kind) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Eigen::Index m = faces_.rows();
+  std::vector<int> rows(9 * m), cols(9 * m);
+  for (Eigen::Index f = 0; f < m; ++f)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        rows[9 * f + 3 * a + b] = faces_(f, a);
+        cols[9 * f + 3 * a + b] = faces_(f, b);
+      }
+  pattern_ = FixedPattern(vertices0_.rows(), rows, cols);
+  boundary_ = boundary_vertices(mesh);
+  const auto t1 = std::chrono::steady_clock::now();
+  update(vertices0_, true, true);
+  const auto t2 = std::chrono::steady_clock::now();
+
+  stats_.dimension = vertices0_.rows();
+  stats_.split_triangles = m;
+  stats_.cubature_points = 0;
+  stats_.levels = 1;
+  stats_.setup_seconds["pattern"] = std::chrono::duration<double>(t1 - t0).count();
+  stats_.setup_seconds["integrate"] = std::chrono::duration<double>(t2 - t1).count();
+}
+
+void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiffness) {
+  if (!update_mass && !update_stiffness) return;
+  const Eigen::Index m = faces_.rows();
+  std::vector<double> local_m(update_mass ? 9 * m : 0), local_k(update_stiffness ? 9 * m : 0);
+  const bool lumped = mass_kind_ == MassKind::lumped;
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, m, 2048), [&](const auto& r) {
+    for (Eigen::Index f = r.begin(); f != r.end(); ++f) {
+      const Eigen::Vector3d p[3] = {x.row(faces_(f, 0)).transpose(), x.row(faces_(f, 1)).transpose(),
+                                    x.row(faces_(f, 2)).transpose()};
+      if (update_mass) {
+        const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+        // Consistent P1 mass: A/6 on the diagonal, A/12 off it; lumped: A/3 on the diagonal.
+        const double diag = lumped ? area / 3.0 : area / 6.0, off = lumped ? 0.0 : area / 12.0;
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) local_m[9 * f + 3 * a + b] = a == b ? diag : off;
+      }
+      if (update_stiffness) {
+        // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite edge.
+        const Eigen::Vector3d cot = corner_cotangents(p[0], p[1], p[2]);
+        double* k = &local_k[9 * f];
+        for (int c = 0; c < 3; ++c) {
+          const int i = (c + 1) % 3, j = (c + 2) % 3;
+          const double w = 0.5 * cot[c];
+          k[3 * i + j] = -w;
+          k[3 * j + i] = -w;
+        }
+        for (int a = 0; a < 3; ++a) k[4 * a] = -(k[3 * a + (a + 1) % 3] + k[3 * a + (a + 2) % 3]);
+      }
+    }
+  });
+  if (update_mass) pattern_.gather(local_m, mass_);
+  if (update_stiffness) pattern_.gather(local_k, stiffness_);
+}
+
+}  // namespace mcf

@@ -1,0 +1,64 @@
+#include "bench/environment.h"
+
+#include "build_info.h"
+
+#include <Eigen/Core>
+#include <OpenMesh/Core/System/config.h>
+#include <suitesparse/cholmod.h>
+#include <tbb/info.h>
+#include <tbb/version.h>
+
+#include <fstream>
+#include <string>
+#include <sys/resource.h>
+#include <thread>
+#include <unistd.h>
+
+namespace mcf {
+namespace {
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
+    }
+  return "unknown";
+}
+
+std::string hostname() {
+  char buf[256] = {};
+  return ::gethostname(buf, sizeof buf - 1) == 0 ? buf : "unknown";
+}
+
+}  // namespace
+
+nlohmann::json environment_json(int threads) {
+  const int cores = int(std::thread::hardware_concurrency());
+  const auto v = [](int a, int b, int c) { return std::to_string(a) + "." + std::to_string(b) + "." + std::to_string(c); };
+  return {{"commit", MCFBENCH_GIT_COMMIT},
+          {"version", MCFBENCH_VERSION},
+          {"cpu", cpu_model()},
+          {"cores", cores},
+          {"threads", threads > 0 ? threads : tbb::info::default_concurrency()},
+          {"hostname", hostname()},
+          {"build", {{"type", MCFBENCH_BUILD_TYPE}, {"compiler", MCFBENCH_CXX_COMPILER}}},
+          {"libraries",
+           {{"eigen", v(EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION)},
+            {"cholmod", v(CHOLMOD_MAIN_VERSION, CHOLMOD_SUB_VERSION, CHOLMOD_SUBSUB_VERSION)},
+            {"suitesparse", v(SUITESPARSE_MAIN_VERSION, SUITESPARSE_SUB_VERSION, SUITESPARSE_SUBSUB_VERSION)},
+            {"tbb", TBB_VERSION_STRING},
+            {"openmesh", std::to_string((OM_VERSION >> 16) & 0xFF) + "." + std::to_string((OM_VERSION >> 8) & 0xFF)},
+            {"nlohmann_json", v(NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH)},
+            {"blas", "openblas"}}}};
+}
+
+long long peak_memory_bytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<long long>(u.ru_maxrss) * 1024;
+}
+
+}  // namespace mcf

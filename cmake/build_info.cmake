@@ -1,0 +1,14 @@
+# Runs at every build (not only at configure): the commit baked into results must be the one
+# the binary was built from. Rewrites the header only when it changes, so nothing rebuilds.
+execute_process(COMMAND git rev-parse --short=12 HEAD WORKING_DIRECTORY ${SOURCE_DIR}
+                OUTPUT_VARIABLE MCFBENCH_GIT_COMMIT OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+execute_process(COMMAND git status --porcelain --untracked-files=no WORKING_DIRECTORY ${SOURCE_DIR}
+                OUTPUT_VARIABLE _dirty OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+if(NOT MCFBENCH_GIT_COMMIT)
+  set(MCFBENCH_GIT_COMMIT "unknown")
+elseif(_dirty)
+  set(MCFBENCH_GIT_COMMIT "${MCFBENCH_GIT_COMMIT}-dirty")
+endif()
+configure_file(${SOURCE_DIR}/cmake/build_info.h.in ${OUTPUT}.tmp @ONLY)
+execute_process(COMMAND ${CMAKE_COMMAND} -E copy_if_different ${OUTPUT}.tmp ${OUTPUT})
+file(REMOVE ${OUTPUT}.tmp)

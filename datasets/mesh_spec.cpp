@@ -1,0 +1,251 @@
+// Mesh-spec strings: `name[:k=v,...][@faces=N]`, `cgal:MODEL[@faces=N]` or a file path.
+// Strict on purpose: a typo in a benchmark config must fail, not silently run the default.
+
+#include "datasets/mesh_spec.h"
+
+#include "datasets/catalogue.h"
+#include "datasets/generators.h"
+#include "datasets/mesh_io.h"
+#include "datasets/subdivide.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace mcf {
+namespace {
+
+struct Param {
+  std::string key;
+  bool integer;
+  double fallback;
+  std::string help;
+};
+
+using Values = std::map<std::string, double>;
+
+struct Generator {
+  std::string name;
+  std::vector<Param> params;
+  std::function<TriangleMesh(const Values&)> build;
+  std::string help;
+};
+
+int as_int(const Values& v, const std::string& k) { return static_cast<int>(v.at(k)); }
+
+const std::vector<Generator>& generators() {
+  static const std::vector<Generator> table = {
+      {"sphere",
+       {{"vertices", true, 10242, "target vertex count"}, {"radius", false, 1.0, "radius"}},
+       [](const Values& v) { return make_sphere(static_cast<long long>(v.at("vertices")), v.at("radius")); },
+       "geodesic sphere with about `vertices` vertices, centred at the origin"},
+      {"icosphere",
+       {{"level", true, 5, "1-to-4 subdivisions of the icosahedron"}, {"radius", false, 1.0, "radius"}},
+       [](const Values& v) { return make_icosphere(as_int(v, "level"), v.at("radius")); },
+       "icosahedron subdivided `level` times (10*4^level+2 vertices)"},
+      {"torus",
+       {{"R", false, 1.0, "major radius"}, {"r", false, 0.3, "minor radius"},
+        {"n_major", true, 96, "segments around the axis"}, {"n_minor", true, 32, "segments around the tube"}},
+       [](const Values& v) { return make_torus(v.at("R"), v.at("r"), as_int(v, "n_major"), as_int(v, "n_minor")); },
+       "torus about z (genus 1)"},
+      {"spiral",
+       {{"turns", true, 3, "turns"}, {"segments_per_turn", true, 128, "segments along one turn"},
+        {"profile_segments", true, 8, "segments across the ribbon"}},
+       [](const Values& v) {
+         return make_cubical_spiral(as_int(v, "turns"), as_int(v, "segments_per_turn"), as_int(v, "profile_segments"));
+       },
+       "cubical spiral: square-profile helical ribbon with boundary"},
+      {"dumbbell",
+       {{"resolution", true, 64, "vertices around"}},
+       [](const Values& v) { return make_dumbbell(as_int(v, "resolution")); },
+       "two unit spheres joined by a thin neck (genus 0)"},
+      {"rounded_cylinder",
+       {{"radius", false, 0.5, "radius"}, {"length", false, 2.0, "length of the straight part"},
+        {"resolution", true, 64, "vertices around"}},
+       [](const Values& v) { return make_rounded_cylinder(v.at("radius"), v.at("length"), as_int(v, "resolution")); },
+       "closed capsule (cylinder with hemispherical caps)"},
+      {"open_cylinder",
+       {{"radius", false, 0.5, "radius"}, {"length", false, 2.0, "length"},
+        {"n_around", true, 64, "vertices around"}, {"n_along", true, 40, "segments along"}},
+       [](const Values& v) {
+         return make_open_cylinder(v.at("radius"), v.at("length"), as_int(v, "n_around"), as_int(v, "n_along"));
+       },
+       "open cylinder (two boundary loops)"},
+      {"catenoid",
+       {{"waist", false, 1.0, "waist radius"}, {"height", false, 1.0, "half height h (z in [-h, h])"},
+        {"n_around", true, 64, "vertices around"}, {"n_along", true, 24, "segments along"}},
+       [](const Values& v) {
+         return make_catenoid(v.at("waist"), v.at("height"), as_int(v, "n_around"), as_int(v, "n_along"));
+       },
+       "catenoid (minimal surface, two boundary loops)"},
+  };
+  return table;
+}
+
+[[noreturn]] void fail(const std::string& spec, const std::string& problem) {
+  throw MeshError("mesh spec '" + spec + "': " + problem);
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+bool looks_like_file(const std::string& s) {
+  if (s.find('/') != std::string::npos) return true;
+  const std::string l = lower(s);
+  for (const char* ext : {".off", ".ply", ".obj", ".stl"})
+    if (l.size() > 4 && l.compare(l.size() - 4, 4, ext) == 0) return true;
+  return false;
+}
+
+// Whole-string numbers only: "12abc", "", "1e400" and "nan" are errors, and so is "1.5" for an
+// integer key.
+double parse_number(const std::string& spec, const std::string& key, const std::string& text, bool integer) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  double value;
+  if (integer) {
+    const long long v = std::strtoll(begin, &end, 10);
+    value = static_cast<double>(v);
+  } else {
+    value = std::strtod(begin, &end);
+  }
+  if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(value))
+    fail(spec, "key '" + key + "' needs " + (integer ? "an integer" : "a number") + ", got '" + text + "'");
+  return value;
+}
+
+std::string param_list(const Generator& g) {
+  std::string s;
+  for (const auto& p : g.params) s += (s.empty() ? "" : ", ") + p.key;
+  return s;
+}
+
+}  // namespace
+
+void fit_unit_cube(TriangleMesh& mesh) {
+  if (mesh.num_vertices() == 0) return;
+  const Eigen::RowVector3d lo = mesh.vertices.colwise().minCoeff();
+  const Eigen::RowVector3d hi = mesh.vertices.colwise().maxCoeff();
+  const Eigen::RowVector3d extent = hi - lo;
+  const double scale = extent.maxCoeff() > 0 ? 1.0 / extent.maxCoeff() : 1.0;
+  // Uniform scale (shape kept); the shorter axes are centred in [0, 1].
+  const Eigen::RowVector3d offset = 0.5 * (Eigen::RowVector3d::Ones() - scale * extent);
+  mesh.vertices = ((mesh.vertices.rowwise() - lo) * scale).rowwise() + offset;
+}
+
+MeshSource load_mesh_spec(const std::string& spec) {
+  MeshSource src;
+  src.spec = spec;
+
+  // Split off "@faces=N".
+  std::string head = spec;
+  long long target_faces = 0;
+  if (auto at = spec.rfind('@'); at != std::string::npos && !looks_like_file(spec.substr(at + 1))) {
+    head = spec.substr(0, at);
+    const std::string mod = spec.substr(at + 1);
+    const auto eq = mod.find('=');
+    const std::string key = mod.substr(0, eq);
+    if (key != "faces" || eq == std::string::npos)
+      fail(spec, "unknown modifier key '" + key + "' (only @faces=N)");
+    target_faces = static_cast<long long>(parse_number(spec, "faces", mod.substr(eq + 1), true));
+    if (target_faces < 1 || target_faces > 200'000'000)
+      fail(spec, "key 'faces' must be in 1..200000000, got " + mod.substr(eq + 1));
+  }
+  if (head.empty()) fail(spec, "empty mesh spec");
+
+  std::string validate_name = spec;
+  if (looks_like_file(head)) {
+    src.kind = "file";
+    src.mesh = read_mesh(head);  // its errors name the file
+    fit_unit_cube(src.mesh);
+    validate_name = head;
+  } else {
+    const auto colon = head.find(':');
+    const std::string name = head.substr(0, colon);
+    const std::string args = colon == std::string::npos ? "" : head.substr(colon + 1);
+    if (name == "cgal") {
+      src.kind = "cgal";
+      if (args.empty()) fail(spec, "cgal needs a model name, e.g. cgal:armadillo");
+      try {
+        src.mesh = read_mesh(catalogue_path(args));
+      } catch (const MeshError& e) {
+        fail(spec, e.what());
+      }
+      fit_unit_cube(src.mesh);
+    } else {
+      const auto& table = generators();
+      auto g = std::find_if(table.begin(), table.end(), [&](const Generator& x) { return x.name == name; });
+      if (g == table.end()) {
+        std::string known = "cgal";
+        for (const auto& x : table) known += ", " + x.name;
+        fail(spec, "unknown generator '" + name + "' (known: " + known + ", or a file path)");
+      }
+      Values values;
+      for (const auto& p : g->params) values[p.key] = p.fallback;
+      std::vector<std::string> seen;
+      size_t pos = 0;
+      while (colon != std::string::npos && pos <= args.size()) {
+        const size_t comma = std::min(args.find(',', pos), args.size());
+        const std::string item = args.substr(pos, comma - pos);
+        pos = comma + 1;
+        const auto eq = item.find('=');
+        const std::string key = item.substr(0, eq);
+        if (eq == std::string::npos || key.empty())
+          fail(spec, "expected key=value, got '" + item + "' (keys of " + name + ": " + param_list(*g) + ")");
+        auto p = std::find_if(g->params.begin(), g->params.end(), [&](const Param& x) { return x.key == key; });
+        if (p == g->params.end())
+          fail(spec, "unknown key '" + key + "' for " + name + " (keys: " + param_list(*g) + ")");
+        if (std::find(seen.begin(), seen.end(), key) != seen.end()) fail(spec, "key '" + key + "' given twice");
+        seen.push_back(key);
+        values[key] = parse_number(spec, key, item.substr(eq + 1), p->integer);
+      }
+      src.kind = name;
+      src.analytic = true;
+      try {
+        src.mesh = g->build(values);
+      } catch (const MeshError& e) {
+        fail(spec, e.what());
+      }
+      if (name == "sphere" || name == "icosphere") src.sphere_radius = values.at("radius");
+    }
+  }
+
+  if (target_faces > 0) {
+    src.mesh = subdivide_to_faces(src.mesh, target_faces);
+    // Midpoints of a sphere lie inside it; put them back so sphere_radius stays exact.
+    if (src.sphere_radius) src.mesh.vertices = src.mesh.vertices.rowwise().normalized() * *src.sphere_radius;
+  }
+  src.report = validate_mesh(src.mesh, validate_name);
+  return src;
+}
+
+std::string mesh_spec_help() {
+  std::string s =
+      "Mesh specs: NAME[:key=value,...][@faces=N] | cgal:MODEL[@faces=N] | path/to/file.{off,ply,obj,stl}[@faces=N]\n"
+      "  @faces=N subdivides 1-to-4 until at least N faces. Files and cgal models are scaled\n"
+      "  uniformly into the unit cube; generated shapes keep their size.\n"
+      "Generators:\n";
+  for (const auto& g : generators()) {
+    s += "  " + g.name + " - " + g.help + "\n";
+    for (const auto& p : g.params) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, p.integer ? "%.0f" : "%g", p.fallback);
+      s += "      " + p.key + "=" + buf + "  " + p.help + "\n";
+    }
+  }
+  s += "Catalogue (libcgal-demo data.tar.gz, see scripts/setup.sh):\n ";
+  for (const auto& m : catalogue_models()) s += " cgal:" + m;
+  s += "\n";
+  return s;
+}
+
+}  // namespace mcf

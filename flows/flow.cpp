@@ -1,0 +1,275 @@
+#include "flows/flow.h"
+
+#include "datasets/validate.h"
+
+#include <Eigen/Geometry>
+#include "flows/integrator.h"
+#include "flows/reduced_system.h"
+#include "flows/registry.h"
+#include "flows/sphere_reference.h"
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include <chrono>
+#include <cmath>
+
+namespace mcf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+int severity(SolveStatus s) {
+  switch (s) {
+    case SolveStatus::converged: return 0;
+    case SolveStatus::max_iterations: return 1;
+    default: return 2;
+  }
+}
+
+// The StepContext of a flow: which operators are re-assembled (MCF both, cMCF mass only,
+// heat neither after the first step), the reduced solve, and per-step timing.
+class FlowStepContext final : public StepContext {
+ public:
+  FlowStepContext(Basis& basis, LinearSolver& solver, const std::string& flow, double dt)
+      : basis_(basis), solver_(solver), system_(std::make_unique<ReducedSystem>(basis, solver)), flow_(flow), dt_(dt) {}
+
+  double dt() const override { return dt_; }
+  const Coefficients& current() const override { return x_; }
+  const Coefficients* previous() const override { return has_prev_ ? &x_prev_ : nullptr; }
+
+  void evaluate_operators(const Coefficients& X) override {
+    const auto t0 = Clock::now();
+    const bool first = !assembled_;
+    const bool mass = flow_ != "heat" || first;
+    const bool stiffness = flow_ == "mcf" || first;
+    basis_.update(X, mass, stiffness);
+    assembled_ = true;
+    update_seconds_ += seconds_since(t0);
+  }
+  Coefficients apply_mass(const Coefficients& X) const override { return basis_.mass() * X; }
+  Coefficients apply_stiffness(const Coefficients& X) const override { return basis_.stiffness() * X; }
+
+  Coefficients solve(double a, double b, const Coefficients& R, const Coefficients& fixed,
+                     const Coefficients& warm) override {
+    const auto t0 = Clock::now();
+    Coefficients Y = system_->solve(a, b, R, fixed, warm);
+    solve_seconds_ += seconds_since(t0);
+    const SolveReport& r = system_->report();
+    ++solves_;
+    iterations_ += r.iterations;
+    last_ = r;
+    if (severity(r.status) >= severity(worst_.status)) worst_ = r;
+    return Y;
+  }
+
+  // Per-step bookkeeping.
+  void begin_step(const Coefficients& x, const Coefficients* prev) {
+    x_ = x;
+    has_prev_ = prev != nullptr;
+    if (prev) x_prev_ = *prev;
+    update_seconds_ = solve_seconds_ = 0;
+    solves_ = iterations_ = 0;
+    worst_ = SolveReport{};
+    last_ = SolveReport{};
+  }
+  void rebuilt() {
+    // A rebuilt basis has new functions: forget the reduction and assemble afresh.
+    system_ = std::make_unique<ReducedSystem>(basis_, solver_);
+    assembled_ = false;
+  }
+  void add_update_seconds(double s) { update_seconds_ += s; }
+
+  double update_seconds_ = 0, solve_seconds_ = 0;
+  int solves_ = 0, iterations_ = 0;
+  SolveReport worst_, last_;
+  std::size_t fixed() const { return system_->num_fixed(); }
+
+ private:
+  Basis& basis_;
+  LinearSolver& solver_;
+  std::unique_ptr<ReducedSystem> system_;
+  std::string flow_;
+  double dt_;
+  Coefficients x_, x_prev_;
+  bool has_prev_ = false, assembled_ = false;
+};
+
+nlohmann::json stats_json(const BasisStats& s) {
+  return {{"dimension", s.dimension},
+          {"split_triangles", s.split_triangles},
+          {"cubature_points", s.cubature_points},
+          {"levels", s.levels},
+          {"bytes_per_cubature_point", s.bytes_per_cubature_point},
+          {"setup_seconds", s.setup_seconds}};
+}
+
+bool all_finite(const Positions& V) { return V.allFinite(); }
+
+}  // namespace
+
+Normalization unit_area_normalization(const Positions& V, const Triangles& F) {
+  double area = 0;
+  Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::RowVector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), d = V.row(F(f, 2));
+    const double A = 0.5 * (b - a).cross(d - a).norm();
+    area += A;
+    c += A * (a + b + d) / 3.0;
+  }
+  Normalization n;
+  if (area > 0) {
+    n.centroid = c / area;
+    n.scale = 1.0 / std::sqrt(area);
+  }
+  return n;
+}
+
+FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const FlowObserver& observer) {
+  const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
+  tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+
+  FlowOutcome out;
+  nlohmann::json& result = out.result;
+  result["schema"] = 1;
+  result["status"] = "ok";
+  result["config"] = to_json(config);
+  const MeshReport& rep = source.report;
+  result["mesh"] = {{"spec", source.spec},
+                    {"vertices", rep.vertices},
+                    {"faces", rep.faces},
+                    {"boundary_loops", rep.boundary_loops},
+                    {"genus", rep.genus},
+                    {"components", rep.connected_components},
+                    {"area", rep.area},
+                    {"analytic", source.analytic}};
+
+  TriangleMesh mesh = source.mesh;
+  const Triangles& F = mesh.faces;
+  auto apply = [](const Normalization& n, Coefficients& x) {
+    x = (x.rowwise() - n.centroid) * n.scale;
+  };
+  if (config.normalize_area) apply(unit_area_normalization(mesh.vertices, F), mesh.vertices);
+
+  const auto setup_start = Clock::now();
+  std::unique_ptr<Basis> basis = make_basis(config, mesh, source.analytic);
+  std::unique_ptr<LinearSolver> solver = make_solver(config.solver);
+  std::unique_ptr<Integrator> integrator = make_integrator(config.integrator, config.extrapolate);
+  result["system"] = stats_json(basis->stats());
+  result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);
+  result["solver_name"] = solver->name();
+
+  FlowStepContext ctx(*basis, *solver, config.flow, config.dt);
+  Positions V = mesh.vertices;
+  Coefficients x = basis->initial_coefficients(), x_prev;
+  bool has_prev = false;
+  const double area0 = surface_area(mesh);
+  std::optional<SphereReference> sphere;
+  if (source.sphere_radius && !config.normalize_area) sphere.emplace(*source.sphere_radius, config.flow == "heat");
+
+  if (observer.on_step) observer.on_step(0, 0.0, V);
+  nlohmann::json steps = nlohmann::json::array();
+  auto stop = [&](int step, const std::string& reason) {
+    result["status"] = "singular";
+    result["stop"] = {{"step", step}, {"reason", reason}};
+  };
+
+  for (int step = 1; step <= config.steps; ++step) {
+    const auto step_start = Clock::now();
+    const double t = step * config.dt;
+    if (basis->rebuilds_every_step()) {
+      const auto t0 = Clock::now();
+      if (step > 1) {
+        basis->rebuild(V);
+        ctx.rebuilt();
+      }
+      x = basis->initial_coefficients();
+      has_prev = false;
+      ctx.begin_step(x, nullptr);
+      if (step > 1) ctx.add_update_seconds(seconds_since(t0));
+    } else {
+      ctx.begin_step(x, has_prev ? &x_prev : nullptr);
+    }
+
+    Coefficients x_new = integrator->step(ctx);
+    const SolveReport& worst = ctx.worst_;
+    nlohmann::json record = {{"step", step}, {"t", t}};
+    record["solver"] = {{"iterations", ctx.iterations_},
+                        {"solves", ctx.solves_},
+                        {"residuals", ctx.last_.residuals},
+                        {"relative_residual", worst.relative_residual},
+                        {"status", to_string(worst.status)}};
+    if (ctx.fixed()) record["fixed_functions"] = ctx.fixed();
+    if (basis->rebuilds_every_step()) {
+      record["dimension"] = basis->dimension();
+      record["split_triangles"] = basis->stats().split_triangles;
+      record["setup_seconds"] = basis->stats().setup_seconds;
+    }
+    if (!worst.ok()) {
+      record["seconds"] = {{"update", ctx.update_seconds_}, {"solve", ctx.solve_seconds_}, {"total", seconds_since(step_start)}};
+      steps.push_back(record);
+      stop(step, std::string("solver: ") + to_string(worst.status) + (worst.message.empty() ? "" : " (" + worst.message + ")"));
+      break;
+    }
+
+    const auto eval_start = Clock::now();
+    Positions V_new = basis->evaluate_vertices(x_new);
+    if (!all_finite(V_new) || !x_new.allFinite()) {
+      steps.push_back(record);
+      stop(step, "non-finite vertex positions");
+      break;
+    }
+    const double area = surface_area(TriangleMesh{V_new, F});
+    if (!(area > 1e-12 * area0)) {
+      steps.push_back(record);
+      stop(step, "collapsed area (" + std::to_string(area) + ")");
+      break;
+    }
+    if (area > 1e3 * area0) {
+      // MCF, cMCF and heat flow never increase the area: this is an unstable (explicit) step.
+      steps.push_back(record);
+      stop(step, "diverged: area grew to " + std::to_string(area / area0) + "x the initial area");
+      break;
+    }
+    double step_difference = 0;
+    if (config.normalize_area) {
+      const Normalization n = unit_area_normalization(V_new, F);
+      apply(n, V_new);
+      apply(n, x_new);
+      apply(n, x);  // becomes X_{n-1}: same frame as X_n for two-step schemes
+    }
+    step_difference = (V_new - V).norm();
+    const double evaluate_seconds = seconds_since(eval_start);
+
+    record["area"] = area;
+    record["step_difference"] = step_difference;
+    if (sphere) {
+      sphere->advance(config.dt);
+      const RadialError d = radial_error(V_new, sphere->discrete);
+      const RadialError c = radial_error(V_new, sphere->continuous(t));
+      record["radial_error"] = {{"rms", d.rms},
+                                {"max", d.max},
+                                {"rms_continuous", c.rms},
+                                {"max_continuous", c.max},
+                                {"radius_semi_implicit", sphere->discrete},
+                                {"radius_continuous", sphere->continuous(t)}};
+    }
+    x_prev = std::move(x);
+    x = std::move(x_new);
+    has_prev = true;
+    V = std::move(V_new);
+    record["seconds"] = {{"update", ctx.update_seconds_},
+                         {"solve", ctx.solve_seconds_},
+                         {"evaluate", evaluate_seconds},
+                         {"total", seconds_since(step_start)}};
+    steps.push_back(std::move(record));
+    if (observer.on_step) observer.on_step(step, t, V);
+  }
+  if (!result.contains("stop")) result["stop"] = {{"step", int(steps.size())}, {"reason", "completed"}};
+  result["steps"] = std::move(steps);
+  out.final_mesh = TriangleMesh{V, F};
+  return out;
+}
+
+}  // namespace mcf

@@ -1,0 +1,100 @@
+#include "flows/flow_config.h"
+
+#include "flows/config_reader.h"
+#include "flows/integrator.h"
+
+namespace mcf {
+
+FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& source) {
+  ConfigReader r(j, source);
+  FlowConfig c;
+  c.mesh = r.get_string("mesh", "");
+  if (c.mesh.empty()) r.fail("mesh", "missing (a mesh spec such as \"sphere:vertices=2000\")");
+  c.flow = r.get_string("flow", c.flow, {"mcf", "cmcf", "heat"});
+  c.basis = r.get_string("basis", c.basis, {"hat", "octree"});
+  c.mass = r.get_string("mass", c.mass, {"consistent", "lumped"});
+  {
+    auto o = r.child("octree");
+    c.octree.tracking = o.get_string("tracking", c.octree.tracking, {"tracked", "rebuilt"});
+    c.octree.depth = int(o.get_integer("depth", c.octree.depth, 2, 10));
+    c.octree.cubature = int(o.get_integer("cubature", c.octree.cubature, 1, 6));
+    if (c.octree.cubature != 1 && c.octree.cubature != 3 && c.octree.cubature != 6)
+      o.fail("cubature", "must be 1, 3 or 6, got " + std::to_string(c.octree.cubature));
+    c.octree.cube = o.get_string("cube", c.octree.cube, {"auto", "unit", "tight"});
+    c.octree.refine_input = o.get_bool("refine_input", c.octree.refine_input);
+    o.finish();
+  }
+  {
+    auto s = r.child("solver");
+    c.solver.name = s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "dense"});
+    c.solver.tolerance = s.get_number("tolerance", c.solver.tolerance, -1, 1);
+    c.solver.max_iterations = int(s.get_integer("max_iterations", c.solver.max_iterations, 1, 100000000));
+    c.solver.preconditioner =
+        s.get_string("preconditioner", c.solver.preconditioner, {"none", "jacobi", "ichol", "multigrid"});
+    c.solver.cycle = s.get_string("cycle", c.solver.cycle, {"V", "W"});
+    c.solver.cycles = int(s.get_integer("cycles", c.solver.cycles, 1, 10000));
+    c.solver.smooth = int(s.get_integer("smooth", c.solver.smooth, 0, 1000));
+    s.finish();
+  }
+  c.integrator = r.get_string("integrator", c.integrator, integrator_names());
+  c.extrapolate = r.get_bool("extrapolate", c.extrapolate);
+  c.dt = r.get_number("dt", c.dt, 1e-300, 1e6);
+  if (c.dt <= 0) r.fail("dt", "must be > 0");
+  c.steps = int(r.get_integer("steps", c.steps, 0, 100000000));
+  c.normalize_area = r.get_bool("normalize_area", c.normalize_area);
+  c.threads = int(r.get_integer("threads", c.threads, 0, 4096));
+  c.save_every = int(r.get_integer("save_every", c.save_every, 0, 100000000));
+  r.finish();
+  if (c.solver.tolerance < 0) c.solver.tolerance = c.solver.name == "multigrid" ? 0.0 : 1e-10;
+  validate_flow_config(c, source);
+  return c;
+}
+
+nlohmann::json to_json(const FlowConfig& c) {
+  return {{"mesh", c.mesh},
+          {"flow", c.flow},
+          {"basis", c.basis},
+          {"mass", c.mass},
+          {"octree",
+           {{"tracking", c.octree.tracking},
+            {"depth", c.octree.depth},
+            {"cubature", c.octree.cubature},
+            {"cube", c.octree.cube},
+            {"refine_input", c.octree.refine_input}}},
+          {"solver",
+           {{"name", c.solver.name},
+            {"tolerance", c.solver.tolerance},
+            {"max_iterations", c.solver.max_iterations},
+            {"preconditioner", c.solver.preconditioner},
+            {"cycle", c.solver.cycle},
+            {"cycles", c.solver.cycles},
+            {"smooth", c.solver.smooth}}},
+          {"integrator", c.integrator},
+          {"extrapolate", c.extrapolate},
+          {"dt", c.dt},
+          {"steps", c.steps},
+          {"normalize_area", c.normalize_area},
+          {"threads", c.threads},
+          {"save_every", c.save_every}};
+}
+
+void validate_flow_config(const FlowConfig& c, const std::string& source) {
+  auto fail = [&](const std::string& key, const std::string& what) {
+    throw ConfigError(source + ": " + key + ": " + what);
+  };
+  const bool rebuilt = c.basis == "octree" && c.octree.tracking == "rebuilt";
+  if (c.basis == "hat" && (c.solver.name == "multigrid" || c.solver.preconditioner == "multigrid") &&
+      (c.solver.name != "pcg" || c.solver.preconditioner == "multigrid"))
+    fail("solver", "multigrid needs a hierarchy: use basis \"octree\" (the hat basis has none)");
+  if (rebuilt && c.flow == "cmcf")
+    fail("flow", "cmcf keeps the stiffness of t=0, which needs a fixed basis; the rebuilt octree "
+                 "changes its functions every step (use octree.tracking \"tracked\" or basis \"hat\")");
+  if (rebuilt && c.flow == "heat")
+    fail("flow", "heat flow keeps the operators of t=0, which needs a fixed basis; the rebuilt "
+                 "octree changes its functions every step");
+  if (rebuilt && (c.integrator == "bdf2" || c.integrator == "crank-nicolson"))
+    fail("integrator", "two-step schemes need coefficients in one fixed basis; the rebuilt octree "
+                       "changes its functions every step");
+}
+
+}  // namespace mcf

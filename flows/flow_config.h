@@ -1,0 +1,53 @@
+#pragma once
+// Every option of one flow run. The same JSON object is a cell of the experiment matrix and the
+// "config" of result.json (with all defaults filled in), so the names below are stable.
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace mcf {
+
+struct OctreeConfig {
+  std::string tracking = "tracked";  ///< tracked | rebuilt
+  int depth = 8;                     ///< finest level, 4..10
+  int cubature = 3;                  ///< 1 | 3 | 6 (rule's name, DESIGN.md "Octree")
+  std::string cube = "auto";         ///< auto | unit | tight
+  bool refine_input = false;         ///< 1-to-4 split of the initial mesh first (Fig. 6, blue)
+};
+
+struct SolverConfig {
+  std::string name = "cholmod";          ///< cholmod | pcg | multigrid | dense (LLT reference, small systems)
+  double tolerance = -1;                 ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
+  int max_iterations = 1000;             ///< PCG iteration cap
+  std::string preconditioner = "jacobi"; ///< PCG: none | jacobi | ichol | multigrid
+  std::string cycle = "W";               ///< multigrid: V | W
+  int cycles = 1;                        ///< multigrid cycles per solve
+  int smooth = 5;                        ///< Gauss–Seidel sweeps before and after (each)
+};
+
+struct FlowConfig {
+  std::string mesh;                       ///< mesh spec (datasets/mesh_spec.h)
+  std::string flow = "mcf";               ///< mcf | cmcf | heat
+  std::string basis = "hat";              ///< hat | octree
+  std::string mass = "consistent";        ///< hat basis: consistent | lumped
+  OctreeConfig octree;
+  SolverConfig solver;
+  std::string integrator = "semi-implicit";  ///< see integrator_names()
+  bool extrapolate = true;                ///< CN/BDF2: operators at the extrapolated X* (else frozen at X_n)
+  double dt = 1e-3;
+  int steps = 10;
+  bool normalize_area = false;            ///< unit area, centroid at origin, before and after every step
+  int threads = 0;                        ///< 0 = all cores
+  int save_every = 0;                     ///< write frame_NNNN.ply every K steps (0 = never)
+};
+
+/// Reads a flow config strictly (unknown keys, wrong types, out-of-range values are errors that
+/// name `source` and the key path) and fills defaults. Throws ConfigError.
+FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& source);
+/// The config as JSON with every default filled in (what result.json records).
+nlohmann::json to_json(const FlowConfig& c);
+/// Cross-option checks (e.g. multigrid needs the octree, cMCF needs a fixed basis).
+void validate_flow_config(const FlowConfig& c, const std::string& source);
+
+}  // namespace mcf

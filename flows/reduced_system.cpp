@@ -1,0 +1,153 @@
+#include "flows/reduced_system.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace mcf {
+namespace {
+
+bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {
+  return A.rows() == B.rows() && A.nonZeros() == B.nonZeros() &&
+         std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
+         std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr());
+}
+
+}  // namespace
+
+ReducedSystem::ReducedSystem(const Basis& basis, LinearSolver& solver)
+    : basis_(basis), solver_(solver), base_fixed_(basis.locked_functions()) {
+  std::sort(base_fixed_.begin(), base_fixed_.end());
+}
+
+Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, const Coefficients& fixed_values,
+                                  const Coefficients& warm) {
+  const SparseMatrix& M = basis_.mass();
+  const SparseMatrix& K = basis_.stiffness();
+  const Eigen::Index n = M.rows();
+  // S = a M + b K. Bases assemble M and K on one pattern, so this is a value-wise sum.
+  if (b == 0.0) {
+    sum_ = M;
+    if (a != 1.0) sum_ *= a;
+  } else if (same_pattern(M, K)) {
+    if (!same_pattern(sum_, M)) sum_ = M;
+    const double *m = M.valuePtr(), *k = K.valuePtr();
+    double* s = sum_.valuePtr();
+    const Eigen::Index nnz = M.nonZeros();
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, nnz, 1 << 14), [&](const auto& r) {
+      for (Eigen::Index i = r.begin(); i != r.end(); ++i) s[i] = a * m[i] + b * k[i];
+    });
+  } else {
+    sum_ = a * M + b * K;
+    sum_.makeCompressed();
+  }
+
+  // Fixed set: the basis's locked functions plus rows that received no contribution.
+  std::vector<int> fixed = base_fixed_;
+  {
+    const auto* outer = sum_.outerIndexPtr();
+    const double* v = sum_.valuePtr();
+    for (Eigen::Index c = 0; c < n; ++c) {
+      bool empty = true;
+      for (int p = outer[c]; p < outer[c + 1] && empty; ++p) empty = v[p] == 0.0;
+      if (empty) fixed.push_back(int(c));
+    }
+    std::sort(fixed.begin(), fixed.end());
+    fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+  }
+
+  HierarchyView view{basis_.prolongations(), basis_.colours()};
+  if (fixed.empty()) {
+    fixed_.clear();
+    reduction_valid_ = false;
+    report_ = solver_.set_matrix(sum_, view);
+    Eigen::MatrixXd X = warm;
+    if (report_.ok()) report_ = solver_.solve(R, X);
+    return X;
+  }
+
+  if (!reduction_valid_ || fixed != fixed_ || !same_pattern(pattern_, sum_)) {
+    fixed_ = std::move(fixed);
+    rebuild_reduction(sum_);
+  }
+
+  // Reduced matrix values.
+  {
+    double* rv = reduced_.valuePtr();
+    const double* sv = sum_.valuePtr();
+    for (std::size_t i = 0; i < source_nz_.size(); ++i) rv[i] = sv[source_nz_[i]];
+  }
+  // Right-hand side: R_f - S_fl Y_l.
+  Coefficients Yfixed = Coefficients::Zero(n, 3);
+  for (int i : fixed_) Yfixed.row(i) = fixed_values.row(i);
+  const Coefficients coupling = sum_ * Yfixed;
+  const Eigen::Index nf = Eigen::Index(free_.size());
+  Eigen::MatrixXd Rf(nf, 3), Xf(nf, 3);
+  for (Eigen::Index i = 0; i < nf; ++i) {
+    Rf.row(i) = R.row(free_[i]) - coupling.row(free_[i]);
+    Xf.row(i) = warm.row(free_[i]);
+  }
+  HierarchyView reduced_view;
+  if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
+  report_ = solver_.set_matrix(reduced_, reduced_view);
+  if (report_.ok()) report_ = solver_.solve(Rf, Xf);
+  Coefficients Y = Yfixed;
+  for (Eigen::Index i = 0; i < nf; ++i) Y.row(free_[i]) = Xf.row(i);
+  return Y;
+}
+
+void ReducedSystem::rebuild_reduction(const SparseMatrix& S) {
+  const Eigen::Index n = S.rows();
+  reduced_of_.assign(n, 0);
+  for (int i : fixed_) reduced_of_[i] = -1;
+  free_.clear();
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (reduced_of_[i] == 0) {
+      reduced_of_[i] = int(free_.size());
+      free_.push_back(int(i));
+    }
+  const Eigen::Index nf = Eigen::Index(free_.size());
+  std::vector<int> outer(nf + 1, 0), inner;
+  source_nz_.clear();
+  for (Eigen::Index j = 0; j < nf; ++j) {
+    const int c = free_[j];
+    for (int p = S.outerIndexPtr()[c]; p < S.outerIndexPtr()[c + 1]; ++p) {
+      const int r = reduced_of_[S.innerIndexPtr()[p]];
+      if (r < 0) continue;
+      inner.push_back(r);
+      source_nz_.push_back(p);
+    }
+    outer[j + 1] = int(inner.size());
+  }
+  const std::vector<double> zeros(inner.size(), 0.0);
+  reduced_ = Eigen::Map<const SparseMatrix>(nf, nf, Eigen::Index(inner.size()), outer.data(), inner.data(),
+                                            zeros.data());
+  reduced_.makeCompressed();
+
+  // Restrict the finest prolongation's rows (and the finest colours) to the free functions; on
+  // coarser levels the correction at a fixed function is then zero (DESIGN.md "Open surfaces").
+  prolongations_.clear();
+  colours_.clear();
+  if (basis_.prolongations() && !basis_.prolongations()->empty()) {
+    prolongations_ = *basis_.prolongations();
+    const SparseMatrix& P = prolongations_.back();
+    SparseMatrix selector(nf, n);
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(nf);
+    for (Eigen::Index i = 0; i < nf; ++i) t.emplace_back(int(i), free_[i], 1.0);
+    selector.setFromTriplets(t.begin(), t.end());
+    prolongations_.back() = selector * P;
+    prolongations_.back().makeCompressed();
+    if (basis_.colours()) {
+      colours_ = *basis_.colours();
+      std::vector<std::uint8_t> finest(nf);
+      for (Eigen::Index i = 0; i < nf; ++i) finest[i] = colours_.back()[free_[i]];
+      colours_.back() = std::move(finest);
+    }
+  }
+  pattern_ = S;
+  reduction_valid_ = true;
+}
+
+}  // namespace mcf

@@ -1,0 +1,44 @@
+#pragma once
+// Solving (a M + b K) Y = R with some functions held fixed. Fixed rows are eliminated, so the
+// system the solver sees stays symmetric positive definite (open boundaries, DESIGN.md), and
+// functions whose row is empty this step (no cubature point contributes: the paper's
+// "anchoring" through a pinch) are held too instead of making the matrix singular.
+// The reduced pattern and the restricted hierarchy are rebuilt only when the fixed set changes.
+
+#include "bases/basis.h"
+#include "solvers/linear_solver.h"
+
+#include <vector>
+
+namespace mcf {
+
+class ReducedSystem {
+ public:
+  ReducedSystem(const Basis& basis, LinearSolver& solver);
+
+  /// Solves; `report()` then holds the solver's report. Returns the full solution.
+  Coefficients solve(double a, double b, const Coefficients& R, const Coefficients& fixed_values,
+                     const Coefficients& warm);
+  const SolveReport& report() const { return report_; }
+  /// Functions held in the last solve (boundary + empty rows).
+  std::size_t num_fixed() const { return fixed_.size(); }
+
+ private:
+  void rebuild_reduction(const SparseMatrix& S);
+
+  const Basis& basis_;
+  LinearSolver& solver_;
+  std::vector<int> base_fixed_;        // from the basis (boundary)
+  std::vector<int> fixed_;             // sorted; last solve's
+  std::vector<int> free_;              // reduced index -> full index
+  std::vector<int> reduced_of_;        // full index -> reduced index or -1
+  std::vector<int> source_nz_;         // reduced nonzero -> nonzero of the full matrix
+  SparseMatrix sum_, reduced_;
+  std::vector<SparseMatrix> prolongations_;            // finest one row-restricted
+  std::vector<std::vector<std::uint8_t>> colours_;
+  bool reduction_valid_ = false;
+  SparseMatrix pattern_;               // the full matrix the reduction was built for
+  SolveReport report_;
+};
+
+}  // namespace mcf

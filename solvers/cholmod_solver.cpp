@@ -1,0 +1,242 @@
+#include "solvers/cholmod_solver.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mcf {
+namespace {
+
+// The whole file uses the long-integer API (cholmod_l_*): factors of ~1M-vertex systems can
+// approach the 2^31-entry limit of the int API, and the index copy into the cached lower
+// triangle happens once per pattern either way.
+using Long = SuiteSparse_long;
+
+// CHOLMOD's default reaction to errors is to print (Common->print > 0) and call a user handler;
+// it never aborts, but the flows must stay silent and decide from the status themselves
+// (a non-SPD matrix means the flow turned singular, DESIGN.md "Studies" cmcf).
+void silent_error_handler(int /*status*/, const char* /*file*/, int /*line*/,
+                          const char* /*message*/) {}
+
+SolveReport make_report(SolveStatus status, std::string message = {}) {
+  SolveReport r;
+  r.status = status;
+  r.message = std::move(message);
+  return r;
+}
+
+}  // namespace
+
+CholmodSolver::CholmodSolver() {
+  cholmod_l_start(&common_);
+  common_.supernodal = CHOLMOD_SUPERNODAL;
+  common_.print = 0;
+  common_.error_handler = &silent_error_handler;
+  // On a non-positive pivot stop at once: the factor is useless and the caller only needs
+  // the status (faster failure for the singular-flow case).
+  common_.quick_return_if_not_posdef = 1;
+}
+
+CholmodSolver::~CholmodSolver() {
+  free_all();
+  cholmod_l_finish(&common_);
+}
+
+void CholmodSolver::free_all() {
+  if (factor_) cholmod_l_free_factor(&factor_, &common_);
+  if (lower_) cholmod_l_free_sparse(&lower_, &common_);
+  if (x_) cholmod_l_free_dense(&x_, &common_);
+  if (y_) cholmod_l_free_dense(&y_, &common_);
+  if (e_) cholmod_l_free_dense(&e_, &common_);
+  if (r_) cholmod_l_free_dense(&r_, &common_);
+}
+
+std::string CholmodSolver::version() {
+  return "CHOLMOD " + std::to_string(CHOLMOD_MAIN_VERSION) + "." +
+         std::to_string(CHOLMOD_SUB_VERSION) + "." + std::to_string(CHOLMOD_SUBSUB_VERSION);
+}
+
+std::int64_t CholmodSolver::factor_nonzeros() const {
+  if (!factor_) return 0;
+  if (factor_->is_super) return static_cast<std::int64_t>(factor_->xsize);
+  return static_cast<std::int64_t>(factor_->nzmax);
+}
+
+bool CholmodSolver::same_pattern(const SparseMatrix& A) const {
+  if (!lower_ || A.rows() != rows_) return false;
+  const auto nnz = static_cast<std::size_t>(A.nonZeros());
+  if (inner_.size() != nnz) return false;
+  // Exact comparison: O(nnz) integer compares, negligible next to the numeric factorization,
+  // and unlike a hash it can never wrongly reuse a symbolic analysis.
+  return std::equal(outer_.begin(), outer_.end(), A.outerIndexPtr()) &&
+         std::equal(inner_.begin(), inner_.end(), A.innerIndexPtr());
+}
+
+void CholmodSolver::build_lower(const SparseMatrix& A) {
+  const Long n = A.rows();
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  Long lower_nnz = 0;
+  bool sorted = true;
+  for (Long j = 0; j < n; ++j)
+    for (int k = outer[j]; k < outer[j + 1]; ++k) {
+      if (inner[k] >= j) ++lower_nnz;
+      if (k > outer[j] && inner[k] <= inner[k - 1]) sorted = false;
+    }
+
+  lower_ = cholmod_l_allocate_sparse(n, n, lower_nnz, sorted ? 1 : 0, /*packed=*/1,
+                                     /*stype=*/-1, CHOLMOD_REAL, &common_);
+  if (!lower_) return;
+  auto* p = static_cast<Long*>(lower_->p);
+  auto* i = static_cast<Long*>(lower_->i);
+  gather_.resize(static_cast<std::size_t>(lower_nnz));
+  Long pos = 0;
+  for (Long j = 0; j < n; ++j) {
+    p[j] = pos;
+    for (int k = outer[j]; k < outer[j + 1]; ++k)
+      if (inner[k] >= j) {
+        i[pos] = inner[k];
+        gather_[static_cast<std::size_t>(pos)] = k;
+        ++pos;
+      }
+  }
+  p[n] = pos;
+
+  rows_ = n;
+  outer_.assign(outer, outer + n + 1);
+  inner_.assign(inner, inner + A.nonZeros());
+}
+
+void CholmodSolver::refresh_values(const SparseMatrix& A) {
+  auto* x = static_cast<double*>(lower_->x);
+  const double* v = A.valuePtr();
+  const std::size_t m = gather_.size();
+  for (std::size_t k = 0; k < m; ++k) x[k] = v[gather_[k]];
+}
+
+SolveReport CholmodSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarchy*/) {
+  factor_ok_ = false;
+  auto fail = [&](SolveStatus s, std::string msg) {
+    last_status_ = s;
+    last_message_ = msg;
+    return make_report(s, std::move(msg));
+  };
+  if (A.rows() != A.cols()) return fail(SolveStatus::failed, "matrix is not square");
+  if (!A.isCompressed()) {
+    // Rare path (callers are asked for compressed storage); a compressed copy keeps the
+    // pattern comparison and the gather simple.
+    SparseMatrix C = A;
+    C.makeCompressed();
+    return set_matrix(C);
+  }
+  // NaN/inf would make the factorization's outcome unpredictable (LAPACK's potrf does not
+  // reliably flag NaN pivots), so reject them here.
+  {
+    const double* v = A.valuePtr();
+    for (Eigen::Index k = 0; k < A.nonZeros(); ++k)
+      if (!std::isfinite(v[k])) return fail(SolveStatus::numerical_issue, "matrix has NaN/inf");
+  }
+
+  if (!same_pattern(A)) {
+    free_all();
+    outer_.clear();
+    inner_.clear();
+    rows_ = -1;
+    build_lower(A);
+    if (!lower_) return fail(SolveStatus::failed, "cholmod_allocate_sparse failed");
+    refresh_values(A);
+    factor_ = cholmod_l_analyze(lower_, &common_);
+    if (!factor_ || common_.status < CHOLMOD_OK) {
+      rows_ = -1;  // force re-analysis next time
+      return fail(SolveStatus::failed,
+                  "cholmod_analyze failed (status " + std::to_string(common_.status) + ")");
+    }
+    ++analyses_;
+  } else {
+    refresh_values(A);
+  }
+
+  const int ok = cholmod_l_factorize(lower_, factor_, &common_);
+  ++factorizations_;
+  const Long n = static_cast<Long>(A.rows());
+  if (common_.status == CHOLMOD_NOT_POSDEF || (ok && static_cast<Long>(factor_->minor) < n)) {
+    return fail(SolveStatus::not_positive_definite,
+                "matrix not positive definite (pivot " + std::to_string(factor_->minor) + " of " +
+                    std::to_string(n) + ")");
+  }
+  if (!ok || common_.status < CHOLMOD_OK) {
+    return fail(SolveStatus::failed,
+                "cholmod_factorize failed (status " + std::to_string(common_.status) + ")");
+  }
+  factor_ok_ = true;
+  last_status_ = SolveStatus::converged;
+  last_message_.clear();
+  SolveReport r;
+  r.status = SolveStatus::converged;
+  return r;
+}
+
+SolveReport CholmodSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
+  if (!factor_ok_) return make_report(last_status_, last_message_);
+  const Long n = rows_;
+  const Long k = B.cols();
+  if (B.rows() != n) return make_report(SolveStatus::failed, "right-hand side has wrong size");
+  SolveReport report;
+  report.iterations = 1;
+  if (k == 0) {
+    X.resize(n, 0);
+    report.residuals = {0.0};
+    return report;
+  }
+
+  // Wrap B without copying; CHOLMOD only reads it.
+  cholmod_dense b{};
+  b.nrow = static_cast<size_t>(n);
+  b.ncol = static_cast<size_t>(k);
+  b.nzmax = static_cast<size_t>(n * k);
+  b.d = static_cast<size_t>(n);
+  b.x = const_cast<double*>(B.data());
+  b.z = nullptr;
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+
+  // All columns in one call; solve2 reuses x_/y_/e_ across calls instead of reallocating.
+  if (!cholmod_l_solve2(CHOLMOD_A, factor_, &b, nullptr, &x_, nullptr, &y_, &e_, &common_) ||
+      !x_)
+    return make_report(SolveStatus::failed,
+                       "cholmod_solve failed (status " + std::to_string(common_.status) + ")");
+
+  X.resize(n, k);
+  const auto* xs = static_cast<const double*>(x_->x);
+  for (Long c = 0; c < k; ++c)
+    std::copy(xs + c * static_cast<Long>(x_->d), xs + c * static_cast<Long>(x_->d) + n,
+              X.data() + c * n);
+
+  // True residual r = b - A x through the cached lower triangle (sdmult honours stype, so no
+  // copy of the full A is kept).
+  if (!cholmod_l_ensure_dense(&r_, n, k, n, CHOLMOD_REAL, &common_))
+    return make_report(SolveStatus::failed, "cholmod_ensure_dense failed");
+  auto* rs = static_cast<double*>(r_->x);
+  std::copy(B.data(), B.data() + n * k, rs);
+  double minus_one[2] = {-1.0, 0.0};
+  double one[2] = {1.0, 0.0};
+  cholmod_l_sdmult(lower_, 0, minus_one, one, x_, r_, &common_);
+
+  double worst = 0.0;
+  for (Long c = 0; c < k; ++c) {
+    const Eigen::Map<const Eigen::VectorXd> rc(rs + c * n, n);
+    const double bn = B.col(c).norm();
+    const double rn = rc.norm();
+    const double rel = bn > 0.0 ? rn / bn : rn;
+    if (!std::isfinite(rel)) worst = rel;
+    else if (std::isfinite(worst)) worst = std::max(worst, rel);
+  }
+  report.relative_residual = worst;
+  report.residuals = {worst};
+  if (!std::isfinite(worst)) {
+    report.status = SolveStatus::numerical_issue;
+    report.message = "solution has NaN/inf";
+  }
+  return report;
+}
+
+}  // namespace mcf

@@ -1,0 +1,77 @@
+#pragma once
+// Sparse direct solver: CHOLMOD supernodal LL^T (DESIGN.md "Layers", solvers/).
+// The symbolic analysis (fill-reducing ordering + supernodal structure) is the expensive part
+// that only depends on the sparsity pattern; the flows keep one pattern for a whole run (tracked
+// octree basis, hat basis on a fixed mesh), so it is computed once and only the numeric
+// factorization is repeated when set_matrix() sees the same pattern again.
+
+#include "solvers/linear_solver.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <suitesparse/cholmod.h>
+
+namespace mcf {
+
+class CholmodSolver final : public LinearSolver {
+ public:
+  CholmodSolver();
+  ~CholmodSolver() override;
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+  std::string name() const override { return "cholmod"; }
+
+  /// Factorizes A (full symmetric storage; only its lower triangle is read). Re-analyzes only
+  /// when the pattern differs from the previous call's. Status not_positive_definite when the
+  /// factorization meets a non-positive pivot (no abort, no output).
+  SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
+
+  /// Solves all columns of B in one cholmod_solve call; X's input is ignored. Reports
+  /// iterations = 1 and the true relative residual max_c ||b_c - A x_c|| / ||b_c||.
+  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
+
+  /// Number of symbolic analyses done so far (tests check that refactorization reuses it).
+  int analyses() const { return analyses_; }
+  /// Number of numeric factorizations done so far.
+  int factorizations() const { return factorizations_; }
+  /// True if the last set_matrix produced a usable factor.
+  bool factorized() const { return factor_ok_; }
+  /// True once a factor exists and CHOLMOD chose the supernodal form (always, as configured).
+  bool is_supernodal() const { return factor_ != nullptr && factor_->is_super != 0; }
+  /// Nonzeros in the factor L (0 before the first factorization); useful for memory reports.
+  std::int64_t factor_nonzeros() const;
+
+  /// "CHOLMOD x.y.z" of the headers compiled against, for result.json "libraries".
+  static std::string version();
+
+ private:
+  void free_all();
+  bool same_pattern(const SparseMatrix& A) const;
+  void build_lower(const SparseMatrix& A);   // new pattern: (re)build the cached lower triangle
+  void refresh_values(const SparseMatrix& A);  // same pattern: copy values only
+
+  cholmod_common common_{};
+  cholmod_sparse* lower_ = nullptr;   // cached lower triangle of A (stype = -1)
+  cholmod_factor* factor_ = nullptr;
+  cholmod_dense* x_ = nullptr;        // solve2 workspaces, reused across solves
+  cholmod_dense* y_ = nullptr;
+  cholmod_dense* e_ = nullptr;
+  cholmod_dense* r_ = nullptr;        // residual workspace
+
+  // Previous full pattern, compared exactly (cheap next to a factorization).
+  std::vector<int> outer_, inner_;
+  std::int64_t rows_ = -1;
+  // lower_->x[k] = A.valuePtr()[gather_[k]]: refreshing values is one gather, no pattern work.
+  std::vector<std::int64_t> gather_;
+
+  int analyses_ = 0;
+  int factorizations_ = 0;
+  bool factor_ok_ = false;
+  SolveStatus last_status_ = SolveStatus::failed;
+  std::string last_message_ = "set_matrix not called";
+};
+
+}  // namespace mcf

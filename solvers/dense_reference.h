@@ -1,0 +1,33 @@
+#pragma once
+// Dense LL^T reference solve for small systems: an independent check on the sparse solvers
+// (tests) and a trivially correct coarsest-level solver for tiny hierarchies.
+
+#include "solvers/linear_solver.h"
+
+#include <Eigen/Cholesky>
+
+namespace mcf {
+
+/// Solves A X = B with Eigen's dense LLT. Refuses (status failed) above max_dimension so a
+/// mistaken call on a real mesh does not allocate n^2 doubles. Reports iterations = 1 and the
+/// true relative residual, like CholmodSolver.
+SolveReport dense_llt_solve(const SparseMatrix& A, const Eigen::MatrixXd& B, Eigen::MatrixXd& X,
+                            Eigen::Index max_dimension = 5000);
+
+/// The same as a LinearSolver (factorizes in set_matrix, ignores the warm start).
+class DenseLltSolver final : public LinearSolver {
+ public:
+  explicit DenseLltSolver(Eigen::Index max_dimension = 5000) : max_dimension_(max_dimension) {}
+  std::string name() const override { return "dense-llt"; }
+  SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
+  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
+
+ private:
+  Eigen::Index max_dimension_;
+  Eigen::MatrixXd A_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
+  SolveStatus status_ = SolveStatus::failed;
+  std::string message_ = "set_matrix not called";
+};
+
+}  // namespace mcf

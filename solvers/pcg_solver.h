@@ -1,0 +1,78 @@
+#pragma once
+// Preconditioned conjugate gradients on a block of right-hand sides (DESIGN.md "Layers",
+// solvers/): k independent CG recurrences that share one pass over A per iteration (the
+// flows always solve x, y, z together, so the matrix is streamed once instead of three times).
+//
+// Determinism: every reduction is summed in fixed 4096-row chunks whose partial sums are
+// combined serially in chunk order, and the SpMV computes each row with a fixed order, so the
+// iterates are bitwise identical for any TBB thread count (result files compare across runs).
+
+#include "solvers/linear_solver.h"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/OrderingMethods>
+
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace mcf {
+
+enum class PcgPreconditioner {
+  none,
+  jacobi,               ///< inverse diagonal
+  incomplete_cholesky,  ///< Eigen IncompleteCholesky<double, Lower, AMDOrdering<int>> (diagonal shift)
+  external              ///< the hook set with PcgSolver::set_preconditioner (e.g. a multigrid cycle)
+};
+
+const char* to_string(PcgPreconditioner p);
+
+struct PcgOptions {
+  double relative_tolerance = 1e-10;  ///< stop when max_c ||b_c - A x_c|| / ||b_c|| <= this
+  int max_iterations = 1000;          ///< iteration cap; reaching it gives max_iterations
+  PcgPreconditioner preconditioner = PcgPreconditioner::jacobi;
+};
+
+class PcgSolver final : public LinearSolver {
+ public:
+  /// z = M^{-1} r for an n x k block (z is resized by the caller to r's shape before the call).
+  using Preconditioner = std::function<void(const Eigen::MatrixXd& r, Eigen::MatrixXd& z)>;
+
+  explicit PcgSolver(PcgOptions options = {});
+  ~PcgSolver() override;
+
+  std::string name() const override;
+  const PcgOptions& options() const { return options_; }
+  void set_options(const PcgOptions& options);
+
+  /// Installs the external preconditioner (used when options.preconditioner == external).
+  /// It must apply a fixed symmetric positive-definite operator for CG to converge.
+  void set_preconditioner(Preconditioner preconditioner);
+
+  /// Copies A (values only when the pattern is unchanged) and builds the preconditioner.
+  /// not_positive_definite for a non-positive diagonal with Jacobi or an IC breakdown.
+  SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
+
+  /// Block PCG from the warm start X (resized to zero if its shape does not match B).
+  /// residuals[i] = max relative residual over columns after iteration i+1; the last entry
+  /// and relative_residual are the true residual recomputed at exit.
+  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
+
+  /// Y = A X with the deterministic parallel row SpMV (exposed for tests and other solvers).
+  void multiply(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const;
+
+ private:
+  SolveReport build_preconditioner();
+  void apply_preconditioner(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) const;
+
+  PcgOptions options_;
+  Preconditioner external_;
+  SparseMatrix A_;
+  bool have_matrix_ = false;
+  SolveStatus matrix_status_ = SolveStatus::failed;
+  std::string matrix_message_ = "set_matrix not called";
+  Eigen::VectorXd inv_diag_;
+  std::unique_ptr<Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>>> ic_;
+};
+
+}  // namespace mcf

@@ -1,0 +1,204 @@
+#include "datasets/generators.h"
+#include "datasets/mesh_io.h"
+#include "datasets/mesh_spec.h"
+#include "datasets/validate.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+namespace mcf {
+namespace {
+
+using test::TempDir;
+
+// Reading and validating, as every user of a file does (load_mesh_spec does both).
+void load_checked(const std::string& path) { validate_mesh(read_mesh(path), path); }
+
+// Expects a MeshError whose message names the file (its base name at least).
+void expect_error_naming(const std::string& path, const std::string& fragment = "") {
+  try {
+    load_checked(path);
+    FAIL() << "no MeshError for " << path;
+  } catch (const MeshError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(std::filesystem::path(path).filename().string()), std::string::npos) << msg;
+    if (!fragment.empty()) {
+      EXPECT_NE(msg.find(fragment), std::string::npos) << msg;
+    }
+  }
+  // The spec loader must report the same problem with the file name too.
+  try {
+    load_mesh_spec(path);
+    FAIL() << "load_mesh_spec accepted " << path;
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find(std::filesystem::path(path).filename().string()), std::string::npos)
+        << e.what();
+  }
+}
+
+const char* kTetraOff = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+
+TEST(MeshIo, ReadsValidOff) {
+  TempDir dir;
+  const auto path = dir.write("tetra.off", kTetraOff);
+  const TriangleMesh m = read_mesh(path);
+  ASSERT_EQ(m.num_vertices(), 4);
+  ASSERT_EQ(m.num_faces(), 4);
+  EXPECT_EQ(m.vertices.row(3), Eigen::RowVector3d(0, 0, 1));  // vertex order kept
+  EXPECT_TRUE(test::same_face(m.faces.row(1), Eigen::RowVector3i(0, 1, 3)));
+  const MeshReport r = validate_mesh(m, path);
+  EXPECT_TRUE(r.closed());
+  EXPECT_EQ(r.genus, 0);
+  EXPECT_EQ(r.misoriented_edges, 0);
+  EXPECT_GT(test::signed_volume(m), 0);
+}
+
+TEST(MeshIo, MissingFile) { expect_error_naming("/nonexistent_dir_xyz/missing_mesh.off", "no such file"); }
+
+TEST(MeshIo, GarbageText) {
+  TempDir dir;
+  expect_error_naming(dir.write("garbage.off", "hello world\nthis is not a mesh\n"));
+  expect_error_naming(dir.write("garbage.ply", "hello world\nthis is not a mesh\n"));
+  expect_error_naming(dir.write("garbage.obj", "hello world\nthis is not a mesh\n"));
+  expect_error_naming(dir.write("garbage.stl", "hello world\nthis is not a mesh\n"));
+}
+
+TEST(MeshIo, EmptyFiles) {
+  TempDir dir;
+  expect_error_naming(dir.write("empty.off", ""), "empty");
+  expect_error_naming(dir.write("empty.obj", ""), "empty");
+  expect_error_naming(dir.write("empty.ply", ""), "empty");
+  // A header announcing no faces parses, but is an empty mesh.
+  expect_error_naming(dir.write("nofaces.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), "empty");
+}
+
+TEST(MeshIo, NanCoordinate) {
+  TempDir dir;
+  expect_error_naming(dir.write("nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"), "vertex 1");
+  expect_error_naming(dir.write("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n"), "vertex 2");
+}
+
+TEST(MeshIo, IndexOutOfRange) {
+  TempDir dir;
+  expect_error_naming(dir.write("range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"), "vertex 7");
+  expect_error_naming(dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"));
+  expect_error_naming(dir.write("range.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n"));
+}
+
+TEST(MeshIo, ZeroAreaFace) {
+  TempDir dir;
+  // Three collinear points.
+  expect_error_naming(dir.write("flat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n"), "degenerate");
+  expect_error_naming(dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"), "degenerate");
+}
+
+TEST(MeshIo, NonManifoldEdge) {
+  TempDir dir;
+  // Edge (0,1) is shared by three triangles.
+  const std::string verts = "0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n";
+  expect_error_naming(dir.write("fin.off", "OFF\n5 3 0\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"), "non-manifold");
+  expect_error_naming(dir.write("fin.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\n"
+                                           "f 1 2 3\nf 2 1 4\nf 1 2 5\n"));
+  expect_error_naming(dir.write("fin.stl", "solid fin\n"
+                                           "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+                                           "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 0 0 0\nvertex 0 -1 0\nendloop\nendfacet\n"
+                                           "facet normal 0 1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+                                           "endsolid fin\n"), "non-manifold");
+  expect_error_naming(dir.write("fin.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+                                "property float z\nelement face 3\nproperty list uchar int vertex_indices\n"
+                                "end_header\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"));
+}
+
+TEST(MeshIo, RepeatedIndexInFace) {
+  TempDir dir;
+  expect_error_naming(dir.write("repeat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n"));
+}
+
+TEST(MeshIo, UnknownExtension) {
+  TempDir dir;
+  const auto path = dir.write("mesh.xyz", kTetraOff);
+  try {
+    read_mesh(path);
+    FAIL();
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("mesh.xyz"), std::string::npos);
+  }
+}
+
+TEST(MeshIo, QuadsAreFanTriangulated) {
+  TempDir dir;
+  const auto path = dir.write("quad.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  const TriangleMesh m = read_mesh(path);
+  EXPECT_EQ(m.num_faces(), 2);
+  EXPECT_NEAR(surface_area(m), 1.0, 1e-12);
+  const auto obj = dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 2 3 4\nf 2 1 5\n");
+  const TriangleMesh o = read_mesh(obj);
+  EXPECT_EQ(o.num_faces(), 3);
+  EXPECT_EQ(o.num_vertices(), 5);
+}
+
+TEST(MeshIo, AsciiKeepsDoublesExactly) {
+  TempDir dir;
+  TriangleMesh m = make_icosphere(1);
+  m.vertices *= 1.0 / 3.0;  // not representable in float
+  for (const char* name : {"x.off", "x.obj"}) {
+    write_mesh(dir.file(name), m);
+    EXPECT_EQ(read_mesh(dir.file(name)).vertices, m.vertices) << name;
+  }
+}
+
+// Round trip of a torus (irrational coordinates) through every format.
+// STL stores triangle soups: the reader merges equal corners in order of first appearance, so
+// only the face order and each face's corner positions can be compared.
+void expect_round_trip(const std::string& name, bool binary, double tol, bool keeps_vertex_order = true) {
+  TempDir dir;
+  const TriangleMesh m = make_torus(1.0, 0.3, 24, 12);
+  const auto path = dir.file(name);
+  write_mesh(path, m, binary);
+  // Atomic write: only the target is left in the folder.
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(std::filesystem::path(path).parent_path())) ++files;
+  EXPECT_EQ(files, 1);
+  const TriangleMesh r = read_mesh(path);
+  ASSERT_EQ(r.num_vertices(), m.num_vertices()) << name;
+  ASSERT_EQ(r.num_faces(), m.num_faces()) << name;
+  if (keeps_vertex_order) {
+    EXPECT_LE((r.vertices - m.vertices).cwiseAbs().maxCoeff(), tol) << name;
+    for (Eigen::Index f = 0; f < m.num_faces(); ++f)
+      ASSERT_TRUE(test::same_face(r.faces.row(f), m.faces.row(f))) << name << " face " << f;
+  } else {
+    for (Eigen::Index f = 0; f < m.num_faces(); ++f) {
+      bool match = false;
+      for (int rot = 0; rot < 3 && !match; ++rot) {
+        double err = 0;
+        for (int c = 0; c < 3; ++c)
+          err = std::max(err, (r.vertices.row(r.faces(f, c)) - m.vertices.row(m.faces(f, (c + rot) % 3))).cwiseAbs().maxCoeff());
+        match = err <= tol;
+      }
+      ASSERT_TRUE(match) << name << " face " << f;
+    }
+  }
+}
+
+TEST(MeshIo, RoundTripOff) { expect_round_trip("t.off", false, 1e-15); }
+TEST(MeshIo, RoundTripPlyAscii) { expect_round_trip("t.ply", false, 1e-6); }  // OpenMesh: float
+TEST(MeshIo, RoundTripPlyBinary) { expect_round_trip("t.ply", true, 1e-6); }
+TEST(MeshIo, RoundTripObj) { expect_round_trip("t.obj", false, 1e-15); }
+TEST(MeshIo, RoundTripStlAscii) { expect_round_trip("t.stl", false, 1e-6, false); }
+TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false); }
+
+TEST(MeshIo, WriteIntoMissingFolderFails) {
+  const TriangleMesh m = make_icosphere(0);
+  EXPECT_THROW(write_mesh("/nonexistent_dir_xyz/out.ply", m), MeshError);
+}
+
+}  // namespace
+}  // namespace mcf

@@ -1,0 +1,94 @@
+#include "datasets/mesh_io.h"
+#include "datasets/mesh_spec.h"
+#include "datasets/generators.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace mcf {
+namespace {
+
+// The error must name the spec and contain `fragment` (typically the offending key).
+void expect_spec_error(const std::string& spec, const std::string& fragment) {
+  try {
+    load_mesh_spec(spec);
+    FAIL() << "accepted '" << spec << "'";
+  } catch (const MeshError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(spec), std::string::npos) << msg;
+    EXPECT_NE(msg.find(fragment), std::string::npos) << msg;
+  }
+}
+
+TEST(MeshSpec, Errors) {
+  expect_spec_error("blob", "unknown generator 'blob'");
+  expect_spec_error("torus:foo=1", "'foo'");
+  expect_spec_error("torus:R=abc", "'R'");
+  expect_spec_error("torus:R=", "'R'");
+  expect_spec_error("torus:R=1x", "'R'");
+  expect_spec_error("torus:R=nan", "'R'");
+  expect_spec_error("icosphere:level=2.5", "'level'");
+  expect_spec_error("icosphere:level=99", "level");
+  expect_spec_error("sphere:vertices=1000,vertices=2000", "'vertices'");
+  expect_spec_error("sphere:radius", "radius");
+  expect_spec_error("sphere@faces=abc", "'faces'");
+  expect_spec_error("sphere@faces=0", "'faces'");
+  expect_spec_error("sphere@vertices=10", "'vertices'");
+  expect_spec_error("torus:R=0.1,r=0.3", "torus");
+  expect_spec_error("cgal:nonexistent_model", "nonexistent_model");
+  expect_spec_error("", "empty");
+}
+
+TEST(MeshSpec, Sphere) {
+  const MeshSource s = load_mesh_spec("sphere:vertices=1000,radius=2");
+  EXPECT_EQ(s.kind, "sphere");
+  EXPECT_TRUE(s.analytic);
+  ASSERT_TRUE(s.sphere_radius.has_value());
+  EXPECT_DOUBLE_EQ(*s.sphere_radius, 2.0);
+  EXPECT_EQ(s.report.vertices, s.mesh.num_vertices());
+  EXPECT_TRUE(s.report.closed());
+  EXPECT_EQ(s.report.genus, 0);
+}
+
+TEST(MeshSpec, IcosphereWithFacesStaysOnTheSphere) {
+  const MeshSource s = load_mesh_spec("icosphere:level=2@faces=5000");
+  EXPECT_EQ(s.mesh.num_faces(), 320 * 16);
+  EXPECT_NEAR(s.mesh.vertices.rowwise().norm().minCoeff(), 1.0, 1e-12);
+  EXPECT_EQ(s.spec, "icosphere:level=2@faces=5000");
+}
+
+TEST(MeshSpec, EveryGeneratorWithDefaults) {
+  for (const char* name : {"sphere", "icosphere", "torus", "spiral", "dumbbell", "rounded_cylinder",
+                           "open_cylinder", "catenoid"}) {
+    const MeshSource s = load_mesh_spec(name);
+    EXPECT_EQ(s.kind, name);
+    EXPECT_TRUE(s.analytic);
+    EXPECT_GT(s.report.faces, 100) << name;
+    EXPECT_NE(mesh_spec_help().find(name), std::string::npos) << name;
+  }
+  EXPECT_EQ(load_mesh_spec("torus").report.genus, 1);
+  EXPECT_EQ(load_mesh_spec("open_cylinder").report.boundary_loops, 2);
+  EXPECT_FALSE(load_mesh_spec("spiral").report.closed());
+}
+
+TEST(MeshSpec, FilesAreScaledIntoTheUnitCube) {
+  test::TempDir dir;
+  TriangleMesh m = make_torus(10.0, 3.0, 24, 12);  // 26 x 26 x 6
+  const auto path = dir.file("torus.ply");
+  write_mesh(path, m);
+  const MeshSource s = load_mesh_spec(path + "@faces=1000");
+  EXPECT_EQ(s.kind, "file");
+  EXPECT_FALSE(s.analytic);
+  EXPECT_EQ(s.mesh.num_faces(), 4 * 576);
+  const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff(), hi = s.mesh.vertices.colwise().maxCoeff();
+  EXPECT_NEAR(lo(0), 0.0, 1e-6);
+  EXPECT_NEAR(hi(0), 1.0, 1e-6);
+  EXPECT_NEAR(lo(2) + hi(2), 1.0, 1e-6);  // short axis centred
+  EXPECT_NEAR(hi(2) - lo(2), 6.0 / 26.0, 1e-6);
+  EXPECT_EQ(s.report.genus, 1);
+}
+
+}  // namespace
+}  // namespace mcf

@@ -1,0 +1,163 @@
+// Flows on the sphere against analytic radii (DESIGN.md "Conventions"), and against each other.
+
+#include "flow_test_util.h"
+
+#include "datasets/validate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+namespace mcf {
+namespace {
+
+using nlohmann::json;
+using testing::last;
+using testing::mean_radius;
+using testing::run;
+
+TEST(SphereFlows, SemiImplicitRadiusConvergesUnderRefinement) {
+  // r_{n+1} = r_n³/(r_n² + 2δ) is what the semi-implicit step gives on the exact sphere; on a
+  // mesh the error is spatial, O(h²): about 4x smaller each time the edge length halves.
+  std::vector<double> errors;
+  for (int level = 2; level <= 5; ++level) {
+    const auto o = run(json{{"mesh", "icosphere:level=" + std::to_string(level)}, {"dt", 1e-3}, {"steps", 10}});
+    ASSERT_EQ(o.result["status"], "ok");
+    errors.push_back(last(o, "radial_error", "rms"));
+  }
+  for (std::size_t i = 1; i < errors.size(); ++i) {
+    const double ratio = errors[i - 1] / errors[i];
+    EXPECT_GT(ratio, 3.0) << "level " << i + 2;
+    EXPECT_LT(ratio, 5.5) << "level " << i + 2;
+  }
+}
+
+TEST(SphereFlows, SolversAgree) {
+  // CHOLMOD, PCG (two preconditioners) and a dense LLT solve give the same flow.
+  const json base = {{"mesh", "icosphere:level=3"}, {"dt", 1e-3}, {"steps", 5}};
+  json dense = base, cholmod = base, ichol = base, jacobi = base;
+  dense["solver"] = {{"name", "dense"}};
+  cholmod["solver"] = {{"name", "cholmod"}};
+  ichol["solver"] = {{"name", "pcg"}, {"preconditioner", "ichol"}, {"tolerance", 1e-13}};
+  jacobi["solver"] = {{"name", "pcg"}, {"preconditioner", "jacobi"}, {"tolerance", 1e-13}};
+  const Positions reference = run(dense).final_mesh.vertices;
+  for (const json& j : {cholmod, ichol, jacobi}) {
+    const Positions V = run(j).final_mesh.vertices;
+    EXPECT_LT((V - reference).norm() / reference.norm(), 1e-10) << j["solver"].dump();
+  }
+}
+
+TEST(SphereFlows, CmcfEqualsMcfOnTheSphere) {
+  // On a sphere K_0 x = λ M_0 x and M_t = (r/r0)² M_0, so keeping K_0 changes nothing
+  // (up to the mesh's deviation from a perfect sphere).
+  const json base = {{"mesh", "icosphere:level=4"}, {"dt", 1e-3}, {"steps", 20}};
+  json cmcf = base;
+  cmcf["flow"] = "cmcf";
+  const auto a = run(base), b = run(cmcf);
+  const Positions& Va = a.final_mesh.vertices;
+  const Positions& Vb = b.final_mesh.vertices;
+  EXPECT_LT((Va - Vb).cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_NEAR(last(b, "radial_error", "rms"), last(a, "radial_error", "rms"), 1e-4);
+  // And the first step is identical: K_0 is the current K then.
+  json one = base, one_c = cmcf;
+  one["steps"] = 1;
+  one_c["steps"] = 1;
+  EXPECT_LT((run(one).final_mesh.vertices - run(one_c).final_mesh.vertices).norm(), 1e-13);
+}
+
+TEST(SphereFlows, HeatFlowMatchesItsClosedForm) {
+  // Heat flow keeps M_0, K_0: r_n = r0 (1 + 2δ/r0²)^-n, and r0 exp(-2t/r0²) as δ → 0.
+  std::vector<double> errors;
+  for (int level = 3; level <= 5; ++level) {
+    const auto o = run(json{{"mesh", "icosphere:level=" + std::to_string(level)}, {"flow", "heat"}, {"dt", 1e-2}, {"steps", 20}});
+    errors.push_back(last(o, "radial_error", "rms"));
+    EXPECT_NEAR(o.result["steps"].back()["radial_error"]["radius_semi_implicit"].get<double>(), std::pow(1.02, -20), 1e-14);
+  }
+  EXPECT_GT(errors[0] / errors[1], 3.0);
+  EXPECT_GT(errors[1] / errors[2], 3.0);
+  EXPECT_LT(errors[2], 2e-4);
+  // Heat flow keeps the shape a sphere for any step: the mean radius follows the recursion.
+  const auto big = run(json{{"mesh", "icosphere:level=4"}, {"flow", "heat"}, {"dt", 0.1}, {"steps", 5}});
+  EXPECT_LT(last(big, "radial_error", "rms"), 1e-2 * std::pow(1.2, -5));
+}
+
+TEST(SphereFlows, LockedBoundaryStaysPut) {
+  const auto o = run(json{{"mesh", "open_cylinder:n_around=32,n_along=16"}, {"dt", 1e-2}, {"steps", 5}});
+  ASSERT_EQ(o.result["status"], "ok");
+  const MeshSource src = load_mesh_spec("open_cylinder:n_around=32,n_along=16");
+  const auto boundary = boundary_vertices(src.mesh);
+  ASSERT_FALSE(boundary.empty());
+  for (int v : boundary) EXPECT_EQ(o.final_mesh.vertices.row(v), src.mesh.vertices.row(v));
+  // Interior vertices moved (towards the axis: MCF shrinks the cylinder's waist).
+  EXPECT_GT((o.final_mesh.vertices - src.mesh.vertices).norm(), 1e-3);
+}
+
+TEST(SphereFlows, PinchStopsCleanly) {
+  // A dumbbell's neck pinches under MCF with a large step: the flow stops, reports the step
+  // and the reason, and never aborts.
+  const auto o = run(json{{"mesh", "dumbbell:resolution=32"}, {"dt", 0.2}, {"steps", 50}});
+  EXPECT_EQ(o.result["status"], "singular");
+  EXPECT_LT(o.result["stop"]["step"].get<int>(), 50);
+  EXPECT_FALSE(o.result["stop"]["reason"].get<std::string>().empty());
+}
+
+TEST(SphereFlows, NormalizationKeepsUnitArea) {
+  const auto o = run(json{{"mesh", "icosphere:level=3,radius=2"}, {"normalize_area", true}, {"dt", 1e-2}, {"steps", 5}});
+  const Positions& V = o.final_mesh.vertices;
+  EXPECT_NEAR(surface_area(o.final_mesh), 1.0, 1e-12);
+  EXPECT_LT(V.colwise().mean().norm(), 1e-12);
+}
+
+// Temporal order on MCF, measured as DESIGN.md says: against a run with a much smaller δ on
+// the same mesh, so the spatial error cancels (against sqrt(1-4t) it puts a floor under it).
+double temporal_error(const std::string& integrator, double dt, double T, bool extrapolate, const Positions& reference,
+                      const std::string& mesh) {
+  const auto o = run(json{{"mesh", mesh}, {"integrator", integrator}, {"extrapolate", extrapolate},
+                          {"dt", dt}, {"steps", int(std::lround(T / dt))}});
+  EXPECT_EQ(o.result["status"], "ok") << integrator;
+  return std::abs(mean_radius(o.final_mesh.vertices) - mean_radius(reference));
+}
+
+double order(const std::string& integrator, double dt, double T, bool extrapolate, const std::string& mesh) {
+  // Reference: Crank-Nicolson (second order) at δ/32, shared by the schemes tested at δ.
+  static std::map<std::pair<double, double>, Positions> references;
+  auto& ref = references[{dt, T}];
+  if (ref.rows() == 0)
+    ref = run(json{{"mesh", mesh}, {"integrator", "crank-nicolson"}, {"dt", dt / 32},
+                   {"steps", int(std::lround(T / (dt / 32)))}}).final_mesh.vertices;
+  const double e1 = temporal_error(integrator, dt, T, extrapolate, ref, mesh);
+  const double e2 = temporal_error(integrator, dt / 2, T, extrapolate, ref, mesh);
+  return std::log2(e1 / e2);
+}
+
+TEST(SphereFlows, TemporalOrders) {
+  const std::string mesh = "icosphere:level=3";
+  EXPECT_NEAR(order("semi-implicit", 0.01, 0.1, true, mesh), 1.0, 0.15);
+  EXPECT_NEAR(order("crank-nicolson", 0.01, 0.1, true, mesh), 2.0, 0.25);
+  EXPECT_NEAR(order("bdf2", 0.01, 0.1, true, mesh), 2.0, 0.25);
+  EXPECT_NEAR(order("crank-nicolson", 0.01, 0.1, false, mesh), 1.0, 0.25);
+  // Explicit schemes need δ below their stability limit (~h²) on this mesh; the truncated
+  // Neumann series (1 - z + z² per eigenvalue) has the smallest one.
+  EXPECT_NEAR(order("explicit-euler", 5e-4, 0.02, true, mesh), 1.0, 0.15);
+  EXPECT_NEAR(order("taylor2", 5e-4, 0.02, true, mesh), 1.0, 0.25);
+  EXPECT_NEAR(order("neumann2", 5e-4, 0.02, true, mesh), 1.0, 0.15);
+}
+
+TEST(SphereFlows, SecondOrderSchemesBeatEulerAgainstTheContinuousRadius) {
+  // Against sqrt(1-4t) itself, on a fine mesh: at δ = 0.01 the second-order schemes' error is
+  // far below semi-implicit Euler's (the spatial floor is ~1e-4 here).
+  const json base = {{"mesh", "icosphere:level=5"}, {"dt", 0.01}, {"steps", 10}};
+  auto err = [&](const char* name) {
+    json j = base;
+    j["integrator"] = name;
+    const auto o = run(j);
+    return std::abs(mean_radius(o.final_mesh.vertices) - std::sqrt(1 - 4 * 0.1));
+  };
+  const double euler = err("semi-implicit");
+  EXPECT_LT(err("crank-nicolson"), 0.2 * euler);
+  EXPECT_LT(err("bdf2"), 0.2 * euler);
+}
+
+}  // namespace
+}  // namespace mcf

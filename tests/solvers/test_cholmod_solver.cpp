@@ -1,0 +1,156 @@
+#include "solvers/cholmod_solver.h"
+#include "solvers/dense_reference.h"
+#include "test_matrices.h"
+
+#include <gtest/gtest.h>
+
+namespace mcf {
+namespace {
+
+using test::laplacian3d;
+using test::graph_laplacian;
+using test::random_rhs;
+using test::relative_difference;
+
+TEST(CholmodSolver, MatchesDenseOnLaplacian3d) {
+  const SparseMatrix A = laplacian3d(10, 9, 8);
+  const Eigen::MatrixXd B = random_rhs(A.rows());
+  Eigen::MatrixXd Xd, Xc;
+  ASSERT_EQ(dense_llt_solve(A, B, Xd).status, SolveStatus::converged);
+  CholmodSolver s;
+  ASSERT_EQ(s.set_matrix(A).status, SolveStatus::converged);
+  const SolveReport r = s.solve(B, Xc);
+  ASSERT_EQ(r.status, SolveStatus::converged) << r.message;
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_TRUE(s.is_supernodal());
+  EXPECT_GT(s.factor_nonzeros(), A.nonZeros() / 2);
+  EXPECT_LT(relative_difference(Xc, Xd), 1e-8);
+  ASSERT_EQ(r.residuals.size(), 1u);
+  EXPECT_EQ(r.residuals[0], r.relative_residual);
+  EXPECT_LT(r.relative_residual, 1e-12);
+  // The reported residual is the true one.
+  EXPECT_NEAR(r.relative_residual, test::relative_residual(A, B, Xc), 1e-14);
+}
+
+TEST(CholmodSolver, MatchesDenseOnGraphLaplacian) {
+  const SparseMatrix A = graph_laplacian(700);
+  const Eigen::MatrixXd B = random_rhs(A.rows());
+  Eigen::MatrixXd Xd, Xc;
+  ASSERT_EQ(dense_llt_solve(A, B, Xd).status, SolveStatus::converged);
+  CholmodSolver s;
+  ASSERT_EQ(s.set_matrix(A).status, SolveStatus::converged);
+  ASSERT_EQ(s.solve(B, Xc).status, SolveStatus::converged);
+  EXPECT_LT(relative_difference(Xc, Xd), 1e-8);
+}
+
+TEST(CholmodSolver, RefactorizationReusesAnalysis) {
+  const SparseMatrix A1 = laplacian3d(8, 8, 8, 0.1, 11);
+  const SparseMatrix A2 = laplacian3d(8, 8, 8, 0.7, 12, 2.5);  // same pattern, new values
+  ASSERT_TRUE(A1.nonZeros() == A2.nonZeros());
+  const Eigen::MatrixXd B = random_rhs(A1.rows());
+  CholmodSolver s;
+  Eigen::MatrixXd X, Xd;
+  ASSERT_EQ(s.set_matrix(A1).status, SolveStatus::converged);
+  ASSERT_EQ(s.solve(B, X).status, SolveStatus::converged);
+  ASSERT_EQ(s.set_matrix(A2).status, SolveStatus::converged);
+  ASSERT_EQ(s.solve(B, X).status, SolveStatus::converged);
+  EXPECT_EQ(s.analyses(), 1);
+  EXPECT_EQ(s.factorizations(), 2);
+  ASSERT_EQ(dense_llt_solve(A2, B, Xd).status, SolveStatus::converged);
+  EXPECT_LT(relative_difference(X, Xd), 1e-8);
+
+  // A different pattern (and size) must be analysed again.
+  const SparseMatrix A3 = graph_laplacian(400);
+  const Eigen::MatrixXd B3 = random_rhs(A3.rows());
+  ASSERT_EQ(s.set_matrix(A3).status, SolveStatus::converged);
+  EXPECT_EQ(s.analyses(), 2);
+  ASSERT_EQ(s.solve(B3, X).status, SolveStatus::converged);
+  ASSERT_EQ(dense_llt_solve(A3, B3, Xd).status, SolveStatus::converged);
+  EXPECT_LT(relative_difference(X, Xd), 1e-8);
+}
+
+TEST(CholmodSolver, SameSizeDifferentPatternReanalyses) {
+  const SparseMatrix A1 = graph_laplacian(300, 4, 0.05, 5);
+  const SparseMatrix A2 = graph_laplacian(300, 4, 0.05, 6);
+  const Eigen::MatrixXd B = random_rhs(300);
+  CholmodSolver s;
+  Eigen::MatrixXd X, Xd;
+  ASSERT_EQ(s.set_matrix(A1).status, SolveStatus::converged);
+  ASSERT_EQ(s.set_matrix(A2).status, SolveStatus::converged);
+  EXPECT_EQ(s.analyses(), 2);
+  ASSERT_EQ(s.solve(B, X).status, SolveStatus::converged);
+  ASSERT_EQ(dense_llt_solve(A2, B, Xd).status, SolveStatus::converged);
+  EXPECT_LT(relative_difference(X, Xd), 1e-8);
+}
+
+TEST(CholmodSolver, IndefiniteIsReportedAndRecoverable) {
+  // Laplacian minus a shift: some eigenvalues negative, diagonal still positive.
+  SparseMatrix A = laplacian3d(8, 8, 8);
+  SparseMatrix shifted = A;
+  for (int j = 0; j < shifted.cols(); ++j) shifted.coeffRef(j, j) -= 3.0;
+  const Eigen::MatrixXd B = random_rhs(A.rows());
+  CholmodSolver s;
+  Eigen::MatrixXd X;
+  const SolveReport f = s.set_matrix(shifted);
+  EXPECT_EQ(f.status, SolveStatus::not_positive_definite) << f.message;
+  EXPECT_FALSE(s.factorized());
+  EXPECT_EQ(s.solve(B, X).status, SolveStatus::not_positive_definite);
+
+  // Same pattern, SPD values again: the flow can go on with the same solver object.
+  ASSERT_EQ(s.set_matrix(A).status, SolveStatus::converged);
+  EXPECT_EQ(s.analyses(), 1);
+  ASSERT_EQ(s.solve(B, X).status, SolveStatus::converged);
+  Eigen::MatrixXd Xd;
+  ASSERT_EQ(dense_llt_solve(A, B, Xd).status, SolveStatus::converged);
+  EXPECT_LT(relative_difference(X, Xd), 1e-8);
+
+  // Negative definite too.
+  const SparseMatrix N = -A;
+  EXPECT_EQ(s.set_matrix(N).status, SolveStatus::not_positive_definite);
+}
+
+TEST(CholmodSolver, RejectsNonFiniteAndBadShapes) {
+  SparseMatrix A = laplacian3d(4, 4, 4);
+  CholmodSolver s;
+  Eigen::MatrixXd X;
+  EXPECT_EQ(s.solve(random_rhs(64), X).status, SolveStatus::failed);  // no matrix yet
+  A.coeffRef(3, 3) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(s.set_matrix(A).status, SolveStatus::numerical_issue);
+  const SparseMatrix R(3, 4);
+  EXPECT_EQ(s.set_matrix(R).status, SolveStatus::failed);
+  ASSERT_EQ(s.set_matrix(laplacian3d(4, 4, 4)).status, SolveStatus::converged);
+  EXPECT_EQ(s.solve(random_rhs(63), X).status, SolveStatus::failed);
+}
+
+TEST(CholmodSolver, AcceptsUncompressedInput) {
+  SparseMatrix A = laplacian3d(5, 5, 5);
+  SparseMatrix U = A;
+  U.reserve(Eigen::VectorXi::Constant(U.cols(), 10));  // leaves the matrix uncompressed
+  ASSERT_FALSE(U.isCompressed());
+  const Eigen::MatrixXd B = random_rhs(A.rows());
+  CholmodSolver s;
+  Eigen::MatrixXd X, Xd;
+  ASSERT_EQ(s.set_matrix(U).status, SolveStatus::converged);
+  ASSERT_EQ(s.solve(B, X).status, SolveStatus::converged);
+  ASSERT_EQ(dense_llt_solve(A, B, Xd).status, SolveStatus::converged);
+  EXPECT_LT(relative_difference(X, Xd), 1e-8);
+}
+
+TEST(CholmodSolver, VersionString) {
+  const std::string v = CholmodSolver::version();
+  EXPECT_EQ(v.rfind("CHOLMOD ", 0), 0u) << v;
+  EXPECT_NE(v.find('.'), std::string::npos);
+}
+
+TEST(DenseReference, ReportsIndefiniteAndTooLarge) {
+  SparseMatrix A = laplacian3d(4, 4, 4);
+  Eigen::MatrixXd X;
+  EXPECT_EQ(dense_llt_solve(SparseMatrix(-A), random_rhs(64), X).status, SolveStatus::not_positive_definite);
+  EXPECT_EQ(dense_llt_solve(A, random_rhs(64), X, 10).status, SolveStatus::failed);
+  const SolveReport r = dense_llt_solve(A, random_rhs(64), X);
+  EXPECT_EQ(r.status, SolveStatus::converged);
+  EXPECT_LT(r.relative_residual, 1e-13);
+}
+
+}  // namespace
+}  // namespace mcf

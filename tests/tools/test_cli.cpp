@@ -1,0 +1,118 @@
+// The mcfbench executable end to end: bad input exits non-zero with a message naming the file
+// (or key) and writes nothing; a good run writes result.json with the contract's keys.
+
+#include <nlohmann/json.hpp>
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int status;
+  std::string err;
+};
+
+fs::path temp_dir() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("mcfbench_cli_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+CommandResult mcfbench(const std::string& args) {
+  const fs::path err = temp_dir() / "stderr.txt";
+  const std::string cmd = std::string(MCFBENCH_BINARY) + " " + args + " >/dev/null 2>" + err.string();
+  const int raw = std::system(cmd.c_str());
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, ss.str()};
+}
+
+fs::path write(const std::string& name, const std::string& content) {
+  const fs::path p = temp_dir() / name;
+  std::ofstream(p) << content;
+  return p;
+}
+
+void expect_rejected(const std::string& mesh_arg, const std::string& must_mention) {
+  const fs::path out = temp_dir() / ("out_" + std::to_string(std::hash<std::string>{}(mesh_arg)));
+  const CommandResult r = mcfbench("flow --mesh " + mesh_arg + " --steps 1 --out " + out.string());
+  EXPECT_NE(r.status, 0) << mesh_arg;
+  EXPECT_NE(r.err.find(must_mention), std::string::npos) << "stderr: " << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "wrote output for bad input " << mesh_arg;
+}
+
+TEST(Cli, BadMeshesAreRejectedNamingTheFile) {
+  expect_rejected((temp_dir() / "missing.off").string(), "missing.off");
+  expect_rejected(write("garbage.off", "this is not a mesh\n").string(), "garbage.off");
+  expect_rejected(write("empty.off", "OFF\n0 0 0\n").string(), "empty.off");
+  expect_rejected(write("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n").string(), "nan.off");
+  expect_rejected(write("range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").string(), "range.off");
+  expect_rejected(write("degenerate.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n").string(), "degenerate.off");
+  // Three triangles on the edge (0,1): non-manifold.
+  expect_rejected(write("nonmanifold.off",
+                        "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n")
+                      .string(),
+                  "nonmanifold.off");
+  expect_rejected("sphere:vertices=abc", "vertices");
+  expect_rejected("nosuchshape", "nosuchshape");
+}
+
+TEST(Cli, BadConfigKeysAreNamed) {
+  const fs::path cfg = write("bad.json", R"({"mesh": "icosphere:level=2", "solver": {"cycels": 3}})");
+  const fs::path out = temp_dir() / "out_badcfg";
+  const CommandResult r = mcfbench("flow --config " + cfg.string() + " --out " + out.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("bad.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("solver.cycels"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  const CommandResult bad_json = mcfbench("flow --config " + write("broken.json", "{\"mesh\": ").string() + " --out " + out.string());
+  EXPECT_NE(bad_json.status, 0);
+  EXPECT_NE(bad_json.err.find("broken.json"), std::string::npos) << bad_json.err;
+  const CommandResult bad_flag = mcfbench("flow --mesh icosphere:level=2 --integrator rk4 --out " + out.string());
+  EXPECT_NE(bad_flag.status, 0);
+  EXPECT_NE(bad_flag.err.find("integrator"), std::string::npos) << bad_flag.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, FlowWritesTheResultContract) {
+  const fs::path out = temp_dir() / "out_ok";
+  const CommandResult r = mcfbench("flow --mesh icosphere:level=2 --dt 1e-3 --steps 4 --save-every 2 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(out / "result.json");
+  const auto j = nlohmann::json::parse(in);
+  for (const char* key : {"schema", "status", "stop", "config", "environment", "mesh", "system", "steps", "peak_memory_bytes"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["steps"].size(), 4u);
+  EXPECT_TRUE(j["steps"][0]["radial_error"].contains("rms_continuous"));
+  for (const char* key : {"commit", "cpu", "cores", "threads", "libraries"}) EXPECT_TRUE(j["environment"].contains(key)) << key;
+  EXPECT_EQ(j["config"]["solver"]["name"], "cholmod");
+  EXPECT_TRUE(fs::exists(out / "final.ply"));
+  EXPECT_TRUE(fs::exists(out / "frame_00002.ply"));
+  EXPECT_TRUE(fs::exists(out / "frame_00004.ply"));
+  // No temporary files left behind.
+  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos);
+}
+
+TEST(Cli, HelpExplainsEveryOption) {
+  const fs::path help = temp_dir() / "help.txt";
+  std::system((std::string(MCFBENCH_BINARY) + " flow --help > " + help.string()).c_str());
+  std::ifstream in(help);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  for (const char* opt : {"--mesh", "--flow", "--basis", "--tracking", "--depth", "--cubature", "--solver", "--cycle",
+                          "--cycles", "--smooth", "--integrator", "--dt", "--steps", "--normalize-area", "--threads",
+                          "--save-every", "--out"})
+    EXPECT_NE(ss.str().find(opt), std::string::npos) << opt;
+}
+
+}  // namespace

@@ -1,0 +1,15 @@
+#pragma once
+// The mcfbench subcommands; each registers its options on the CLI11 app and returns the
+// callback's exit status through run().
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace mcf {
+
+/// Adds a subcommand; `run` is set to the function that executes it after parsing.
+void add_flow_command(CLI::App& app, std::function<int()>& run);
+void add_mesh_info_command(CLI::App& app, std::function<int()>& run);
+
+}  // namespace mcf
