@@ -14,9 +14,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// A metric whose determinant falls this low (relative to X_0, where g = I) is a pinch: the
-// triangle has collapsed, and the paper lets such points contribute nothing.
+// A metric whose determinant falls this low is a pinch: the triangle has collapsed (area ratio
+// below 1e-12 of X_0's, where g = I) or flattened to a segment (the two tangent vectors parallel
+// to rounding: det below 1e-12 of g11·g22). The paper lets such points contribute nothing.
 constexpr double kDegenerateDeterminant = 1e-24;
+constexpr double kDegenerateRelative = 1e-12;
 
 }  // namespace
 
@@ -128,7 +130,7 @@ void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool up
                 const double g12 = Ju[0] * Jv[0] + Ju[1] * Jv[1] + Ju[2] * Jv[2];
                 const double g22 = Jv[0] * Jv[0] + Jv[1] * Jv[1] + Jv[2] * Jv[2];
                 const double det = g11 * g22 - g12 * g12;
-                if (!(det > kDegenerateDeterminant) || !std::isfinite(det)) {
+                if (!(det > kDegenerateDeterminant) || !(det > kDegenerateRelative * g11 * g22) || !std::isfinite(det)) {
                   ++count;
                   continue;
                 }
