@@ -1,0 +1,215 @@
+#include "bases/octree_basis.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace mcf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::uint64_t edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+}
+
+}  // namespace
+
+std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces) {
+  std::vector<std::uint64_t> e;
+  e.reserve(static_cast<std::size_t>(3 * faces.rows()));
+  for (Eigen::Index f = 0; f < faces.rows(); ++f)
+    for (int c = 0; c < 3; ++c) e.push_back(edge_key(faces(f, c), faces(f, (c + 1) % 3)));
+  std::sort(e.begin(), e.end());
+  std::vector<std::array<int, 2>> out;
+  for (std::size_t i = 0; i < e.size();) {
+    std::size_t j = i;
+    while (j < e.size() && e[j] == e[i]) ++j;
+    if (j - i == 1) out.push_back({static_cast<int>(e[i] >> 32), static_cast<int>(e[i] & 0xffffffffu)});
+    i = j;
+  }
+  return out;
+}
+
+std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices, const Triangles& faces) {
+  const OctreeLevel& L = octree.finest();
+  const GridCube& cube = octree.cube;
+  const double h = cube.cell_size();
+  const int res = cube.resolution();
+  std::vector<int> out;
+  auto add_cell = [&](const Eigen::Vector3d& p) {
+    int ijk[3];
+    for (int a = 0; a < 3; ++a)
+      ijk[a] = std::clamp(static_cast<int>(std::floor((p[a] - cube.origin[a]) / h)), 0, res - 1);
+    for (int c = 0; c < 8; ++c) {
+      const auto o = corner_offset(c);
+      const int f = L.find_function(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
+      if (f >= 0) out.push_back(f);
+    }
+  };
+  for (const auto& e : boundary_edges(faces)) {
+    const Eigen::Vector3d a = vertices.row(e[0]).transpose(), b = vertices.row(e[1]).transpose();
+    std::vector<double> ts = {0.0, 1.0};
+    for (int ax = 0; ax < 3; ++ax) {
+      const double ua = (a[ax] - cube.origin[ax]) / h, ub = (b[ax] - cube.origin[ax]) / h;
+      if (ua == ub) continue;
+      for (int i = static_cast<int>(std::ceil(std::min(ua, ub))); i <= static_cast<int>(std::floor(std::max(ua, ub))); ++i) {
+        const double t = (i - ua) / (ub - ua);
+        if (t > 0.0 && t < 1.0) ts.push_back(t);
+      }
+    }
+    std::sort(ts.begin(), ts.end());
+    add_cell(a);
+    add_cell(b);
+    for (std::size_t i = 0; i + 1 < ts.size(); ++i)
+      if (ts[i + 1] > ts[i]) add_cell(a + 0.5 * (ts[i] + ts[i + 1]) * (b - a));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+TriangleMesh split_1_to_4(const TriangleMesh& mesh) {
+  const Eigen::Index n = mesh.num_vertices(), m = mesh.num_faces();
+  std::unordered_map<std::uint64_t, int> mid;
+  mid.reserve(static_cast<std::size_t>(3 * m));
+  std::vector<Eigen::Vector3d> extra;
+  Triangles F(4 * m, 3);
+  for (Eigen::Index f = 0; f < m; ++f) {
+    int e[3];
+    for (int c = 0; c < 3; ++c) {
+      const int a = mesh.faces(f, c), b = mesh.faces(f, (c + 1) % 3);
+      auto [it, inserted] = mid.try_emplace(edge_key(a, b), static_cast<int>(n + static_cast<Eigen::Index>(extra.size())));
+      if (inserted) extra.push_back(0.5 * (mesh.vertices.row(a) + mesh.vertices.row(b)).transpose());
+      e[c] = it->second;
+    }
+    const int v0 = mesh.faces(f, 0), v1 = mesh.faces(f, 1), v2 = mesh.faces(f, 2);
+    F.row(4 * f + 0) << v0, e[0], e[2];
+    F.row(4 * f + 1) << e[0], v1, e[1];
+    F.row(4 * f + 2) << e[2], e[1], v2;
+    F.row(4 * f + 3) << e[0], e[1], e[2];
+  }
+  TriangleMesh out;
+  out.vertices.resize(n + static_cast<Eigen::Index>(extra.size()), 3);
+  out.vertices.topRows(n) = mesh.vertices;
+  for (std::size_t i = 0; i < extra.size(); ++i) out.vertices.row(n + static_cast<Eigen::Index>(i)) = extra[i].transpose();
+  out.faces = std::move(F);
+  return out;
+}
+
+RebuiltOctreeBasis::RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions options) : options_(options) {
+  if (options_.depth < 4 || options_.depth > 10)
+    throw std::invalid_argument("octree depth must be in 4..10, got " + std::to_string(options_.depth));
+  (void)cubature_rule(options_.cubature);  // validates
+  if (mesh.num_faces() == 0) throw std::invalid_argument("RebuiltOctreeBasis: mesh has no faces");
+  input_vertices_ = mesh.num_vertices();
+  mesh_ = options_.refine_input ? split_1_to_4(mesh) : mesh;
+  rebuild(mesh.vertices);
+}
+
+Eigen::Index RebuiltOctreeBasis::dimension() const { return octree_.finest().num_functions(); }
+
+void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
+  if (vertices.rows() != input_vertices_)
+    throw std::invalid_argument("RebuiltOctreeBasis::rebuild: expected " + std::to_string(input_vertices_) + " vertices");
+  if (options_.refine_input) {
+    const Eigen::Index n = input_vertices_;
+    if (last_evaluated_build_ == build_id_ && last_evaluated_.rows() == mesh_.num_vertices() &&
+        last_evaluated_.topRows(n) == vertices) {
+      mesh_.vertices = last_evaluated_;
+    } else {
+      mesh_.vertices.topRows(n) = vertices;  // midpoints of the current edges
+      // Midpoint vertex of edge (a,b) is the one shared by the four sub-faces; recompute from the
+      // corner faces: sub-face 4f+0 = (v0, e01, e20), 4f+1 = (e01, v1, e12).
+      for (Eigen::Index f = 0; f < mesh_.num_faces() / 4; ++f) {
+        const int v0 = mesh_.faces(4 * f, 0), v1 = mesh_.faces(4 * f + 1, 1), v2 = mesh_.faces(4 * f + 2, 2);
+        const int e01 = mesh_.faces(4 * f, 1), e20 = mesh_.faces(4 * f, 2), e12 = mesh_.faces(4 * f + 1, 2);
+        mesh_.vertices.row(e01) = 0.5 * (vertices.row(v0) + vertices.row(v1));
+        mesh_.vertices.row(e12) = 0.5 * (vertices.row(v1) + vertices.row(v2));
+        mesh_.vertices.row(e20) = 0.5 * (vertices.row(v2) + vertices.row(v0));
+      }
+    }
+  } else {
+    mesh_.vertices = vertices;
+  }
+  ++build_id_;
+  stats_ = BasisStats{};
+
+  auto t0 = Clock::now();
+  const GridCube cube = choose_cube(mesh_.vertices, options_.depth, options_.cube);
+  double t_octree = seconds_since(t0);
+
+  t0 = Clock::now();
+  pieces_ = clip_mesh(mesh_.vertices, mesh_.faces, cube);
+  stats_.setup_seconds["clip"] = seconds_since(t0);
+
+  t0 = Clock::now();
+  system_.reset();
+  octree_ = build_octree(cube, pieces_, options_.coarsest_depth);
+  piece_cells_ = locate_pieces(octree_, pieces_);
+  {
+    std::vector<char> used(static_cast<std::size_t>(mesh_.num_vertices()), 0);
+    for (Eigen::Index f = 0; f < mesh_.num_faces(); ++f)
+      for (int c = 0; c < 3; ++c) used[static_cast<std::size_t>(mesh_.faces(f, c))] = 1;
+    referenced_.clear();
+    for (std::size_t v = 0; v < used.size(); ++v)
+      if (used[v]) referenced_.push_back(static_cast<int>(v));
+    Positions pts(static_cast<Eigen::Index>(referenced_.size()), 3);
+    for (std::size_t i = 0; i < referenced_.size(); ++i) pts.row(static_cast<Eigen::Index>(i)) = mesh_.vertices.row(referenced_[i]);
+    stencils_ = point_stencils(octree_, pts);
+  }
+  locked_ = boundary_functions(octree_, mesh_.vertices, mesh_.faces);
+  stats_.setup_seconds["octree"] = t_octree + seconds_since(t0);
+
+  t0 = Clock::now();
+  system_ = std::make_unique<OctreeSystem>(octree_, octree_.num_levels() - 1, pieces_, piece_cells_);
+  system_->assemble(cubature_rule(options_.cubature), mass_, stiffness_);
+  stats_.setup_seconds["integrate"] = seconds_since(t0);
+
+  t0 = Clock::now();
+  prolongations_ = build_prolongations(octree_);
+  colours_ = build_colours(octree_);
+  stats_.setup_seconds["hierarchy"] = seconds_since(t0);
+
+  stats_.dimension = dimension();
+  stats_.split_triangles = static_cast<long long>(pieces_.size());
+  stats_.cubature_points = stats_.split_triangles * cubature_rule(options_.cubature).size();
+  stats_.levels = octree_.num_levels();
+  // Rebuilt: nothing is stored per cubature point beyond the piece (3 corners, cell, triangle).
+  stats_.bytes_per_cubature_point =
+      static_cast<double>(sizeof(ClippedTriangle) + sizeof(int)) / cubature_rule(options_.cubature).size();
+}
+
+Coefficients RebuiltOctreeBasis::initial_coefficients() const {
+  return octree_.function_positions(octree_.num_levels() - 1);
+}
+
+void RebuiltOctreeBasis::update(const Coefficients& x, bool, bool) {
+  if (x.rows() != dimension())
+    throw std::invalid_argument("RebuiltOctreeBasis::update: coefficient count does not match the dimension");
+}
+
+Positions RebuiltOctreeBasis::evaluate_vertices(const Coefficients& x) const {
+  if (x.rows() != dimension())
+    throw std::invalid_argument("RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
+  Positions all = mesh_.vertices;
+  if (static_cast<Eigen::Index>(referenced_.size()) == all.rows()) {
+    all = evaluate_stencils(stencils_, x);
+  } else {
+    const Positions ev = evaluate_stencils(stencils_, x);
+    for (std::size_t i = 0; i < referenced_.size(); ++i) all.row(referenced_[i]) = ev.row(static_cast<Eigen::Index>(i));
+  }
+  if (!options_.refine_input) return all;
+  last_evaluated_ = all;
+  last_evaluated_build_ = build_id_;
+  return all.topRows(input_vertices_);
+}
+
+}  // namespace mcf

@@ -1,0 +1,96 @@
+#pragma once
+// The rebuilt octree basis (DESIGN.md "Octree trilinear B-spline basis", "Rebuilt"): the CLB*09
+// baseline that builds the octree, clips the mesh and integrates with the identity metric on the
+// current vertex positions at every step.
+
+#include "bases/basis.h"
+#include "bases/clip.h"
+#include "bases/cubature.h"
+#include "bases/octree.h"
+#include "bases/octree_system.h"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mcf {
+
+struct OctreeOptions {
+  int depth = 8;                          ///< finest depth, 4..10
+  int cubature = 3;                       ///< 1, 3 or 6 (cubature_rule)
+  OctreeCube cube = OctreeCube::automatic;
+  bool refine_input = false;              ///< 1-to-4 split of the initial mesh first
+  int coarsest_depth = 2;                 ///< coarsest multigrid level (clamped to depth)
+};
+
+/// Boundary edges (edges with exactly one incident face) as vertex pairs (smaller index first).
+std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces);
+
+/// Finest-level functions whose support meets a boundary edge (or a boundary vertex): the corners
+/// of every finest cell a boundary edge passes through. Sorted, unique.
+std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices, const Triangles& faces);
+
+/// One 1-to-4 midpoint split (original vertices keep their indices 0..n-1, then one vertex per edge).
+TriangleMesh split_1_to_4(const TriangleMesh& mesh);
+
+class RebuiltOctreeBasis : public Basis {
+ public:
+  /// Builds from the mesh's initial positions (faces are fixed from now on).
+  explicit RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions options = {});
+  RebuiltOctreeBasis(const RebuiltOctreeBasis&) = delete;  // the system points into members
+  RebuiltOctreeBasis& operator=(const RebuiltOctreeBasis&) = delete;
+
+  std::string name() const override { return "octree-rebuilt"; }
+  Eigen::Index dimension() const override;
+  bool rebuilds_every_step() const override { return true; }
+  /// Rebuilds octree, pieces, matrices and hierarchy on `vertices` (rows = the input mesh's
+  /// vertex count). With refine_input the midpoint vertices come from the last
+  /// evaluate_vertices call when there was one on the current basis, else from the edges' midpoints.
+  void rebuild(const Positions& vertices) override;
+  /// x_0^I = c_I, the grid-vertex positions of the finest functions.
+  Coefficients initial_coefficients() const override;
+  /// The matrices integrated by rebuild() are those of the identity metric, i.e. of x =
+  /// initial_coefficients(); this basis cannot re-integrate at another embedding, so update() is a
+  /// no-op (it only checks the dimension). Call rebuild() to move to a new embedding.
+  void update(const Coefficients& x, bool update_mass, bool update_stiffness) override;
+  const SparseMatrix& mass() const override { return mass_; }
+  const SparseMatrix& stiffness() const override { return stiffness_; }
+  /// v = Σ_I B_I(v) x^I for the input mesh's vertices (trilinear stencils in an active finest cell).
+  /// Vertices used by no face keep the position they had at the last rebuild.
+  Positions evaluate_vertices(const Coefficients& x) const override;
+  /// Open surfaces: finest functions whose support meets a boundary edge (see boundary_functions).
+  std::vector<int> locked_functions() const override { return locked_; }
+  const std::vector<SparseMatrix>* prolongations() const override { return &prolongations_; }
+  const std::vector<std::vector<std::uint8_t>>* colours() const override { return &colours_; }
+  const BasisStats& stats() const override { return stats_; }
+
+  // Internals, for tests and the tracked basis.
+  const OctreeOptions& options() const { return options_; }
+  const TriangleMesh& working_mesh() const { return mesh_; }  ///< the (possibly 1-to-4 refined) mesh integrated
+  const Octree& octree() const { return octree_; }
+  const std::vector<ClippedTriangle>& pieces() const { return pieces_; }
+  const std::vector<int>& piece_cells() const { return piece_cells_; }
+  const OctreeSystem& system() const { return *system_; }
+
+ private:
+  OctreeOptions options_;
+  Eigen::Index input_vertices_ = 0;
+  TriangleMesh mesh_;
+  Octree octree_;
+  std::vector<ClippedTriangle> pieces_;
+  std::vector<int> piece_cells_;
+  std::unique_ptr<OctreeSystem> system_;
+  SparseMatrix mass_, stiffness_;
+  std::vector<SparseMatrix> prolongations_;
+  std::vector<std::vector<std::uint8_t>> colours_;
+  std::vector<PointStencil> stencils_;  ///< of mesh_'s referenced vertices (see referenced_)
+  std::vector<int> referenced_;         ///< vertices used by a face; the others keep their position
+  std::vector<int> locked_;
+  BasisStats stats_;
+  long long build_id_ = 0;
+  mutable Positions last_evaluated_;  ///< refine_input: all working-mesh vertices of the last evaluation
+  mutable long long last_evaluated_build_ = -1;
+};
+
+}  // namespace mcf

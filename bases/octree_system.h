@@ -1,0 +1,139 @@
+#pragma once
+// Integration of trilinear B-splines over clipped pieces (DESIGN.md "Octree trilinear B-spline
+// basis"): per piece and cubature point the weight w = area·ω, the 8 values of the cell's corner
+// functions and their 3-D gradients projected onto the piece's plane; mass and stiffness are
+// accumulated into a sparsity pattern built once per octree level. Also the multigrid hierarchy
+// (prolongations, parity colours) and vertex evaluation. The pieces are exposed so the tracked
+// basis can reuse them.
+
+#include "bases/basis.h"
+#include "bases/clip.h"
+#include "bases/cubature.h"
+#include "bases/octree.h"
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+namespace mcf {
+
+/// Values and gradients of the 8 corner functions of a cell at local coordinates t ∈ [0,1]^3
+/// (t = (p - cell origin)/h). Corner c as in corner_offset(c). gradient[c] is in world units.
+inline void trilinear_values(const double t[3], double inv_h, double value[8], double gradient[8][3]) {
+  const double w0[3] = {1.0 - t[0], 1.0 - t[1], 1.0 - t[2]};
+  for (int c = 0; c < 8; ++c) {
+    const int ox = c & 1, oy = (c >> 1) & 1, oz = (c >> 2) & 1;
+    const double bx = ox ? t[0] : w0[0], by = oy ? t[1] : w0[1], bz = oz ? t[2] : w0[2];
+    const double sx = ox ? inv_h : -inv_h, sy = oy ? inv_h : -inv_h, sz = oz ? inv_h : -inv_h;
+    value[c] = bx * by * bz;
+    gradient[c][0] = sx * by * bz;
+    gradient[c][1] = bx * sy * bz;
+    gradient[c][2] = bx * by * sz;
+  }
+}
+
+/// One cubature point of a piece: weight w = area·ω, the 8 corner-function values and their 3-D
+/// gradients projected onto the piece's plane (world units), and the point's local coordinates in
+/// the cell. cell_origin is the world position of the cell's corner 0, h its size.
+struct CubatureSample {
+  double weight;
+  double local[3];
+  double value[8];
+  double gradient[8][3];
+};
+/// unit_normal = cross / |cross| of the piece, area = |cross| / 2 (pass them in to share them
+/// between the points of a piece).
+inline void sample_piece(const ClippedTriangle& t, const Eigen::Vector3d& unit_normal, double area,
+                         const double cell_origin[3], double h, const std::array<double, 3>& bary, double omega,
+                         CubatureSample& s) {
+  const double inv_h = 1.0 / h;
+  for (int a = 0; a < 3; ++a) {
+    const double x = bary[0] * t.corners[0][a] + bary[1] * t.corners[1][a] + bary[2] * t.corners[2][a];
+    const double u = (x - cell_origin[a]) * inv_h;
+    s.local[a] = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+  }
+  trilinear_values(s.local, inv_h, s.value, s.gradient);
+  for (int c = 0; c < 8; ++c) {
+    const double gn = s.gradient[c][0] * unit_normal[0] + s.gradient[c][1] * unit_normal[1] + s.gradient[c][2] * unit_normal[2];
+    for (int e = 0; e < 3; ++e) s.gradient[c][e] -= gn * unit_normal[e];
+  }
+  s.weight = area * omega;
+}
+
+/// Offset bit (0..26) of row function I relative to column function J, both corners of one cell:
+/// o = (dz+1)*9 + (dy+1)*3 + (dx+1) with d = corner(a) - corner(b).
+inline int neighbour_bit(int corner_row, int corner_col) {
+  const auto a = corner_offset(corner_row), b = corner_offset(corner_col);
+  return (a[2] - b[2] + 1) * 9 + (a[1] - b[1] + 1) * 3 + (a[0] - b[0] + 1);
+}
+
+/// Integration data of one octree level over fixed pieces: pieces grouped by cell, cells grouped
+/// by parity colour, and the CSC pattern of the level's matrices (full symmetric storage).
+/// Slot of (I = cell_functions[a], J = cell_functions[b]) is
+///   outer[J] + popcount(neighbour_mask[J] & ((1 << neighbour_bit(a,b)) - 1)).
+class OctreeSystem {
+ public:
+  /// `level` indexes octree.levels. piece_finest_cell[p] = index of piece p's cell in the finest level.
+  /// Keeps pointers to `octree` and `pieces`: both must outlive the system and stay unchanged.
+  OctreeSystem(const Octree& octree, int level, const std::vector<ClippedTriangle>& pieces,
+               const std::vector<int>& piece_finest_cell);
+
+  int level() const { return level_; }
+  Eigen::Index dimension() const { return pattern_.rows(); }
+  /// The pattern with zero values (compressed, full symmetric storage).
+  const SparseMatrix& pattern() const { return pattern_; }
+  int slot(int cell, int corner_row, int corner_col) const {
+    const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];
+    const int J = f[static_cast<std::size_t>(corner_col)];
+    const std::uint32_t below = (1u << neighbour_bit(corner_row, corner_col)) - 1u;
+    return pattern_.outerIndexPtr()[J] + std::popcount(mask_[static_cast<std::size_t>(J)] & below);
+  }
+  /// Pieces of cell c: piece_order()[cell_start()[c] .. cell_start()[c+1]).
+  const std::vector<int>& cell_start() const { return cell_start_; }
+  const std::vector<int>& piece_order() const { return piece_order_; }
+  /// Cells of parity colour q = (i%2)+2(j%2)+4(k%2); cells of one colour share no function.
+  const std::vector<std::vector<int>>& colour_cells() const { return colour_cells_; }
+  const std::vector<int>& piece_cell() const { return piece_cell_; }
+
+  /// Mass and stiffness with the identity metric (the pieces' own geometry), any cubature rule.
+  /// M and K get this system's pattern; accumulation is lock-free (8 parity passes, parallel over
+  /// cells inside a pass), deterministic.
+  void assemble(const CubatureRule& rule, SparseMatrix& mass, SparseMatrix& stiffness) const;
+
+ private:
+  const Octree* octree_;
+  const std::vector<ClippedTriangle>* pieces_;
+  int level_;
+  std::vector<int> piece_cell_;
+  std::vector<int> cell_start_, piece_order_;
+  std::vector<std::vector<int>> colour_cells_;
+  std::vector<std::uint32_t> mask_;
+  SparseMatrix pattern_;
+};
+
+/// Finest-cell index of every piece (binary search, parallel). Throws if a piece's cell is inactive.
+std::vector<int> locate_pieces(const Octree& octree, const std::vector<ClippedTriangle>& pieces);
+
+/// Builds the octree over the pieces' cells (cube.depth = finest depth).
+Octree build_octree(const GridCube& cube, const std::vector<ClippedTriangle>& pieces, int coarsest_depth);
+
+/// P_l : level l -> l+1 (rows: fine functions, columns: coarse functions), coarsest first.
+std::vector<SparseMatrix> build_prolongations(const Octree& octree);
+/// Per level, per function: (i%2) + 2(j%2) + 4(k%2).
+std::vector<std::vector<std::uint8_t>> build_colours(const Octree& octree);
+
+/// The 8 functions and trilinear weights that evaluate a point (e.g. an original vertex).
+struct PointStencil {
+  std::array<int, 8> functions;
+  std::array<double, 8> weights;
+};
+/// Stencils at the finest level; each point is evaluated in an active finest cell whose closed box
+/// contains it (points on cell faces: the first active one of the candidate cells). Throws
+/// std::runtime_error when no such cell is active (a point away from every piece).
+std::vector<PointStencil> point_stencils(const Octree& octree, const Positions& points);
+/// Stencil of a point in a given level-`level` cell (local coordinates clamped to the cell).
+PointStencil cell_stencil(const Octree& octree, int level, int cell, const Eigen::Vector3d& p);
+Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coefficients& x);
+
+}  // namespace mcf

@@ -1,0 +1,207 @@
+#include "bases/tracked_octree_basis.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace mcf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// A metric whose determinant falls this low is a pinch: the triangle has collapsed (area ratio
+// below 1e-12 of X_0's, where g = I) or flattened to a segment (the two tangent vectors parallel
+// to rounding: det below 1e-12 of g11·g22). The paper lets such points contribute nothing.
+constexpr double kDegenerateDeterminant = 1e-24;
+constexpr double kDegenerateRelative = 1e-12;
+
+}  // namespace
+
+TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions options)
+    : initial_(std::make_unique<RebuiltOctreeBasis>(mesh, options)), rule_(&cubature_rule(options.cubature)) {
+  const auto t0 = Clock::now();
+  const Octree& octree = initial_->octree();
+  const OctreeLevel& L = octree.finest();
+  const GridCube& cube = octree.cube;
+  const double h = cube.cell_size(L.depth), inv_h = 1.0 / h;
+  const OctreeSystem& system = initial_->system();
+  const auto& pieces = initial_->pieces();
+  const auto& order = system.piece_order();
+  cell_start_ = system.cell_start();
+  identity_ = initial_->initial_coefficients();
+
+  // Pieces in cell order, corners in their cell's local coordinates (p - cell origin) / h.
+  local_corners_.resize(9 * order.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, L.cells.size(), 256), [&](const auto& r) {
+    for (std::size_t c = r.begin(); c != r.end(); ++c) {
+      const auto ijk = grid_index(L.cells[c]);
+      for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
+        const ClippedTriangle& t = pieces[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
+        for (int v = 0; v < 3; ++v)
+          for (int a = 0; a < 3; ++a)
+            local_corners_[9 * std::size_t(s) + 3 * v + a] = (t.corners[v][a] - cube.origin[a]) * inv_h - ijk[a];
+      }
+    }
+  });
+  // Only the original vertices are evaluated (with refine_input the midpoints are internal).
+  stencils_ = point_stencils(octree, mesh.vertices);
+  const double preprocess = seconds_since(t0);
+
+  const auto t1 = Clock::now();
+  update(identity_, true, true);
+  const double integrate = seconds_since(t1);
+
+  stats_ = initial_->stats();
+  stats_.setup_seconds["integrate_initial"] = stats_.setup_seconds["integrate"];
+  stats_.setup_seconds["preprocess"] = preprocess;
+  stats_.setup_seconds["integrate"] = integrate;
+  stats_.bytes_per_cubature_point = double(preprocessed_bytes()) / double(stats_.cubature_points);
+}
+
+std::size_t TrackedOctreeBasis::preprocessed_bytes() const {
+  return local_corners_.size() * sizeof(double) + cell_start_.size() * sizeof(int);
+}
+
+void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool update_stiffness) {
+  if (!update_mass && !update_stiffness) return;
+  if (x.rows() != dimension())
+    throw std::invalid_argument("TrackedOctreeBasis::update: coefficient count does not match the dimension");
+  const Octree& octree = initial_->octree();
+  const OctreeLevel& L = octree.finest();
+  const double h = octree.cube.cell_size(L.depth), inv_h = 1.0 / h;
+  const OctreeSystem& system = initial_->system();
+  if (update_mass) mass_ = system.pattern();
+  if (update_stiffness) stiffness_ = system.pattern();
+  double* Mv = update_mass ? mass_.valuePtr() : nullptr;
+  double* Kv = update_stiffness ? stiffness_.valuePtr() : nullptr;
+  const int nq = rule_->size();
+  const double* X = x.data();
+  const Eigen::Index ld = x.rows();  // column-major n x 3
+
+  long long degenerate = 0;
+  for (int colour = 0; colour < 8; ++colour) {
+    const auto& cells = system.colour_cells()[std::size_t(colour)];
+    degenerate += tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, cells.size(), 32), 0LL,
+        [&](const tbb::blocked_range<std::size_t>& r, long long count) {
+          for (std::size_t ci = r.begin(); ci != r.end(); ++ci) {
+            const int c = cells[ci];
+            const auto& f = L.cell_functions[std::size_t(c)];
+            double xc[8][3];
+            for (int a = 0; a < 8; ++a)
+              for (int d = 0; d < 3; ++d) xc[a][d] = X[d * ld + f[std::size_t(a)]];
+            double m[8][8] = {}, k[8][8] = {};
+            for (int s = cell_start_[std::size_t(c)]; s < cell_start_[std::size_t(c) + 1]; ++s) {
+              const double* p = &local_corners_[9 * std::size_t(s)];
+              // Orthonormal frame (e1, e2) of the piece's plane on X_0 (ComputeDifferential).
+              const double u[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
+              const double v[3] = {p[6] - p[0], p[7] - p[1], p[8] - p[2]};
+              double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+              const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+              if (!(len > 0.0)) continue;
+              const double area = 0.5 * len * h * h;
+              const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+              const double e1[3] = {u[0] / ul, u[1] / ul, u[2] / ul};
+              for (double& ni : n) ni /= len;
+              const double e2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]};
+              for (int q = 0; q < nq; ++q) {
+                const auto& b = rule_->points[std::size_t(q)];
+                double t[3];
+                for (int a = 0; a < 3; ++a) t[a] = std::clamp(b[0] * p[a] + b[1] * p[3 + a] + b[2] * p[6 + a], 0.0, 1.0);
+                double val[8], grad[8][3];
+                trilinear_values(t, inv_h, val, grad);
+                double eta[8], mu[8];
+                double Ju[3] = {0, 0, 0}, Jv[3] = {0, 0, 0};
+                for (int a = 0; a < 8; ++a) {
+                  eta[a] = grad[a][0] * e1[0] + grad[a][1] * e1[1] + grad[a][2] * e1[2];
+                  mu[a] = grad[a][0] * e2[0] + grad[a][1] * e2[1] + grad[a][2] * e2[2];
+                  for (int d = 0; d < 3; ++d) {
+                    Ju[d] += eta[a] * xc[a][d];
+                    Jv[d] += mu[a] * xc[a][d];
+                  }
+                }
+                // Metric g = dXᵀdX in the frame of X_0 (identity at t = 0).
+                const double g11 = Ju[0] * Ju[0] + Ju[1] * Ju[1] + Ju[2] * Ju[2];
+                const double g12 = Ju[0] * Jv[0] + Ju[1] * Jv[1] + Ju[2] * Jv[2];
+                const double g22 = Jv[0] * Jv[0] + Jv[1] * Jv[1] + Jv[2] * Jv[2];
+                const double det = g11 * g22 - g12 * g12;
+                if (!(det > kDegenerateDeterminant) || !(det > kDegenerateRelative * g11 * g22) || !std::isfinite(det)) {
+                  ++count;
+                  continue;
+                }
+                const double sq = std::sqrt(det);
+                const double w = area * rule_->weights[std::size_t(q)] * sq;
+                if (Mv)
+                  for (int a = 0; a < 8; ++a) {
+                    const double wa = w * val[a];
+                    for (int bb = a; bb < 8; ++bb) m[a][bb] += wa * val[bb];
+                  }
+                if (Kv) {
+                  // (η,μ)_a g⁻¹ (η,μ)_bᵀ √|g| w = P_a η_b + Q_a μ_b.
+                  const double s = w / det;
+                  for (int a = 0; a < 8; ++a) {
+                    const double P = s * (g22 * eta[a] - g12 * mu[a]);
+                    const double Q = s * (g11 * mu[a] - g12 * eta[a]);
+                    for (int bb = a; bb < 8; ++bb) k[a][bb] += P * eta[bb] + Q * mu[bb];
+                  }
+                }
+              }
+            }
+            // Add the cell's blocks to the fixed pattern (SetSystemMatrices); symmetric halves mirrored.
+            for (int a = 0; a < 8; ++a)
+              for (int bb = 0; bb < 8; ++bb) {
+                const int lo = std::min(a, bb), hi = std::max(a, bb);
+                const int slot = system.slot(c, a, bb);
+                if (Mv) Mv[slot] += m[lo][hi];
+                if (Kv) Kv[slot] += k[lo][hi];
+              }
+          }
+          return count;
+        },
+        [](long long a, long long b) { return a + b; });
+  }
+  degenerate_points_ = degenerate;
+}
+
+double TrackedOctreeBasis::max_metric_deviation(const Coefficients& x) const {
+  const Octree& octree = initial_->octree();
+  const OctreeLevel& L = octree.finest();
+  const double inv_h = 1.0 / octree.cube.cell_size(L.depth);
+  double worst = 0;
+  for (std::size_t c = 0; c < L.cells.size(); ++c) {
+    const auto& f = L.cell_functions[c];
+    for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
+      const double* p = &local_corners_[9 * std::size_t(s)];
+      const Eigen::Vector3d p0(p[0], p[1], p[2]), p1(p[3], p[4], p[5]), p2(p[6], p[7], p[8]);
+      const Eigen::Vector3d e1 = (p1 - p0).normalized();
+      const Eigen::Vector3d e2 = (p1 - p0).cross(p2 - p0).normalized().cross(e1);
+      for (int q = 0; q < rule_->size(); ++q) {
+        const auto& b = rule_->points[std::size_t(q)];
+        double t[3], val[8], grad[8][3];
+        for (int a = 0; a < 3; ++a) t[a] = std::clamp(b[0] * p0[a] + b[1] * p1[a] + b[2] * p2[a], 0.0, 1.0);
+        trilinear_values(t, inv_h, val, grad);
+        Eigen::Matrix<double, 3, 2> J = Eigen::Matrix<double, 3, 2>::Zero();
+        for (int a = 0; a < 8; ++a) {
+          const Eigen::Vector3d g(grad[a][0], grad[a][1], grad[a][2]);
+          J.col(0) += g.dot(e1) * x.row(f[std::size_t(a)]).transpose();
+          J.col(1) += g.dot(e2) * x.row(f[std::size_t(a)]).transpose();
+        }
+        worst = std::max(worst, ((J.transpose() * J) - Eigen::Matrix2d::Identity()).cwiseAbs().maxCoeff());
+      }
+    }
+  }
+  return worst;
+}
+
+Positions TrackedOctreeBasis::evaluate_vertices(const Coefficients& x) const {
+  if (x.rows() != dimension())
+    throw std::invalid_argument("TrackedOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
+  return evaluate_stencils(stencils_, x);
+}
+
+}  // namespace mcf

@@ -1,0 +1,117 @@
+// The tracked basis against the rebuilt one (same octree, pieces and cubature: at X_0 the two
+// integrate the same functions, so the matrices must agree to rounding) and against the
+// invariances of the metric: scaling the coefficients by s scales M by s² and leaves K; a
+// rotation leaves both.
+
+#include "bases/tracked_octree_basis.h"
+#include "test_meshes.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+namespace mcf {
+namespace {
+
+double relative_difference(const SparseMatrix& a, const SparseMatrix& b) {
+  return (a - b).norm() / b.norm();
+}
+
+TEST(TrackedOctree, StepZeroEqualsRebuilt) {
+  const TriangleMesh mesh = test_icosphere(3, 1.0);
+  for (int cubature : {1, 3, 6}) {
+    OctreeOptions o;
+    o.depth = 6;
+    o.cubature = cubature;
+    TrackedOctreeBasis tracked(mesh, o);
+    const RebuiltOctreeBasis& rebuilt = tracked.initial();
+    EXPECT_LT(relative_difference(tracked.mass(), rebuilt.mass()), 1e-12) << cubature;
+    EXPECT_LT(relative_difference(tracked.stiffness(), rebuilt.stiffness()), 1e-12) << cubature;
+    // And an independently constructed rebuilt basis.
+    RebuiltOctreeBasis fresh(mesh, o);
+    EXPECT_LT(relative_difference(tracked.stiffness(), fresh.stiffness()), 1e-12) << cubature;
+    EXPECT_EQ(tracked.evaluate_vertices(tracked.initial_coefficients()).rows(), mesh.num_vertices());
+    EXPECT_LT((tracked.evaluate_vertices(tracked.initial_coefficients()) - mesh.vertices).cwiseAbs().maxCoeff(), 1e-12);
+  }
+}
+
+TEST(TrackedOctree, InitialMetricIsIdentity) {
+  const TriangleMesh mesh = test_icosphere(2, 0.8);
+  OctreeOptions o;
+  o.depth = 5;
+  TrackedOctreeBasis tracked(mesh, o);
+  EXPECT_LT(tracked.max_metric_deviation(tracked.initial_coefficients()), 1e-12);
+  EXPECT_NEAR(tracked.max_metric_deviation(2.0 * tracked.initial_coefficients()), 3.0, 1e-12);  // g = 4 I
+  EXPECT_EQ(tracked.degenerate_points(), 0);
+}
+
+TEST(TrackedOctree, MetricInvariances) {
+  const TriangleMesh mesh = test_icosphere(3, 1.0);
+  OctreeOptions o;
+  o.depth = 5;
+  TrackedOctreeBasis tracked(mesh, o);
+  const SparseMatrix M0 = tracked.mass(), K0 = tracked.stiffness();
+  const Coefficients x0 = tracked.initial_coefficients();
+  tracked.update(2.5 * x0, true, true);
+  EXPECT_LT(relative_difference(tracked.mass(), 6.25 * M0), 1e-12);
+  EXPECT_LT(relative_difference(tracked.stiffness(), K0), 1e-12);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  tracked.update((x0 * R.transpose()).rowwise() + Eigen::RowVector3d(1, -2, 3), true, true);
+  EXPECT_LT(relative_difference(tracked.mass(), M0), 1e-12);
+  EXPECT_LT(relative_difference(tracked.stiffness(), K0), 1e-12);
+  // A non-conformal stretch changes K (g⁻¹ is no longer a multiple of I).
+  Coefficients stretched = x0;
+  stretched.col(0) *= 2.0;
+  tracked.update(stretched, true, true);
+  EXPECT_GT(relative_difference(tracked.stiffness(), K0), 1e-3);
+}
+
+TEST(TrackedOctree, DegenerateMetricContributesNothing) {
+  const TriangleMesh mesh = test_icosphere(2, 1.0);
+  OctreeOptions o;
+  o.depth = 4;
+  TrackedOctreeBasis tracked(mesh, o);
+  // Collapse everything onto a line: every metric has rank <= 1.
+  Coefficients line = tracked.initial_coefficients();
+  line.col(1).setZero();
+  line.col(2).setZero();
+  tracked.update(line, true, true);
+  EXPECT_EQ(tracked.degenerate_points(), tracked.stats().cubature_points);
+  EXPECT_EQ(tracked.mass().norm(), 0.0);
+  EXPECT_EQ(tracked.stiffness().norm(), 0.0);
+}
+
+TEST(TrackedOctree, ThreadCountDoesNotChangeTheResult) {
+  const TriangleMesh mesh = test_icosphere(3, 1.0);
+  OctreeOptions o;
+  o.depth = 6;
+  TrackedOctreeBasis tracked(mesh, o);
+  Coefficients x = tracked.initial_coefficients();
+  x.col(2) *= 0.7;
+  SparseMatrix M1, K1;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    tracked.update(x, true, true);
+    M1 = tracked.mass();
+    K1 = tracked.stiffness();
+  }
+  tracked.update(x, true, true);
+  ASSERT_EQ(M1.nonZeros(), tracked.mass().nonZeros());
+  for (Eigen::Index i = 0; i < M1.nonZeros(); ++i) {
+    ASSERT_EQ(M1.valuePtr()[i], tracked.mass().valuePtr()[i]);
+    ASSERT_EQ(K1.valuePtr()[i], tracked.stiffness().valuePtr()[i]);
+  }
+}
+
+TEST(TrackedOctree, LeanStorage) {
+  const TriangleMesh mesh = test_icosphere(3, 1.0);
+  OctreeOptions o;
+  o.depth = 6;
+  o.cubature = 3;
+  TrackedOctreeBasis tracked(mesh, o);
+  // 9 doubles per split triangle = 24 bytes per point of the 3-point rule (+ cell offsets);
+  // the paper stores 25 floats = 100 bytes.
+  EXPECT_LT(tracked.stats().bytes_per_cubature_point, 100.0 / 3.0);
+}
+
+}  // namespace
+}  // namespace mcf
