@@ -5,6 +5,7 @@ model, left) and Hausdorff distance vs depth per number of W-cycles (sphere, rig
 import statistics
 
 import matplotlib.pyplot as plt
+from matplotlib.ticker import MaxNLocator
 
 import common
 
@@ -56,10 +57,11 @@ def plot_residuals(ax, cells):
             pts = [(i + 1, v) for i, v in enumerate(res) if common.finite(v)]
         if pts:
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label="depth %s" % d)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("W-cycles")
     ax.set_ylabel("relative residual")
     ax.set_yscale("log")
-    ax.set_title("residual (model)", fontsize=9)
+    ax.set_title("residual (%s)" % ("sphere" if all(is_sphere(r) for r in cells) else "model"), fontsize=9)
 
 
 def plot_hausdorff(ax, cells):
@@ -68,6 +70,7 @@ def plot_hausdorff(ax, cells):
         pts = sorted((depth(r), hausdorff(r)) for r in rs if depth(r) is not None and common.finite(hausdorff(r)))
         if pts:
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label="%s W-cycles" % c)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("octree depth")
     ax.set_ylabel("Hausdorff distance")
     ax.set_yscale("log")

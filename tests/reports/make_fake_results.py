@@ -37,12 +37,13 @@ def uv_sphere(n_theta, n_phi, radii=(1.0, 1.0, 1.0)):
     return np.array(verts) * np.array(radii), np.array(tris)
 
 
-def step(n, dt, errscale=1e-4, extra=None):
+def step(n, dt, errscale=1e-4, extra=None, slow=1.0, residual=1e-2):
     """One fake step record with every key the reports read."""
     t = n * dt
     s = {"step": n, "t": t,
-         "seconds": {"update": 0.01 + 1e-4 * n, "solve": 0.002, "evaluate": 1e-4, "total": 0.0125},
-         "solver": {"iterations": 1, "residuals": [10.0 ** -(k + 2) for k in range(3)], "status": "converged"},
+         "seconds": {"update": slow * (0.01 + 1e-4 * n), "solve": 0.002, "evaluate": 1e-4,
+                     "total": slow * 0.0101 + 0.0021},
+         "solver": {"iterations": 1, "residuals": [residual * 0.1 ** k for k in range(3)], "status": "converged"},
          "area": 4 * math.pi * (1 - 4 * t), "step_difference": 0.05 / n,
          "radial_error": {"rms": errscale * n, "max": 3 * errscale * n,
                           "rms_continuous": errscale * n * 2, "max_continuous": errscale * n * 5}}
@@ -103,7 +104,7 @@ def main(root):
                                            ("cgal:bunny00", "tracked", 0.02)]):
         write(os.path.join(root, s), "cell_%03d" % i,
               result(s, i, {"mesh": mesh, "octree.tracking": mode}, config(mesh=mesh, octree__tracking=mode),
-                     [step(n, 1e-3) for n in range(1, 4)]))
+                     [step(n, 1e-3, slow=upd / 0.01) for n in range(1, 4)]))
     # sphere_error: three variants, one with frames.
     s = "sphere_error"
     for i, (basis, mode) in enumerate([("octree", "tracked"), ("octree", "rebuilt"), ("hat", "tracked")]):
@@ -128,7 +129,8 @@ def main(root):
             write(os.path.join(root, s), "cell_%03d" % i,
                   result(s, i, {"octree.depth": depth, "solver.cycles": cyc},
                          config(octree__depth=depth, solver__cycles=cyc),
-                         [step(n, 1e-3, 1e-3 / (depth * cyc)) for n in range(1, 6)]))
+                         [step(n, 1e-3, 1e-3 / (depth * cyc), residual=0.1 ** (cyc + depth - 3))
+                          for n in range(1, 6)]))
             i += 1
     # cubature: three rules.
     s = "cubature"
