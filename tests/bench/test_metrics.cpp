@@ -15,11 +15,13 @@ namespace mcf {
 namespace {
 
 /// Unit square [x0, x0+w] × [0, 1] at height z, split into 2·n·n triangles (normal +z).
-TriangleMesh make_patch(int n, double x0 = 0, double w = 1, double z = 0) {
+/// warp > 1 crowds the columns towards x0 (x = x0 + w (i/n)^warp): triangles of very unequal area.
+TriangleMesh make_patch(int n, double x0 = 0, double w = 1, double z = 0, double warp = 1) {
   TriangleMesh m;
   m.vertices.resize((n + 1) * (n + 1), 3);
   for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) m.vertices.row(j * (n + 1) + i) << x0 + w * i / n, double(j) / n, z;
+    for (int i = 0; i <= n; ++i)
+      m.vertices.row(j * (n + 1) + i) << x0 + w * std::pow(double(i) / n, warp), double(j) / n, z;
   m.faces.resize(2 * n * n, 3);
   int f = 0;
   for (int j = 0; j < n; ++j)
@@ -80,6 +82,15 @@ TEST(MeshDistance, SubPatchIsOneSided) {
   EXPECT_NEAR(d.rms_forward, std::sqrt(1.0 / 24), 0.01 * std::sqrt(1.0 / 24));
   EXPECT_DOUBLE_EQ(d.max, d.max_forward);
   EXPECT_NEAR(d.rms, std::sqrt(1.0 / 48), 0.01 * std::sqrt(1.0 / 48));
+}
+
+TEST(MeshDistance, SamplingIsUniformByAreaNotByTriangle) {
+  // Same case as SubPatchIsOneSided, but A's triangles crowd at x = 0 (areas differ 100-fold):
+  // sampling per triangle instead of per area would pull the forward RMS far below √(1/24).
+  const TriangleMesh a = make_patch(20, 0, 1, 0, 3.0), b = make_patch(4, 0, 0.5);
+  const MeshDistance d = mesh_distance(a, b, 200000, 13);
+  EXPECT_NEAR(d.rms_forward, std::sqrt(1.0 / 24), 0.01 * std::sqrt(1.0 / 24));
+  EXPECT_LT(d.rms_backward, 1e-12);
 }
 
 TEST(MeshDistance, InPlaneShiftGivesTheIntegralOfTheOverhang) {
