@@ -20,9 +20,13 @@ def final_error(result):
     return ys[-1] if ys else None
 
 
-def stable(result):
-    """A run is stable when it finished and its error is finite."""
-    return result.get("status") == "ok" and common.finite(final_error(result))
+def stable(result, threshold=None):
+    """A run is stable when it finished with a finite error (below the reference file's
+    "stability_threshold" when it gives one, the SGI note's definition)."""
+    e = final_error(result)
+    if result.get("status") != "ok" or not common.finite(e):
+        return False
+    return not common.finite(threshold) or e < threshold
 
 
 def variant(result):
@@ -50,19 +54,20 @@ def make(results, out_dir, reference, written):
     groups = common.group_by(cells, variant)
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     rows, values = [], []
-    expected = (reference or {}).get("orders", {}) if isinstance(reference, dict) else {}
+    reference = reference if isinstance(reference, dict) else {}
+    expected = reference.get("orders", {})
+    threshold = reference.get("stability_threshold")
     for i, (name, rs) in enumerate(groups.items()):
-        pts = sorted((common.get(r, "config.dt"), final_error(r)) for r in rs
-                     if stable(r) and common.finite(common.get(r, "config.dt")))
+        with_dt = [r for r in rs if common.finite(common.get(r, "config.dt"))]
+        pts = sorted((common.get(r, "config.dt"), final_error(r)) for r in with_dt if stable(r, threshold))
         slope = fit_slope(pts)
         color = "C%d" % (i % 10)
         if pts:
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=color, ms=4,
                     label="%s (slope %s)" % (name, common.fmt(slope, "%.2f")))
             values += [p[1] for p in pts]
-        dts = [common.get(r, "config.dt") for r in rs if common.finite(common.get(r, "config.dt"))]
-        stable_dts = [common.get(r, "config.dt") for r in rs if stable(r)]
-        unstable = [dt for dt, r in zip(dts, rs) if not stable(r)]
+        stable_dts = [common.get(r, "config.dt") for r in with_dt if stable(r, threshold)]
+        unstable = [common.get(r, "config.dt") for r in with_dt if not stable(r, threshold)]
         rows.append([name, common.fmt(slope, "%.2f"), len(pts), common.fmt(max(stable_dts) if stable_dts else None),
                      common.fmt(min(unstable) if unstable else None),
                      str(expected.get(name, expected.get(name.split(" ")[0], "—")))])

@@ -162,6 +162,13 @@ def main(root):
             i += 1
     # A study with one cell and no steps at all.
     write(os.path.join(root, "single"), "only", result("cubature", 0, {"octree.cubature": 3}, config(), []))
+    # Files a results folder may also hold: the runner's index, a truncated file, a non-result.
+    with open(os.path.join(root, "time_order", "index.json"), "w") as f:
+        json.dump({"cells": []}, f)
+    with open(os.path.join(root, "time_order", "broken.json"), "w") as f:
+        f.write('{"config": {')
+    with open(os.path.join(root, "cubature", "notes.json"), "w") as f:
+        json.dump([1, 2, 3], f)
     # Paper references.
     refs = os.path.join(root, "references")
     os.makedirs(refs, exist_ok=True)

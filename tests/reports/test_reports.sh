@@ -35,5 +35,13 @@ for f in "$work"/out/*.png "$work"/out/*.md; do
   b=$(basename "$f"); [ "$b" = index.md ] && continue
   grep -q "$b" "$work/out/index.md" || { echo "FAIL: index.md does not link $b"; fail=1; }
 done
+# Partial data: each study with a single cell (and frames dropped) must still report cleanly.
+solo=""
+for s in $studies; do
+  mkdir -p "$work/solo/$s"; cp "$work/results/$s/cell_000.json" "$work/solo/$s/"; solo="$solo $work/solo/$s"
+done
+"$py" "$root/reports/make_report.py" $solo "$work/solo_out" >"$work/solo_log" 2>&1 \
+  || { cat "$work/solo_log"; echo "FAIL: make_report.py on one-cell studies"; fail=1; }
+[ -s "$work/solo_out/index.md" ] || { echo "FAIL: no index for one-cell studies"; fail=1; }
 [ $fail = 0 ] && echo "reports test passed: $(ls "$work"/out/*.png | wc -l) figures, $(ls "$work"/out/*.md | wc -l) Markdown files"
 exit $fail
