@@ -67,6 +67,15 @@ def main(argv):
         print("%s: %d result file(s)%s" % (study, len(results), "" if reference is None else ", paper reference found"))
         if study in STUDIES:
             ok &= run_module(study, results, out_dir, reference, written)
+        elif any(common.series(r, "radial_error.rms")[0] for r in results):
+            # Plain `mcfbench flow` runs or a new study: at least show the radial errors.
+            import sphere_error
+            try:
+                sphere_error.plot_radial_errors(results, out_dir, "%s_radial_error" % study,
+                                                "%s: radial error per step" % study, reference, written)
+            except Exception:  # noqa: BLE001
+                common.warn("radial error plot for %s failed:\n%s" % (study, traceback.format_exc()))
+                ok = False
         else:
             common.warn("no report module for study %r; frames only" % study)
         ok &= run_module("frames", results, out_dir, reference, written)
