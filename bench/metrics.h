@@ -23,6 +23,8 @@ MeshDistance mesh_distance(const TriangleMesh& a, const TriangleMesh& b, long lo
 
 /// Area-weighted (initial areas) mean over triangles of σ_max/σ_min of the affine map from the
 /// initial triangle to the current one (1 for a conformal map; cMCF paper, DESIGN.md).
+/// Triangles degenerate initially or now (σ_min = 0: infinite ratio) are left out of the mean
+/// and of the weights; NaN when no triangle is left. Throws if the vertex counts differ.
 double quasi_conformal_error(const TriangleMesh& initial, const Positions& current);
 
 /// Area-weighted standard deviation of the vertex distances to the area-weighted centre,

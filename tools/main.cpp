@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   std::function<int()> run;
   mcf::add_flow_command(app, run);
   mcf::add_mesh_info_command(app, run);
+  mcf::add_distance_command(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,75 @@
+#!/usr/bin/python3
+"""Kazhdan, Solomon & Ben-Chen 2012, Fig. 7: convergence (‖ΔX‖ per step), quasi-conformal error
+and sphericity per step, MCF vs heat vs cMCF per model; singular stops marked with an x."""
+
+import matplotlib.pyplot as plt
+
+import common
+
+PANELS = (("step_difference", "‖X$_{n+1}$ − X$_n$‖", True),
+          ("metrics.quasi_conformal", "quasi-conformal error", False),
+          ("metrics.sphericity", "sphericity (σ/μ of radius)", True))
+FLOW_COLORS = {"mcf": "C3", "heat": "C2", "cmcf": "C0"}
+
+
+def model_of(r):
+    return common.short_value(common.get(r, "config.mesh", r["_stem"]))
+
+
+def plot_model(model, cells, out_dir, reference, written, index):
+    """One figure per model: three panels, one curve per flow (and other varying keys)."""
+    keys = [k for k in common.varying_keys(cells) if k != "mesh"]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    for i, r in enumerate(cells):
+        flow = common.get(r, "config.flow", "")
+        color = FLOW_COLORS.get(flow, "C%d" % (i % 10)) if len(cells) <= 3 else "C%d" % (i % 10)
+        for ax, (path, ylabel, logy) in zip(axes, PANELS):
+            xs, ys = common.series(r, path)
+            if xs:
+                ax.plot(xs, ys, "-", color=color, lw=1.3, label=common.label(r, keys or ["flow"]))
+                common.mark_stop(ax, r, xs, ys, color)
+    for ax, (path, ylabel, logy) in zip(axes, PANELS):
+        common.plot_reference_curves(ax, reference, path.split(".")[-1])
+        ax.set_xlabel("step")
+        ax.set_ylabel(ylabel)
+        if logy:
+            vals = [y for r in cells for y in common.series(r, path)[1]]
+            common.log_if_positive(ax, vals)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend()
+        else:
+            ax.text(0.5, 0.5, "not recorded", transform=ax.transAxes, ha="center", color="0.5")
+    title = "%s: MCF vs heat vs cMCF (SGP 2012 Fig. 7)" % model
+    fig.suptitle(title)
+    fig.text(0.01, -0.03, common.sources_line(cells), fontsize=6, wrap=True)
+    common.save_figure(fig, out_dir, "cmcf_%02d" % index, cells, title, written)
+
+
+def last(r, path):
+    xs, ys = common.series(r, path)
+    return ys[-1] if ys else None
+
+
+def summary(cells, out_dir, reference, written):
+    """Markdown table: how each run ended and its last recorded metrics."""
+    rows = []
+    for r in cells:
+        rows.append([model_of(r), common.get(r, "config.flow", "?"), common.fmt(common.get(r, "config.dt")),
+                     r.get("status", "?"), common.get(r, "stop.step", len(r.get("steps", []))),
+                     common.get(r, "stop.reason", ""), common.fmt(last(r, "step_difference")),
+                     common.fmt(last(r, "metrics.quasi_conformal"), "%.4f"),
+                     common.fmt(last(r, "metrics.sphericity"))])
+    text = "## cMCF study: how each run ended\n\n" + common.markdown_table(
+        ["model", "flow", "dt", "status", "stop step", "reason", "last ‖ΔX‖", "last QC error", "last sphericity"], rows)
+    paper = (reference or {}).get("notes") or (reference or {}).get("values")
+    if paper:
+        text += "\n\nPaper: %s\n" % paper
+    common.save_markdown(text, out_dir, "cmcf_summary", cells, "cMCF study summary", written)
+
+
+def make(results, out_dir, reference, written):
+    """Write cmcf_NN.png per model and cmcf_summary.md."""
+    cells = common.first_repetition(results)
+    for i, (model, rs) in enumerate(common.group_by(cells, model_of).items()):
+        plot_model(model, rs, out_dir, reference, written, i)
+    summary(cells, out_dir, reference, written)

@@ -1,0 +1,260 @@
+#!/usr/bin/python3
+"""Shared helpers for the report scripts: loading result files, labelling variants,
+reference values, figure style and provenance sidecars.
+
+Reports read result JSON only (DESIGN.md "Layers"); nothing here runs a flow.
+"""
+
+import glob
+import json
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")  # headless: reports run on build machines without a display
+import matplotlib.pyplot as plt  # noqa: E402
+
+DPI = 120
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_REFERENCES = os.path.join(REPO_ROOT, "bench", "configs")
+
+plt.rcParams.update({
+    "figure.dpi": DPI,
+    "savefig.dpi": DPI,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "legend.fontsize": 8,
+    "legend.frameon": False,
+    "font.size": 9,
+})
+
+
+def warn(msg):
+    """Print a warning to stderr (reports keep going on partial data)."""
+    print("warning: " + msg, file=sys.stderr)
+
+
+def get(d, dotted, default=None):
+    """d["a"]["b"] for dotted "a.b"; also accepts a literal dotted key; default when missing."""
+    if not isinstance(d, dict):
+        return default
+    if dotted in d:
+        return d[dotted]
+    node = d
+    for part in dotted.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return default
+        node = node[part]
+    return node
+
+
+def finite(x):
+    """True for a real finite number (JSON null, NaN, inf and strings are not)."""
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def load_results(folder):
+    """All result files of a results folder: `*.json` except index.json, or, when there are
+    none, `**/result.json` (a folder of `mcfbench flow` outputs). Each dict gets `_path`
+    (absolute file) and `_stem` (file stem, names its frames folder). Unreadable files and
+    files without "config" are skipped with a warning."""
+    paths = sorted(p for p in glob.glob(os.path.join(folder, "*.json"))
+                   if os.path.basename(p) != "index.json")
+    if not paths:
+        paths = sorted(glob.glob(os.path.join(folder, "**", "result.json"), recursive=True))
+    results = []
+    for p in paths:
+        try:
+            with open(p) as f:
+                r = json.load(f)
+        except (OSError, ValueError) as e:
+            warn("skipping %s: %s" % (p, e))
+            continue
+        if not isinstance(r, dict) or "config" not in r:
+            warn("skipping %s: not a result file (no \"config\")" % p)
+            continue
+        r["_path"] = os.path.abspath(p)
+        stem = os.path.splitext(os.path.basename(p))[0]
+        if stem == "result":  # mcfbench flow output: the folder names the run
+            stem = os.path.basename(os.path.dirname(p))
+        r["_stem"] = stem
+        r["_folder"] = os.path.abspath(folder)
+        r.setdefault("steps", [])
+        results.append(r)
+    return results
+
+
+def study_of(result):
+    """The study a result belongs to: cell.study, else "flow" (a plain `mcfbench flow` run)."""
+    return get(result, "cell.study") or "flow"
+
+
+def assignment(result):
+    """The cell's {dotted key: value} assignment; built from the config when missing."""
+    a = get(result, "cell.assignment")
+    if isinstance(a, dict) and a:
+        return a
+    cfg = result.get("config", {})
+    keys = ["mesh", "flow", "basis", "octree.tracking", "octree.depth", "octree.cubature",
+            "octree.refine_input", "solver.name", "solver.cycles", "integrator", "extrapolate", "dt"]
+    return {k: get(cfg, k) for k in keys if get(cfg, k) is not None}
+
+
+def short_value(v):
+    """Compact text for a config value (mesh paths lose their folders)."""
+    if isinstance(v, float):
+        return "%g" % v
+    if isinstance(v, str) and "/" in v:
+        return os.path.basename(v)
+    return str(v)
+
+
+def varying_keys(results, exclude=()):
+    """Assignment keys whose values differ between results (sorted), minus `exclude`."""
+    values = {}
+    for r in results:
+        for k, v in assignment(r).items():
+            values.setdefault(k, set()).add(json.dumps(v, sort_keys=True))
+    keys = [k for k, vs in values.items() if len(vs) > 1 or any(k not in assignment(r) for r in results)]
+    return sorted(k for k in keys if k not in exclude)
+
+
+def label(result, keys):
+    """Legend label: the values of `keys` in the result's assignment, "key=value" joined."""
+    a = assignment(result)
+    parts = ["%s=%s" % (k.split(".")[-1], short_value(a[k])) for k in keys if k in a]
+    return ", ".join(parts) if parts else short_value(get(result, "config.mesh", result["_stem"]))
+
+
+def group_by(results, keyfunc):
+    """Ordered {key: [results]} (first-seen order, repetitions stay together)."""
+    groups = {}
+    for r in results:
+        groups.setdefault(keyfunc(r), []).append(r)
+    return groups
+
+
+def first_repetition(results):
+    """One result per cell key (lowest repetition): curves are drawn once per variant."""
+    best = {}
+    for r in results:
+        key = get(r, "cell.key") or r["_stem"]
+        rep = get(r, "cell.repetition", 0) or 0
+        if key not in best or rep < (get(best[key], "cell.repetition", 0) or 0):
+            best[key] = r
+    return sorted(best.values(), key=lambda r: (get(r, "cell.index", 0) or 0, r["_stem"]))
+
+
+def series(result, path):
+    """(steps, values) of steps[*].<path> where the value is finite."""
+    xs, ys = [], []
+    for i, s in enumerate(result.get("steps", []) or []):
+        v = get(s, path)
+        if finite(v):
+            xs.append(s.get("step", i + 1))
+            ys.append(v)
+    return xs, ys
+
+
+def is_singular(result):
+    """Whether the run stopped at a singularity (or diverged/failed) rather than finishing."""
+    return result.get("status") not in (None, "ok")
+
+
+def load_reference(study, references_dir):
+    """bench/configs/<study>.reference.json as a dict, or None when absent or unreadable."""
+    if not references_dir:
+        return None
+    p = os.path.join(references_dir, study + ".reference.json")
+    if not os.path.exists(p):
+        return None
+    try:
+        with open(p) as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        warn("ignoring %s: %s" % (p, e))
+        return None
+
+
+def reference_curves(reference):
+    """Paper curves from a reference file: {"curves": {label: {"step": [...], <metric>: [...]}}}."""
+    curves = (reference or {}).get("curves", {})
+    return curves if isinstance(curves, dict) else {}
+
+
+def plot_reference_curves(ax, reference, metric, xkey="step"):
+    """Draw the paper's digitised curves for `metric` (grey, dotted) when the reference has them."""
+    for name, c in reference_curves(reference).items():
+        if isinstance(c, dict) and xkey in c and metric in c:
+            ax.plot(c[xkey], c[metric], ":", color="0.5", lw=1.2, label="paper: " + str(name))
+
+
+def log_if_positive(ax, values, axis="y"):
+    """Log scale (as the papers use) only when every plotted value is positive."""
+    vals = [v for v in values if finite(v)]
+    if vals and min(vals) > 0:
+        (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
+
+
+def sources_line(results):
+    """Caption text naming the result files a figure/table came from."""
+    return "Sources: " + ", ".join(os.path.basename(r["_path"]) for r in results)
+
+
+def write_sources(out_path, results):
+    """Write OUT.sources.txt beside a figure/table: one result file path per line."""
+    side = os.path.splitext(out_path)[0] + ".sources.txt"
+    with open(side, "w") as f:
+        for r in results:
+            f.write(r["_path"] + "\n")
+    return side
+
+
+def save_figure(fig, out_dir, name, results, title, written):
+    """Save a figure as OUT_DIR/NAME.png with its sources sidecar; record it in `written`."""
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, name + ".png")
+    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    plt.close(fig)
+    write_sources(path, results)
+    print("wrote " + path)
+    written.append({"path": path, "title": title, "kind": "figure"})
+    return path
+
+
+def save_markdown(text, out_dir, name, results, title, written):
+    """Save OUT_DIR/NAME.md (with a sources caption line and sidecar); record it in `written`."""
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, name + ".md")
+    with open(path, "w") as f:
+        f.write(text.rstrip() + "\n\n" + sources_line(results) + "\n")
+    write_sources(path, results)
+    print("wrote " + path)
+    written.append({"path": path, "title": title, "kind": "table"})
+    return path
+
+
+def markdown_table(header, rows):
+    """A Markdown table from a header list and rows of already formatted cells."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for row in rows:
+        lines.append("| " + " | ".join(str(c) for c in row) + " |")
+    return "\n".join(lines)
+
+
+def fmt(x, spec="%.3g"):
+    """Format a number; '—' for missing/non-finite."""
+    return spec % x if finite(x) else "—"
+
+
+def mark_stop(ax, result, xs, ys, color):
+    """Mark a singular/diverged stop with an x at the last recorded point."""
+    if is_singular(result) and xs:
+        ax.plot([xs[-1]], [ys[-1]], "x", color=color, ms=8, mew=2)
+        reason = get(result, "stop.reason", result.get("status"))
+        ax.annotate(str(reason)[:24], (xs[-1], ys[-1]), fontsize=6, color=color,
+                    xytext=(3, 3), textcoords="offset points")

@@ -1,0 +1,97 @@
+#!/usr/bin/python3
+"""Table 1 of Chuang & Kazhdan 2011: per model and depth, input vertices, split triangles,
+dimension, set-up time, per-step system update + solve for tracked and rebuilt octrees, and the
+tracked-vs-rebuilt speed-up, with the paper's row beside ours when the reference file has one.
+
+Reference format (bench/configs/table1.reference.json), read if present:
+  {"rows": [{"model": "Bimba", "mesh": "<our stand-in spec, optional>", "depth": 8,
+             "input_vertices": 3.0e5, "split_triangles": 2.7e6, "dimension": 3.4e5,
+             "setup_seconds": 4, "system_seconds": 3, "update_seconds": 0.9, "solve_seconds": 0.14}]}
+"""
+
+import statistics
+
+import common
+
+
+def mean_step(result, phase):
+    """Mean per-step seconds of one phase (update / solve / evaluate / total)."""
+    xs, ys = common.series(result, "seconds." + phase)
+    return statistics.mean(ys) if ys else None
+
+
+def median_over(results, fn):
+    """Median over repetitions of fn(result), ignoring missing values."""
+    vals = [v for v in (fn(r) for r in results) if common.finite(v)]
+    return statistics.median(vals) if vals else None
+
+
+def setup_seconds(result):
+    """system.setup_seconds.total, else the sum of its phases: the paper's "set-up time"."""
+    s = common.get(result, "system.setup_seconds")
+    if isinstance(s, dict):
+        if common.finite(s.get("total")):
+            return s["total"]
+        vals = [v for v in s.values() if common.finite(v)]
+        return sum(vals) if vals else None
+    return s if common.finite(s) else None
+
+
+def tracking(r):
+    return common.get(r, "config.octree.tracking") or common.get(r, "config.basis", "?")
+
+
+def model_key(r):
+    return (common.get(r, "config.mesh", r["_stem"]), common.get(r, "config.octree.depth"))
+
+
+def find_paper_row(reference, mesh, depth):
+    """The reference row for our mesh spec (its "mesh" field), or None."""
+    for row in (reference or {}).get("rows", []) if isinstance(reference, dict) else []:
+        if isinstance(row, dict) and row.get("mesh") == mesh and row.get("depth", depth) == depth:
+            return row
+    return None
+
+
+def paper_table(reference):
+    """The paper's own Table 1 from the reference file, as Markdown."""
+    rows = []
+    for row in reference.get("rows", []):
+        rows.append([row.get("model", "?"), row.get("depth", "—"), common.fmt(row.get("input_vertices")),
+                     common.fmt(row.get("split_triangles")), common.fmt(row.get("dimension")),
+                     "%s (+%s)" % (common.fmt(row.get("setup_seconds")), common.fmt(row.get("system_seconds"))),
+                     "%s + %s" % (common.fmt(row.get("update_seconds")), common.fmt(row.get("solve_seconds")))])
+    return common.markdown_table(["model", "depth", "input vertices", "split triangles", "dimension",
+                                  "set-up (+system) s", "update + solve s"], rows)
+
+
+def make(results, out_dir, reference, written):
+    """Write table1.md."""
+    rows = []
+    for (mesh, depth), rs in common.group_by(results, model_key).items():
+        by_mode = common.group_by(rs, tracking)
+        tr, rb = by_mode.get("tracked", []), by_mode.get("rebuilt", [])
+        base = tr or rb or rs
+        upd_t, sol_t = median_over(tr, lambda r: mean_step(r, "update")), median_over(tr, lambda r: mean_step(r, "solve"))
+        upd_r, sol_r = median_over(rb, lambda r: mean_step(r, "update")), median_over(rb, lambda r: mean_step(r, "solve"))
+        tot_t, tot_r = median_over(tr, lambda r: mean_step(r, "total")), median_over(rb, lambda r: mean_step(r, "total"))
+        speedup = tot_r / tot_t if common.finite(tot_t) and common.finite(tot_r) and tot_t > 0 else None
+        paper = find_paper_row(reference, mesh, depth)
+        paper_cell = ("%s + %s" % (common.fmt(paper.get("update_seconds")), common.fmt(paper.get("solve_seconds")))
+                      if paper else "—")
+        rows.append([common.short_value(mesh), common.fmt(depth, "%d"),
+                     common.fmt(median_over(base, lambda r: common.get(r, "mesh.vertices")), "%.3g"),
+                     common.fmt(median_over(base, lambda r: common.get(r, "system.split_triangles")), "%.3g"),
+                     common.fmt(median_over(base, lambda r: common.get(r, "system.dimension")), "%.3g"),
+                     common.fmt(median_over(base, setup_seconds)),
+                     "%s + %s" % (common.fmt(upd_t), common.fmt(sol_t)),
+                     "%s + %s" % (common.fmt(upd_r), common.fmt(sol_r)),
+                     common.fmt(speedup, "%.1f×"), paper_cell])
+    header = ["model", "depth", "input vertices", "split triangles", "dimension", "set-up s",
+              "tracked update + solve s/step", "rebuilt update + solve s/step", "speed-up (total/step)",
+              "paper update + solve"]
+    text = "## Table 1: performance (Chuang & Kazhdan 2011)\n\n" + common.markdown_table(header, rows)
+    text += "\n\nTimes are medians over repetitions of the mean per-step seconds."
+    if isinstance(reference, dict) and reference.get("rows"):
+        text += "\n\n### Paper (Table 1)\n\n" + paper_table(reference)
+    common.save_markdown(text, out_dir, "table1", results, "Table 1: performance", written)

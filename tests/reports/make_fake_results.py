@@ -1,0 +1,189 @@
+#!/usr/bin/python3
+"""Fabricate small results folders, one per study (2–3 result files each, plus frames, a
+singular stop, a one-cell study and paper reference files), for the reports test.
+
+usage: make_fake_results.py OUT_ROOT   ->  OUT_ROOT/<study>/*.json, OUT_ROOT/references/*.json
+"""
+
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "reports"))
+import plyio  # noqa: E402
+
+
+def uv_sphere(n_theta, n_phi, radii=(1.0, 1.0, 1.0)):
+    """A closed UV sphere (poles included) scaled per axis."""
+    verts = [(0, 0, 1)]
+    for i in range(1, n_theta):
+        th = math.pi * i / n_theta
+        for j in range(n_phi):
+            ph = 2 * math.pi * j / n_phi
+            verts.append((math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)))
+    verts.append((0, 0, -1))
+    tris = []
+    ring = lambda i, j: 1 + (i - 1) * n_phi + (j % n_phi)  # noqa: E731
+    for j in range(n_phi):
+        tris.append((0, ring(1, j), ring(1, j + 1)))
+        tris.append((len(verts) - 1, ring(n_theta - 1, j + 1), ring(n_theta - 1, j)))
+    for i in range(1, n_theta - 1):
+        for j in range(n_phi):
+            a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)
+            tris += [(a, c, b), (b, c, d)]
+    return np.array(verts) * np.array(radii), np.array(tris)
+
+
+def step(n, dt, errscale=1e-4, extra=None, slow=1.0, residual=1e-2):
+    """One fake step record with every key the reports read."""
+    t = n * dt
+    s = {"step": n, "t": t,
+         "seconds": {"update": slow * (0.01 + 1e-4 * n), "solve": 0.002, "evaluate": 1e-4,
+                     "total": slow * 0.0101 + 0.0021},
+         "solver": {"iterations": 1, "residuals": [residual * 0.1 ** k for k in range(3)], "status": "converged"},
+         "area": 4 * math.pi * (1 - 4 * t), "step_difference": 0.05 / n,
+         "radial_error": {"rms": errscale * n, "max": 3 * errscale * n,
+                          "rms_continuous": errscale * n * 2, "max_continuous": errscale * n * 5}}
+    if extra:
+        s.update(extra(n))
+    return s
+
+
+def result(study, index, assignment, config, steps, status="ok", reason="completed", **more):
+    r = {"schema": 1, "status": status, "stop": {"step": len(steps), "reason": reason},
+         "config": config, "steps": steps,
+         "environment": {"commit": "fake", "cpu": "fake", "cores": 2, "threads": 2, "libraries": {}},
+         "mesh": {"spec": config.get("mesh"), "vertices": 642, "faces": 1280, "boundary_loops": 0, "genus": 0},
+         "system": {"dimension": 5000 + 100 * index, "split_triangles": 20000, "cubature_points": 60000,
+                    "levels": 5, "setup_seconds": {"octree": 0.3, "clip": 0.2, "total": 0.5}},
+         "cell": {"index": index, "key": "%s-%d" % (study, index), "assignment": assignment,
+                  "repetition": 0, "study": study},
+         "study_config": {"name": study}}
+    r.update(more)
+    return r
+
+
+def config(**kw):
+    c = {"mesh": "icosphere:level=3", "flow": "mcf", "basis": "octree", "dt": 1e-3, "steps": 10,
+         "integrator": "semi-implicit", "extrapolate": True,
+         "octree": {"tracking": "tracked", "depth": 6, "cubature": 3},
+         "solver": {"name": "multigrid", "cycle": "W", "cycles": 1}}
+    for k, v in kw.items():
+        node = c
+        *path, last = k.split("__")
+        for p in path:
+            node = node.setdefault(p, {})
+        node[last] = v
+    return c
+
+
+def write(folder, name, r):
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, name + ".json"), "w") as f:
+        json.dump(r, f, indent=1)
+
+
+def frames(folder, stem, count, n_theta=12, n_phi=24, stretch=1.6):
+    """Frames of an ellipsoid relaxing to a sphere, binary and ASCII PLY alternately."""
+    d = os.path.join(folder, "frames", stem)
+    os.makedirs(d, exist_ok=True)
+    for k in range(count):
+        a = 1 + (stretch - 1) * (1 - k / max(1, count - 1))
+        v, f = uv_sphere(n_theta, n_phi, (a, 1, 0.8))
+        plyio.write_ply(os.path.join(d, "frame_%05d.ply" % (5 * k)), v * (1 - 0.05 * k), f, binary=(k % 2 == 0))
+
+
+def main(root):
+    # table1: one model, tracked + rebuilt; a second model with tracked only (missing variant).
+    s = "table1"
+    for i, (mesh, mode, upd) in enumerate([("sphere:vertices=40000", "tracked", 0.01),
+                                           ("sphere:vertices=40000", "rebuilt", 0.2),
+                                           ("cgal:bunny00", "tracked", 0.02)]):
+        write(os.path.join(root, s), "cell_%03d" % i,
+              result(s, i, {"mesh": mesh, "octree.tracking": mode}, config(mesh=mesh, octree__tracking=mode),
+                     [step(n, 1e-3, slow=upd / 0.01) for n in range(1, 4)]))
+    # sphere_error: three variants, one with frames.
+    s = "sphere_error"
+    for i, (basis, mode) in enumerate([("octree", "tracked"), ("octree", "rebuilt"), ("hat", "tracked")]):
+        write(os.path.join(root, s), "cell_%03d" % i,
+              result(s, i, {"basis": basis, "octree.tracking": mode}, config(basis=basis, octree__tracking=mode),
+                     [step(n, 1e-3, 1e-4 * (i + 1)) for n in range(1, 21)]))
+    frames(os.path.join(root, s), "cell_000", 4)
+    # model_error: reference distances, one cell without them.
+    s = "model_error"
+    for i, mode in enumerate(["tracked", "rebuilt"]):
+        write(os.path.join(root, s), "cell_%03d" % i,
+              result(s, i, {"octree.tracking": mode}, config(mesh="cgal:bunny00", octree__tracking=mode),
+                     [step(n, 1e-5) for n in range(1, 11)],
+                     reference_distance=[{"step": n, "rms": 1e-4 * n * (i + 1), "max": 1e-3 * n * (i + 1)}
+                                         for n in (1, 5, 10)]))
+    write(os.path.join(root, s), "cell_002", result(s, 2, {"octree.tracking": "x"}, config(), []))
+    # depth_cycles: depths × cycles on a sphere.
+    s = "depth_cycles"
+    i = 0
+    for depth in (5, 6):
+        for cyc in (1, 2):
+            write(os.path.join(root, s), "cell_%03d" % i,
+                  result(s, i, {"octree.depth": depth, "solver.cycles": cyc},
+                         config(octree__depth=depth, solver__cycles=cyc),
+                         [step(n, 1e-3, 1e-3 / (depth * cyc), residual=0.1 ** (cyc + depth - 3))
+                          for n in range(1, 6)]))
+            i += 1
+    # cubature: three rules.
+    s = "cubature"
+    for i, rule in enumerate([1, 3, 6]):
+        write(os.path.join(root, s), "cell_%03d" % i,
+              result(s, i, {"octree.cubature": rule}, config(octree__cubature=rule),
+                     [step(n, 1e-3, 1e-4 * (3 if rule == 1 else 1)) for n in range(1, 11)]))
+    # cmcf: mcf stops singular, heat and cmcf converge; frames for cmcf.
+    s = "cmcf"
+    metrics = lambda n: {"metrics": {"quasi_conformal": 1 + 0.5 / n, "sphericity": 0.2 / n}}  # noqa: E731
+    for i, (flow, status, steps) in enumerate([("mcf", "singular", 6), ("heat", "ok", 12), ("cmcf", "ok", 12)]):
+        write(os.path.join(root, s), "cell_%03d" % i,
+              result(s, i, {"flow": flow}, config(mesh="dumbbell", flow=flow),
+                     [step(n, 1e-3, extra=metrics) for n in range(1, steps + 1)], status=status,
+                     reason="pinched" if status != "ok" else "completed"))
+    frames(os.path.join(root, s), "cell_002", 8, 60, 120)  # 14k faces × ... decimation exercised below
+    frames(os.path.join(root, s), "cell_001", 3, 110, 220)  # ~48k faces: decimated
+    # time_order: two integrators × dts (error ∝ dt and dt²), one unstable explicit run.
+    s = "time_order"
+    i = 0
+    for integ, order in (("semi-implicit", 1), ("bdf2", 2), ("explicit", 1)):
+        for dt in (1e-3, 5e-4, 2.5e-4):
+            err = 0.3 * dt ** order
+            status = "error" if (integ == "explicit" and dt == 1e-3) else "ok"
+            write(os.path.join(root, s), "cell_%03d" % i,
+                  result(s, i, {"integrator": integ, "dt": dt}, config(integrator=integ, dt=dt),
+                         [step(1, dt, extra=lambda n, e=err: {"radial_error": {"rms_continuous": e}})],
+                         status=status, reason="diverged" if status != "ok" else "completed"))
+            i += 1
+    # A study with one cell and no steps at all.
+    write(os.path.join(root, "single"), "only", result("cubature", 0, {"octree.cubature": 3}, config(), []))
+    # Files a results folder may also hold: the runner's index, a truncated file, a non-result.
+    with open(os.path.join(root, "time_order", "index.json"), "w") as f:
+        json.dump({"cells": []}, f)
+    with open(os.path.join(root, "time_order", "broken.json"), "w") as f:
+        f.write('{"config": {')
+    with open(os.path.join(root, "cubature", "notes.json"), "w") as f:
+        json.dump([1, 2, 3], f)
+    # Paper references.
+    refs = os.path.join(root, "references")
+    os.makedirs(refs, exist_ok=True)
+    with open(os.path.join(refs, "table1.reference.json"), "w") as f:
+        json.dump({"rows": [{"model": "Sphere", "mesh": "sphere:vertices=40000", "depth": 6,
+                             "input_vertices": 3.7e5, "split_triangles": 3.8e6, "dimension": 5.1e5,
+                             "setup_seconds": 6, "system_seconds": 3, "update_seconds": 1.4, "solve_seconds": 0.22}]}, f)
+    with open(os.path.join(refs, "sphere_error.reference.json"), "w") as f:
+        json.dump({"curves": {"tracked MG": {"step": [1, 10, 20], "rms": [1e-4, 1e-3, 2e-3],
+                                             "max": [3e-4, 3e-3, 6e-3]}}}, f)
+    with open(os.path.join(refs, "time_order.reference.json"), "w") as f:
+        json.dump({"orders": {"semi-implicit": 1, "bdf2": 2}}, f)
+    with open(os.path.join(refs, "cmcf.reference.json"), "w") as f:
+        f.write("{ not json")  # a broken reference must be ignored, not fatal
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])

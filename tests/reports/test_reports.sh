@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Reports end to end on fabricated results: every study's figures/tables and the index exist and
+# are non-empty. Skips (exit 0) where Debian's matplotlib is missing for /usr/bin/python3.
+set -u
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+py=/usr/bin/python3
+if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
+  echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 0
+fi
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+"$py" "$here/make_fake_results.py" "$work/results" || { echo "FAIL: fake results generator"; exit 1; }
+studies="table1 sphere_error model_error depth_cycles cubature cmcf time_order"
+dirs=""; for s in $studies single; do dirs="$dirs $work/results/$s"; done
+"$py" "$root/reports/make_report.py" $dirs "$work/out" --references "$work/results/references" >"$work/log" 2>&1
+rc=$?
+cat "$work/log"
+[ $rc = 0 ] || { echo "FAIL: make_report.py exited $rc"; exit 1; }
+fail=0
+expect() { [ -s "$work/out/$1" ] || { echo "FAIL: missing or empty $1"; fail=1; }; }
+for f in table1.md sphere_error.png model_error.png depth_cycles.png cubature.png cmcf_00.png \
+         cmcf_summary.md time_order.png time_order.md index.md frames_sphere_error_00.png \
+         frames_cmcf_00.png frames_cmcf_01.png; do expect "$f"; done
+for f in "$work"/out/*.png "$work"/out/*.md; do
+  case "$f" in */index.md) continue;; esac
+  [ -s "${f%.*}.sources.txt" ] || { echo "FAIL: no sources sidecar for $(basename "$f")"; fail=1; }
+done
+# Contents: paper values beside ours, fitted orders, singular stop recorded, index links all.
+grep -q "Paper (Table 1)" "$work/out/table1.md" || { echo "FAIL: table1 lacks the paper table"; fail=1; }
+grep -q "1.4 + 0.22" "$work/out/table1.md" || { echo "FAIL: table1 lacks the paper row beside ours"; fail=1; }
+grep -qE "\| bdf2 \| 2\.00 \|" "$work/out/time_order.md" || { echo "FAIL: bdf2 order not fitted as 2"; fail=1; }
+grep -qE "\| semi-implicit \| 1\.00 \|" "$work/out/time_order.md" || { echo "FAIL: semi-implicit order not 1"; fail=1; }
+grep -q "singular" "$work/out/cmcf_summary.md" || { echo "FAIL: singular stop not in cmcf summary"; fail=1; }
+for f in "$work"/out/*.png "$work"/out/*.md; do
+  b=$(basename "$f"); [ "$b" = index.md ] && continue
+  grep -q "$b" "$work/out/index.md" || { echo "FAIL: index.md does not link $b"; fail=1; }
+done
+# Partial data: each study with a single cell (and frames dropped) must still report cleanly.
+solo=""
+for s in $studies; do
+  mkdir -p "$work/solo/$s"; cp "$work/results/$s/cell_000.json" "$work/solo/$s/"; solo="$solo $work/solo/$s"
+done
+"$py" "$root/reports/make_report.py" $solo "$work/solo_out" >"$work/solo_log" 2>&1 \
+  || { cat "$work/solo_log"; echo "FAIL: make_report.py on one-cell studies"; fail=1; }
+[ -s "$work/solo_out/index.md" ] || { echo "FAIL: no index for one-cell studies"; fail=1; }
+[ $fail = 0 ] && echo "reports test passed: $(ls "$work"/out/*.png | wc -l) figures, $(ls "$work"/out/*.md | wc -l) Markdown files"
+exit $fail
