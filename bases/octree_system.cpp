@@ -108,12 +108,21 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
   });
 }
 
+namespace {
+// Eigen 3.4's SparseMatrix has no move assignment: fill in place (reusing its storage).
+void set_pattern(SparseMatrix& A, const std::vector<int>& outer, const std::vector<int>& inner) {
+  const auto n = static_cast<Eigen::Index>(outer.size()) - 1, nnz = static_cast<Eigen::Index>(inner.size());
+  A.resize(n, n);
+  A.resizeNonZeros(nnz);
+  std::copy(outer.begin(), outer.end(), A.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), A.innerIndexPtr());
+  std::fill_n(A.valuePtr(), nnz, 0.0);
+}
+}  // namespace
+
 SparseMatrix OctreeSystem::pattern() const {
-  SparseMatrix A(dimension(), dimension());
-  A.resizeNonZeros(non_zeros());
-  std::copy(outer_.begin(), outer_.end(), A.outerIndexPtr());
-  std::copy(inner_.begin(), inner_.end(), A.innerIndexPtr());
-  std::fill_n(A.valuePtr(), non_zeros(), 0.0);
+  SparseMatrix A;
+  set_pattern(A, outer_, inner_);
   return A;
 }
 
@@ -121,8 +130,8 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
   const OctreeLevel& L = octree_->levels[static_cast<std::size_t>(level_)];
   const GridCube& cube = octree_->cube;
   const double h = cube.cell_size(L.depth);
-  mass = pattern();
-  stiffness = pattern();
+  set_pattern(mass, outer_, inner_);
+  set_pattern(stiffness, outer_, inner_);
   double* Mv = mass.valuePtr();
   double* Kv = stiffness.valuePtr();
   const int nq = rule.size();
