@@ -73,7 +73,8 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
   // Pattern: per column J the 27-bit mask of neighbours that share an active cell with J; rows in
   // bit order are in increasing index order (keys are (k,j,i)-lexicographic).
   mask_.assign(nf, 0u);
-  std::vector<int> outer(nf + 1, 0);
+  outer_.assign(nf + 1, 0);
+  std::vector<int>& outer = outer_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t J = r.begin(); J != r.end(); ++J) {
       std::uint32_t m = 0;
@@ -86,12 +87,8 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
     }
   });
   for (std::size_t J = 0; J < nf; ++J) outer[J + 1] += outer[J];
-  const int nnz = outer[nf];
-  pattern_.resize(static_cast<Eigen::Index>(nf), static_cast<Eigen::Index>(nf));
-  pattern_.resizeNonZeros(nnz);
-  std::copy(outer.begin(), outer.end(), pattern_.outerIndexPtr());
-  int* inner = pattern_.innerIndexPtr();
-  double* values = pattern_.valuePtr();
+  inner_.resize(static_cast<std::size_t>(outer[nf]));
+  int* inner = inner_.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t J = r.begin(); J != r.end(); ++J) {
       int row[27];
@@ -105,19 +102,36 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
       for (int o = 0; o < 27; ++o) {
         if (!(mask_[J] & (1u << o))) continue;
         inner[s] = row[o];
-        values[s] = 0.0;
         ++s;
       }
     }
   });
 }
 
+namespace {
+// Eigen 3.4's SparseMatrix has no move assignment: fill in place (reusing its storage).
+void set_pattern(SparseMatrix& A, const std::vector<int>& outer, const std::vector<int>& inner) {
+  const auto n = static_cast<Eigen::Index>(outer.size()) - 1, nnz = static_cast<Eigen::Index>(inner.size());
+  A.resize(n, n);
+  A.resizeNonZeros(nnz);
+  std::copy(outer.begin(), outer.end(), A.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), A.innerIndexPtr());
+  std::fill_n(A.valuePtr(), nnz, 0.0);
+}
+}  // namespace
+
+SparseMatrix OctreeSystem::pattern() const {
+  SparseMatrix A;
+  set_pattern(A, outer_, inner_);
+  return A;
+}
+
 void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, SparseMatrix& stiffness) const {
   const OctreeLevel& L = octree_->levels[static_cast<std::size_t>(level_)];
   const GridCube& cube = octree_->cube;
   const double h = cube.cell_size(L.depth);
-  mass = pattern_;
-  stiffness = pattern_;
+  set_pattern(mass, outer_, inner_);
+  set_pattern(stiffness, outer_, inner_);
   double* Mv = mass.valuePtr();
   double* Kv = stiffness.valuePtr();
   const int nq = rule.size();

@@ -80,14 +80,18 @@ class OctreeSystem {
                const std::vector<int>& piece_finest_cell);
 
   int level() const { return level_; }
-  Eigen::Index dimension() const { return pattern_.rows(); }
-  /// The pattern with zero values (compressed, full symmetric storage).
-  const SparseMatrix& pattern() const { return pattern_; }
+  Eigen::Index dimension() const { return static_cast<Eigen::Index>(outer_.size()) - 1; }
+  Eigen::Index non_zeros() const { return static_cast<Eigen::Index>(inner_.size()); }
+  /// A matrix with this pattern and zero values (compressed, full symmetric storage).
+  SparseMatrix pattern() const;
+  /// Column starts (dimension+1) and row indices of the pattern.
+  const std::vector<int>& outer() const { return outer_; }
+  const std::vector<int>& inner() const { return inner_; }
   int slot(int cell, int corner_row, int corner_col) const {
     const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];
     const int J = f[static_cast<std::size_t>(corner_col)];
     const std::uint32_t below = (1u << neighbour_bit(corner_row, corner_col)) - 1u;
-    return pattern_.outerIndexPtr()[J] + std::popcount(mask_[static_cast<std::size_t>(J)] & below);
+    return outer_[static_cast<std::size_t>(J)] + std::popcount(mask_[static_cast<std::size_t>(J)] & below);
   }
   /// Pieces of cell c: piece_order()[cell_start()[c] .. cell_start()[c+1]).
   const std::vector<int>& cell_start() const { return cell_start_; }
@@ -109,7 +113,7 @@ class OctreeSystem {
   std::vector<int> cell_start_, piece_order_;
   std::vector<std::vector<int>> colour_cells_;
   std::vector<std::uint32_t> mask_;
-  SparseMatrix pattern_;
+  std::vector<int> outer_, inner_;  // the pattern (no values stored: M and K carry their own)
 };
 
 /// Finest-cell index of every piece (binary search, parallel). Throws if a piece's cell is inactive.
