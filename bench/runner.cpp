@@ -84,6 +84,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   json result;
   try {
     const MeshSource& source = meshes.get(config.mesh);
+    if (!frames.empty() || config.save_every > 0) fs::create_directories(frame_dir);  // write_mesh does not
     TriangleMesh initial;  // X_0 as the flow sees it (after area normalisation, if any)
     FlowObserver observer;
     observer.on_step = [&](int step, double, const Positions& V) {
