@@ -277,11 +277,14 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
     if (o.on_cell) o.on_cell(report);
   }
 
-  // Distances to the reference flow once the cells are there. Over all cells with a result in
-  // this folder, not just this shard's, so the last shard to finish (or a rerun) fills in
-  // what other shards could not compute before their reference existed.
+  // Distances to the reference flow once the cells are there. Only this shard's cells: a cell
+  // file then has exactly one writer even when shards run at once on a shared file system.
+  // A cell whose reference belongs to a shard that had not finished gets its distances on
+  // the next run that includes it (e.g. one unsharded `mcfbench run` after a Slurm array:
+  // every cell is skipped, the missing distances are filled in).
   if (with_reference) {
     for (const CellPlan& p : plans) {
+      if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
       const CellPlan* ref = reference_for(e, plans, p);
       if (!ref || !fs::exists(p.file) || !fs::exists(ref->file)) continue;
       json result = read_json_file(p.file);

@@ -31,6 +31,7 @@ struct Group {  // results of one study variant at one commit
   std::string study, commit, source;
   bool quick = false;
   std::map<int, std::vector<std::string>> files_by_index;
+  std::vector<int> without_distance;  ///< candidates; reference cells themselves are filtered below
 };
 
 }  // namespace
@@ -84,6 +85,12 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           g.commit = commit;
           g.quick = entry["quick"];
           g.files_by_index[entry["index"].get<int>()].push_back(path.string());
+          // Cells of a study with a reference flow that still lack their distances (their
+          // reference was not finished when they ran; an unsharded rerun fills them in).
+          if (r.contains("study_config") && r["study_config"].contains("metrics") &&
+              r["study_config"]["metrics"].contains("reference") && !r.contains("reference_distance") &&
+              !r.contains("reference_cell") && r.value("status", "") != "error")
+            g.without_distance.push_back(c.value("index", -1));
         }
       }
       json studies = json::array();
@@ -99,6 +106,18 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           s["cells_expected"] = e.cells.size();
           for (const Cell& c : e.cells)
             if (!g.files_by_index.count(c.index)) missing.push_back(c.index);
+        }
+        if (!g.study_config.is_null() && !g.without_distance.empty()) {
+          const ExperimentConfig e = parse_experiment_config(g.study_config, g.source, g.quick, g.study);
+          json lacking = json::array();
+          for (int index : g.without_distance)
+            if (index >= 0 && index < int(e.cells.size()) && !matches_assignment(e.cells[size_t(index)], e.metrics.reference))
+              lacking.push_back(index);
+          if (!lacking.empty()) {
+            s["without_reference_distance"] = lacking;
+            std::printf("%s: %zu cells lack their reference distance (rerun `mcfbench run` without --shard to add them)\n",
+                        name.c_str(), lacking.size());
+          }
         }
         s["missing"] = missing;
         s["duplicates"] = dup;

@@ -89,6 +89,30 @@ TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
   EXPECT_EQ(other["reference_cell"]["hash"], plans[0].hash);
 }
 
+TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
+  HookGuard guard(fake_hooks());
+  const fs::path out = fresh_dir("sharded_ref");
+  const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
+                  {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
+                  {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  o.shard_count = 2;
+  o.shard_index = 1;  // cell 1 only: its reference (cell 0) is not there yet
+  EXPECT_EQ(run_experiment(e, o).distances, 0);
+  o.shard_index = 0;  // cells 0 and 2: cell 2 gets its distance, cell 1 belongs to shard 1
+  EXPECT_EQ(run_experiment(e, o).distances, 1);
+  o.shard_count = 1;  // unsharded rerun: nothing runs, the missing distance is added
+  const RunSummary s = run_experiment(e, o);
+  EXPECT_EQ(s.ran, 0);
+  EXPECT_EQ(s.distances, 1);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  for (int i : {1, 2}) EXPECT_EQ(read_json(plans[size_t(i)].file)["reference_distance"].size(), 1u) << i;
+  EXPECT_EQ(run_experiment(e, o).distances, 0);  // nothing stale any more
+}
+
 TEST(Runner, ACellErrorIsRecordedAndTheRunGoesOn) {
   MetricHooks h = fake_hooks();
   h.sphericity = [](const Positions& V, const Triangles&) -> double {
