@@ -201,14 +201,14 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, c
     if (c.faster) verdict += "faster ";
     if (c.less_accurate) verdict += "**less accurate** ";
     if (c.has_error && c.error_ratio < 1 / (1 + o.threshold)) verdict += "more accurate ";
-    if (verdict.empty()) continue;
-    ++changed;
+    if (!verdict.empty()) ++changed;
+    if (verdict.empty() && !o.show_all) continue;
     table << "| " << c.label << " | " << fmt(c.old_median) << " | " << fmt(c.new_median) << " | "
           << fmt(c.ratio, "%.3f") << " | " << fmt(c.p_value, "%.2g") << " | "
           << (c.has_error ? fmt(c.old_error) : "–") << " | " << (c.has_error ? fmt(c.new_error) : "–") << " | "
-          << (c.has_error ? fmt(c.error_ratio, "%.3f") : "–") << " | " << verdict << "|\n";
+          << (c.has_error ? fmt(c.error_ratio, "%.3f") : "–") << " | " << (verdict.empty() ? "same " : verdict) << "|\n";
   }
-  if (changed) md << table.str() << "\n";
+  if (changed || (o.show_all && !r.cells.empty())) md << table.str() << "\n";
   md << r.cells.size() << " cells compared, " << changed << " changed, " << (r.cells.size() - size_t(changed))
      << " unchanged.\n";
   if (!r.only_old.empty()) md << r.only_old.size() << " cells only in OLD.\n";

@@ -32,6 +32,7 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
 struct CompareOptions {
   double threshold = 0.1, alpha = 0.05;
   std::string metric = "seconds.total";
+  bool show_all = false;  ///< table lists unchanged cells too
 };
 
 struct CellComparison {

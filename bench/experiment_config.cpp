@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 
 namespace mcf {
@@ -340,6 +341,15 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
     }
   }
   if (e.cells.empty()) fail(source, "exclude", "every cell of the matrix is excluded");
+  // Two cells with the same full config would share one result file (same key): the second
+  // would be "skipped" and `collect` would report it missing. Usually a duplicated axis value.
+  std::map<std::string, const Cell*> seen;
+  for (const Cell& c : e.cells) {
+    auto [it, fresh] = seen.emplace(c.config.dump() + "#" + std::to_string(c.repetition), &c);
+    if (!fresh)
+      fail(source, axes_where, "cells " + it->second->assignment.dump() + " and " + c.assignment.dump() +
+                                   " are the same flow config (duplicate values?)");
+  }
   if (!e.metrics.reference.is_null() &&
       std::none_of(e.cells.begin(), e.cells.end(), [&](const Cell& c) { return matches_assignment(c, e.metrics.reference); }))
     fail(source, "metrics.reference", "matches no cell of the matrix: " + e.metrics.reference.dump());

@@ -28,6 +28,7 @@ void add_compare_command(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--threshold", a->options.threshold, "Relative change that counts (default 0.1 = 10%)")->check(CLI::PositiveNumber);
   cmd->add_option("--alpha", a->options.alpha, "Significance level of the Mann-Whitney U test (default 0.05)")->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--metric", a->options.metric, "Per-step value compared (dotted path in steps[]; default seconds.total; e.g. seconds.solve)");
+  cmd->add_flag("--all", a->options.show_all, "List unchanged cells in the table too");
   cmd->add_option("--history", a->history, "Append one JSON line for NEW to this file (no value: results/history.jsonl)")
       ->expected(0, 1);
   cmd->callback([cmd, a, &run] {

@@ -63,8 +63,10 @@ TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
   Command c = mcfbench("compare old old", dir);
   EXPECT_EQ(c.status, 0) << c.out << c.err;
   EXPECT_NE(c.out.find("3 cells compared, 0 changed"), std::string::npos) << c.out;
-  c = mcfbench("compare old same", dir);
+  c = mcfbench("compare old same --all", dir);
   EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("same |"), std::string::npos) << "unchanged rows are listed with --all: " << c.out;
+  EXPECT_NE(c.out.find("| solver.name=solver2 |"), std::string::npos) << c.out;
   c = mcfbench("compare old slow --history hist/h.jsonl", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(c.out.find("solver.name=solver1"), std::string::npos) << c.out;

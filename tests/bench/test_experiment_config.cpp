@@ -152,6 +152,7 @@ TEST(ExperimentConfig, ErrorsNameTheFileAndTheKeyPath) {
   expect_error({{"defaults", base}, {"axes", {{"solver.cycles", {1, 0}}}}}, "solver.cycles");
   expect_error({{"defaults", base}, {"axes", {{"steps", {"two"}}}}}, "steps");
   expect_error({{"defaults", {{"steps", 2}}}}, "mesh");  // missing mesh
+  expect_error({{"defaults", base}, {"axes", {{"dt", {1e-3, 0.001}}}}}, "axes");  // duplicate cells
 }
 
 TEST(ExperimentConfig, ShardsPartitionTheCells) {
