@@ -26,7 +26,9 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
   cmd->footer(
       "Finished cells are skipped on a rerun (--force redoes them); a killed run leaves no partial file.\n"
       "Slurm: sbatch --array=0-15 --wrap 'mcfbench run cfg.json --shard $SLURM_ARRAY_TASK_ID/16'\n"
-      "then `mcfbench collect results/NAME` checks that every cell is there.\n"
+      "then `mcfbench collect results/NAME` checks that every cell is there (with metrics.reference, first\n"
+      "run `mcfbench run cfg.json` once without --shard: every cell is skipped and the distances to the\n"
+      "reference cells that other shards computed are added).\n"
       "Config format: see bench/experiment_config.h and bench/configs/.");
   cmd->add_option("config", a->config, "Experiment config (JSON)")->required();
   cmd->add_option("--out", a->out, "Results folder (default results/NAME, or results/NAME-quick with --quick)");

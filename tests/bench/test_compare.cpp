@@ -98,7 +98,7 @@ TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
 
 TEST(CompareCli, InjectedSlowdownOnARealRun) {
   const fs::path dir = fresh_dir("compare_real");
-  write_text(dir / "c.json", R"({"name": "c", "defaults": {"mesh": "icosphere:level=2", "steps": 20, "dt": 1e-3, "threads": 1}})");
+  write_text(dir / "c.json", R"({"name": "c", "defaults": {"mesh": "icosphere:level=3", "steps": 30, "dt": 1e-4, "threads": 1}})");
   Command c = mcfbench("run c.json --out old", dir);
   ASSERT_EQ(c.status, 0) << c.err;
   fs::create_directories(dir / "new");
