@@ -3,6 +3,7 @@
 
 #include "bench/experiment_config.h"
 #include "datasets/atomic_file.h"
+#include "flows/config_reader.h"
 #include "tools/commands.h"
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 
 namespace mcf {
@@ -100,18 +102,26 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         json missing = json::array(), dup = json::array();
         for (const auto& [index, list] : g.files_by_index)
           if (list.size() > 1) dup.push_back({{"index", index}, {"files", list}});
+        std::optional<ExperimentConfig> e;
         if (!g.study_config.is_null()) {
-          // Re-expanding the stored matrix tells which cells should be there.
-          const ExperimentConfig e = parse_experiment_config(g.study_config, g.source, g.quick, g.study);
-          s["cells_expected"] = e.cells.size();
-          for (const Cell& c : e.cells)
+          // Re-expanding the stored matrix tells which cells should be there. Results of an older
+          // binary may hold a config this one rejects: say so instead of failing the whole index.
+          try {
+            e = parse_experiment_config(g.study_config, g.source, g.quick, g.study);
+          } catch (const ConfigError& err) {
+            s["expand_error"] = err.what();
+            std::printf("%s: cannot re-expand the stored matrix: %s\n", name.c_str(), err.what());
+          }
+        }
+        if (e) {
+          s["cells_expected"] = e->cells.size();
+          for (const Cell& c : e->cells)
             if (!g.files_by_index.count(c.index)) missing.push_back(c.index);
         }
-        if (!g.study_config.is_null() && !g.without_distance.empty()) {
-          const ExperimentConfig e = parse_experiment_config(g.study_config, g.source, g.quick, g.study);
+        if (e && !g.without_distance.empty()) {
           json lacking = json::array();
           for (int index : g.without_distance)
-            if (index >= 0 && index < int(e.cells.size()) && !matches_assignment(e.cells[size_t(index)], e.metrics.reference))
+            if (index >= 0 && index < int(e->cells.size()) && !matches_assignment(e->cells[size_t(index)], e->metrics.reference))
               lacking.push_back(index);
           if (!lacking.empty()) {
             s["without_reference_distance"] = lacking;
