@@ -11,6 +11,10 @@ namespace mcf {
 /// Adds a subcommand; `run` is set to the function that executes it after parsing.
 void add_flow_command(CLI::App& app, std::function<int()>& run);
 void add_mesh_info_command(CLI::App& app, std::function<int()>& run);
+void add_run_command(CLI::App& app, std::function<int()>& run);
+void add_expand_command(CLI::App& app, std::function<int()>& run);
+void add_collect_command(CLI::App& app, std::function<int()>& run);
+void add_compare_command(CLI::App& app, std::function<int()>& run);
 void add_distance_command(CLI::App& app, std::function<int()>& run);
 
 }  // namespace mcf

@@ -14,6 +14,10 @@ int main(int argc, char** argv) {
   std::function<int()> run;
   mcf::add_flow_command(app, run);
   mcf::add_mesh_info_command(app, run);
+  mcf::add_run_command(app, run);
+  mcf::add_expand_command(app, run);
+  mcf::add_collect_command(app, run);
+  mcf::add_compare_command(app, run);
   mcf::add_distance_command(app, run);
   try {
     app.parse(argc, argv);

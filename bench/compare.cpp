@@ -1,0 +1,229 @@
+#include "bench/compare.h"
+
+#include "bench/experiment_config.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace mcf {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string label_of(const json& assignment, const std::string& key) {
+  if (!assignment.is_object() || assignment.empty()) return key;
+  std::string s;
+  for (auto it = assignment.begin(); it != assignment.end(); ++it) {
+    if (!s.empty()) s += " ";
+    s += it.key() + "=" + (it->is_string() ? it->get<std::string>() : it->dump());
+  }
+  return s;
+}
+
+/// Accuracy of one result: the last distance to the reference flow when there is one (octree
+/// vs cotangent studies), else the final RMS radial error (spheres); NaN when neither exists.
+double accuracy_of(const json& r) {
+  if (r.contains("reference_distance") && r["reference_distance"].is_array() && !r["reference_distance"].empty())
+    return r["reference_distance"].back().value("rms", NAN);
+  if (r.contains("steps"))
+    for (auto it = r["steps"].rbegin(); it != r["steps"].rend(); ++it)
+      if (it->contains("radial_error")) return (*it)["radial_error"].value("rms", NAN);
+  return NAN;
+}
+
+std::string fmt(double v, const char* f = "%.4g") {
+  if (!std::isfinite(v)) return "–";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+}  // namespace
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  const size_t n = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + long(n), v.end());
+  if (v.size() % 2) return v[n];
+  const double hi = v[n];
+  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + long(n)));
+}
+
+double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b) {
+  const double n1 = double(a.size()), n2 = double(b.size());
+  if (a.empty() || b.empty()) return 1.0;
+  std::vector<std::pair<double, int>> all;
+  for (double x : a) all.push_back({x, 0});
+  for (double x : b) all.push_back({x, 1});
+  std::sort(all.begin(), all.end());
+  // Mid-ranks for ties; the tie term Σ(t³ - t) corrects the variance.
+  double rank_sum_a = 0, ties = 0;
+  for (size_t i = 0; i < all.size();) {
+    size_t j = i;
+    while (j < all.size() && all[j].first == all[i].first) ++j;
+    const double t = double(j - i), mid = 0.5 * double(i + 1 + j);
+    ties += t * t * t - t;
+    for (size_t k = i; k < j; ++k)
+      if (all[k].second == 0) rank_sum_a += mid;
+    i = j;
+  }
+  const double n = n1 + n2;
+  const double u = rank_sum_a - n1 * (n1 + 1) / 2;
+  const double mean = n1 * n2 / 2;
+  const double var = n1 * n2 / 12 * ((n + 1) - ties / (n * (n - 1)));
+  if (!(var > 0)) return 1.0;
+  const double z = std::max(0.0, std::abs(u - mean) - 0.5) / std::sqrt(var);
+  return std::erfc(z / std::sqrt(2.0));
+}
+
+ResultSet load_result_set(const std::string& dir_at_commit, const std::string& metric) {
+  ResultSet set;
+  std::string commit_filter;
+  set.dir = dir_at_commit;
+  if (!fs::is_directory(set.dir)) {
+    const auto at = dir_at_commit.rfind('@');
+    if (at != std::string::npos) {
+      set.dir = dir_at_commit.substr(0, at);
+      commit_filter = dir_at_commit.substr(at + 1);
+    }
+  }
+  if (!fs::is_directory(set.dir)) throw std::runtime_error(dir_at_commit + ": not a results folder");
+  std::set<std::string> commits, studies;
+  std::vector<json> results;
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(set.dir))
+    if (entry.is_regular_file() && entry.path().extension() == ".json" && entry.path().filename() != "index.json")
+      files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    std::ifstream in(f);
+    json r;
+    try {
+      r = json::parse(in);
+    } catch (const json::parse_error& e) {
+      throw std::runtime_error(f.string() + ": JSON parse error: " + e.what());
+    }
+    if (!r.is_object() || !r.contains("cell")) continue;  // not a cell result
+    const std::string commit = r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
+    if (!commit_filter.empty() && commit.rfind(commit_filter, 0) != 0) continue;
+    commits.insert(commit);
+    studies.insert(r["cell"].value("study", ""));
+    results.push_back(std::move(r));
+  }
+  if (results.empty())
+    throw std::runtime_error(dir_at_commit + ": no cell results" + (commit_filter.empty() ? "" : " of commit " + commit_filter));
+  if (commits.size() > 1) {
+    std::string list;
+    for (const auto& c : commits) list += " " + c;
+    throw std::runtime_error(dir_at_commit + ": holds results of " + std::to_string(commits.size()) +
+                             " commits (" + list.substr(1) + "); pick one as " + set.dir + "@COMMIT");
+  }
+  set.commit = *commits.begin();
+  set.study = *studies.begin();
+  for (const json& r : results) {
+    const json& cell = r["cell"];
+    const std::string key = cell.value("config_key", cell.value("key", ""));
+    CellSamples& c = set.cells[key];
+    c.label = label_of(cell.value("assignment", json::object()), key);
+    ++c.repetitions;
+    if (r.contains("steps"))
+      for (const auto& s : r["steps"]) {
+        const json* v = json_at_path(s, metric);
+        if (v && v->is_number()) c.values.push_back(v->get<double>());
+      }
+    const double err = accuracy_of(r);
+    if (std::isfinite(err)) c.errors.push_back(err);
+  }
+  return set;
+}
+
+CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set, const CompareOptions& o) {
+  CompareReport rep;
+  for (const auto& [key, n] : new_set.cells) {
+    auto it = old_set.cells.find(key);
+    if (it == old_set.cells.end()) {
+      rep.only_new.push_back(n.label);
+      continue;
+    }
+    const CellSamples& old = it->second;
+    CellComparison c;
+    c.key = key;
+    c.label = n.label;
+    c.n_old = int(old.values.size());
+    c.n_new = int(n.values.size());
+    c.old_median = median(old.values);
+    c.new_median = median(n.values);
+    c.ratio = c.old_median > 0 ? c.new_median / c.old_median : NAN;
+    c.p_value = mann_whitney_p(old.values, n.values);
+    c.slower = std::isfinite(c.ratio) && c.ratio > 1 + o.threshold && c.p_value < o.alpha;
+    c.faster = std::isfinite(c.ratio) && c.ratio < 1 / (1 + o.threshold) && c.p_value < o.alpha;
+    if (!old.errors.empty() && !n.errors.empty()) {
+      c.has_error = true;
+      c.old_error = median(old.errors);
+      c.new_error = median(n.errors);
+      // Errors at round-off level are noise, not accuracy: a floor keeps 1e-16 vs 3e-16 quiet.
+      const double floor = 1e-12;
+      c.error_ratio = std::max(c.new_error, floor) / std::max(c.old_error, floor);
+      c.less_accurate = c.error_ratio > 1 + o.threshold;
+    }
+    rep.regression = rep.regression || c.slower || c.less_accurate;
+    rep.cells.push_back(std::move(c));
+  }
+  for (const auto& [key, old] : old_set.cells)
+    if (!new_set.cells.count(key)) rep.only_old.push_back(old.label);
+  return rep;
+}
+
+std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, const ResultSet& new_set,
+                             const CompareOptions& o) {
+  std::ostringstream md;
+  md << "## compare " << old_set.dir << " (" << old_set.commit << ") → " << new_set.dir << " (" << new_set.commit
+     << ")\n\n";
+  md << "Metric `" << o.metric << "` per step (median over steps and repetitions); Mann–Whitney U, "
+     << "slower/faster when the ratio passes 1±" << o.threshold << " with p < " << o.alpha
+     << "; accuracy = final reference distance or radial error (RMS).\n\n";
+  int changed = 0;
+  std::ostringstream table;
+  table << "| cell | old | new | new/old | p | old error | new error | error ratio | verdict |\n"
+        << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : r.cells) {
+    std::string verdict;
+    if (c.slower) verdict += "**slower** ";
+    if (c.faster) verdict += "faster ";
+    if (c.less_accurate) verdict += "**less accurate** ";
+    if (c.has_error && c.error_ratio < 1 / (1 + o.threshold)) verdict += "more accurate ";
+    if (!verdict.empty()) ++changed;
+    if (verdict.empty() && !o.show_all) continue;
+    table << "| " << c.label << " | " << fmt(c.old_median) << " | " << fmt(c.new_median) << " | "
+          << fmt(c.ratio, "%.3f") << " | " << fmt(c.p_value, "%.2g") << " | "
+          << (c.has_error ? fmt(c.old_error) : "–") << " | " << (c.has_error ? fmt(c.new_error) : "–") << " | "
+          << (c.has_error ? fmt(c.error_ratio, "%.3f") : "–") << " | " << (verdict.empty() ? "same " : verdict) << "|\n";
+  }
+  if (changed || (o.show_all && !r.cells.empty())) md << table.str() << "\n";
+  md << r.cells.size() << " cells compared, " << changed << " changed, " << (r.cells.size() - size_t(changed))
+     << " unchanged.\n";
+  if (!r.only_old.empty()) md << r.only_old.size() << " cells only in OLD.\n";
+  if (!r.only_new.empty()) md << r.only_new.size() << " cells only in NEW.\n";
+  md << (r.regression ? "REGRESSION\n" : "no regression\n");
+  return md.str();
+}
+
+json history_entry(const ResultSet& set, const std::string& metric) {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  json cells = json::object();
+  for (const auto& [key, c] : set.cells) cells[key] = {{"label", c.label}, {"median", median(c.values)}};
+  return {{"commit", set.commit}, {"date", date}, {"study", set.study}, {"dir", set.dir}, {"metric", metric}, {"cells", cells}};
+}
+
+}  // namespace mcf

@@ -1,0 +1,63 @@
+#pragma once
+// `mcfbench compare OLD NEW`: cell-by-cell performance and accuracy comparison of two result
+// sets (e.g. two commits), for regression tracking. Cells are matched by their config key
+// (config + input mesh, without code version or repetition, which are pooled).
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace mcf {
+
+struct CellSamples {
+  std::string label;                 ///< "basis=hat solver.name=cholmod" (the assignment)
+  std::vector<double> values;        ///< the metric per step, all repetitions pooled
+  std::vector<double> errors;        ///< accuracy per repetition (final reference distance or radial rms)
+  int repetitions = 0;
+};
+
+struct ResultSet {
+  std::string dir, commit, study;
+  std::map<std::string, CellSamples> cells;  ///< by config key
+};
+
+/// Reads DIR[@COMMIT]: every cell result (*.json with a "cell" object) in DIR, keeping only
+/// those of COMMIT (a prefix) when given. A folder holding several commits without @COMMIT is
+/// an error listing them (timings of different code must not be pooled). `metric` is the
+/// dotted path of the per-step value ("seconds.total", "radial_error.rms", ...).
+ResultSet load_result_set(const std::string& dir_at_commit, const std::string& metric);
+
+struct CompareOptions {
+  double threshold = 0.1, alpha = 0.05;
+  std::string metric = "seconds.total";
+  bool show_all = false;  ///< table lists unchanged cells too
+};
+
+struct CellComparison {
+  std::string key, label;
+  double old_median = 0, new_median = 0, ratio = 1, p_value = 1;
+  int n_old = 0, n_new = 0;
+  bool has_error = false;
+  double old_error = 0, new_error = 0, error_ratio = 1;
+  bool slower = false, faster = false, less_accurate = false;
+};
+
+struct CompareReport {
+  std::vector<CellComparison> cells;
+  std::vector<std::string> only_old, only_new;  ///< labels of unmatched cells
+  bool regression = false;
+};
+
+CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set, const CompareOptions& o);
+std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, const ResultSet& new_set, const CompareOptions& o);
+/// One line for the history file: {commit, date, study, dir, metric, cells: {key: median}}.
+nlohmann::json history_entry(const ResultSet& set, const std::string& metric);
+
+/// Two-sided p-value of the Mann–Whitney U test (normal approximation, tie-corrected, with
+/// continuity correction). 1 when either sample is empty or all values tie.
+double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b);
+double median(std::vector<double> v);
+
+}  // namespace mcf

@@ -1,0 +1,371 @@
+#include "bench/experiment_config.h"
+
+#include "flows/config_reader.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace mcf {
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& source, const std::string& path, const std::string& what) {
+  throw ConfigError(source + ": " + path + ": " + what);
+}
+
+void flatten_keys(const json& j, const std::string& prefix, std::vector<std::string>& out) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    out.push_back(key);
+    if (it->is_object()) flatten_keys(*it, key, out);
+  }
+}
+
+bool is_config_key(const std::string& k) {
+  const auto& keys = flow_config_keys();
+  return std::find(keys.begin(), keys.end(), k) != keys.end();
+}
+
+std::string known_keys_hint() {
+  std::string s = " (known keys:";
+  for (const auto& k : flow_config_keys()) s += " " + k;
+  return s + ")";
+}
+
+void require_config_key(const std::string& source, const std::string& where, const std::string& key) {
+  if (!is_config_key(key)) fail(source, where + key, "unknown config key" + known_keys_hint());
+}
+
+/// Unknown keys inside a (nested) flow-config object are reported with their full dotted path
+/// before any cell is built, so a typo in `defaults` is named as such (not as a cell error).
+void check_config_object(const json& j, const std::string& source, const std::string& where,
+                         const std::string& prefix = "") {
+  if (!j.is_object()) fail(source, where.empty() ? "config" : where.substr(0, where.size() - 1), "expected an object, got " + j.dump());
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (!is_config_key(key)) fail(source, where + key, "unknown key" + known_keys_hint());
+    if (it->is_object()) check_config_object(*it, source, where, key);
+  }
+}
+
+/// One dimension of the matrix: several keys that vary together (one key for an axis).
+struct Dimension {
+  std::vector<std::string> keys;
+  std::vector<std::vector<json>> rows;  // rows[i][k] = value of keys[k] in the i-th setting
+};
+
+const json& member(const json& j, const char* key) {
+  static const json null_value;
+  return j.contains(key) ? j.at(key) : null_value;
+}
+
+void check_axes(const json& axes, const std::string& source, const std::string& where) {
+  if (axes.is_null()) return;
+  if (!axes.is_object()) fail(source, where, "expected an object {dotted key: [values]}, got " + axes.dump());
+  for (auto it = axes.begin(); it != axes.end(); ++it) {
+    require_config_key(source, where + ".", it.key());
+    if (!it->is_array() || it->empty()) fail(source, where + "." + it.key(), "expected a non-empty list of values, got " + it->dump());
+  }
+}
+
+void check_zip(const json& zip, const std::string& source, const std::string& where) {
+  if (zip.is_null()) return;
+  if (!zip.is_array()) fail(source, where, "expected a list of groups [{dotted key: [values]}, ...], got " + zip.dump());
+  for (size_t g = 0; g < zip.size(); ++g) {
+    const std::string gp = where + "[" + std::to_string(g) + "]";
+    const json& group = zip[g];
+    if (!group.is_object() || group.empty()) fail(source, gp, "expected a non-empty object {dotted key: [values]}, got " + group.dump());
+    std::string first_key;
+    size_t length = 0;
+    for (auto it = group.begin(); it != group.end(); ++it) {
+      require_config_key(source, gp + ".", it.key());
+      if (!it->is_array() || it->empty()) fail(source, gp + "." + it.key(), "expected a non-empty list of values, got " + it->dump());
+      if (first_key.empty()) {
+        first_key = it.key();
+        length = it->size();
+      } else if (it->size() != length) {
+        fail(source, gp + "." + it.key(),
+             std::to_string(it->size()) + " values, but " + gp + "." + first_key + " has " + std::to_string(length) +
+                 " (the lists of a zip group vary together and must be equally long)");
+      }
+    }
+  }
+}
+
+void check_exclude(const json& exclude, const std::string& source, const std::string& where) {
+  if (exclude.is_null()) return;
+  if (!exclude.is_array()) fail(source, where, "expected a list of partial assignments [{dotted key: value}, ...], got " + exclude.dump());
+  for (size_t i = 0; i < exclude.size(); ++i) {
+    const std::string ip = where + "[" + std::to_string(i) + "]";
+    if (!exclude[i].is_object() || exclude[i].empty()) fail(source, ip, "expected a non-empty object {dotted key: value}, got " + exclude[i].dump());
+    for (auto it = exclude[i].begin(); it != exclude[i].end(); ++it) require_config_key(source, ip + ".", it.key());
+  }
+}
+
+int read_repetitions(const json& r, const std::string& source, const std::string& where) {
+  if (r.is_null()) return 1;
+  if (!r.is_number_integer() || r.get<long long>() < 1 || r.get<long long>() > 1000000)
+    fail(source, where, "expected an integer >= 1, got " + r.dump());
+  return r.get<int>();
+}
+
+MetricsConfig read_metrics(const json& m, const std::string& source) {
+  MetricsConfig out;
+  if (m.is_null()) return out;
+  ConfigReader r(m, source, "metrics");
+  out.quasi_conformal = r.get_bool("quasi_conformal", false);
+  out.sphericity = r.get_bool("sphericity", false);
+  out.every = int(r.get_integer("every", 1, 1, 100000000));
+  out.distance_samples = r.get_integer("distance_samples", out.distance_samples, 100, 100000000);
+  // Lists and partial assignments are not ConfigReader types, so the key set is checked here.
+  for (auto it = m.begin(); it != m.end(); ++it) {
+    const std::string& k = it.key();
+    if (k == "quasi_conformal" || k == "sphericity" || k == "every" || k == "distance_samples") continue;
+    if (k == "frames") {
+      if (!it->is_array()) fail(source, "metrics.frames", "expected a list of step numbers, got " + it->dump());
+      for (const auto& s : *it) {
+        if (!s.is_number_integer() || s.get<long long>() < 0 || s.get<long long>() > 100000000)
+          fail(source, "metrics.frames", "expected step numbers >= 0, got " + s.dump());
+        out.frames.push_back(s.get<int>());
+      }
+      std::sort(out.frames.begin(), out.frames.end());
+      out.frames.erase(std::unique(out.frames.begin(), out.frames.end()), out.frames.end());
+    } else if (k == "reference") {
+      if (!it->is_object() || it->empty()) fail(source, "metrics.reference", "expected a non-empty object {dotted key: value}, got " + it->dump());
+      for (auto e = it->begin(); e != it->end(); ++e) require_config_key(source, "metrics.reference.", e.key());
+      out.reference = *it;
+    } else {
+      fail(source, "metrics." + k,
+           "unknown key (known: quasi_conformal, sphericity, every, frames, reference, distance_samples)");
+    }
+  }
+  if (!out.reference.is_null() && out.frames.empty())
+    fail(source, "metrics.reference", "needs metrics.frames: distances are computed between saved frames");
+  return out;
+}
+
+json default_value(const std::string& key) {
+  static const json defaults = to_json(FlowConfig{});
+  const json* v = json_at_path(defaults, key);
+  return v ? *v : json();
+}
+
+/// Exclusion is decided before validation, on the raw config plus the defaults, because
+/// excluding invalid combinations (say hat + multigrid) is exactly what `exclude` is for.
+bool excluded(const json& raw, const json& exclude) {
+  if (!exclude.is_array()) return false;
+  for (const auto& partial : exclude) {
+    bool all = true;
+    for (auto it = partial.begin(); it != partial.end() && all; ++it) {
+      const json* v = json_at_path(raw, it.key());
+      all = (v ? *v : default_value(it.key())) == *it;
+    }
+    if (all) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+const std::vector<std::string>& flow_config_keys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k;
+    flatten_keys(to_json(FlowConfig{}), "", k);
+    return k;
+  }();
+  return keys;
+}
+
+const json* json_at_path(const json& j, const std::string& dotted) {
+  const json* node = &j;
+  size_t start = 0;
+  while (true) {
+    const size_t dot = dotted.find('.', start);
+    const std::string part = dotted.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    if (!node->is_object() || !node->contains(part)) return nullptr;
+    node = &node->at(part);
+    if (dot == std::string::npos) return node;
+    start = dot + 1;
+  }
+}
+
+void set_json_path(json& j, const std::string& dotted, const json& value) {
+  json* node = &j;
+  size_t start = 0;
+  for (size_t dot = dotted.find('.'); dot != std::string::npos; dot = dotted.find('.', start)) {
+    node = &(*node)[dotted.substr(start, dot - start)];
+    start = dot + 1;
+  }
+  (*node)[dotted.substr(start)] = value;
+}
+
+bool matches_assignment(const Cell& cell, const json& partial) {
+  if (!partial.is_object()) return false;
+  for (auto it = partial.begin(); it != partial.end(); ++it) {
+    const json* v = json_at_path(cell.config, it.key());
+    if (!v || *v != *it) return false;
+  }
+  return true;
+}
+
+ExperimentConfig parse_experiment_config(const json& j, const std::string& source, bool quick,
+                                         const std::string& default_name) {
+  if (!j.is_object()) throw ConfigError(source + ": expected a JSON object at the top level");
+  static const std::set<std::string> top = {"name",    "description", "paper",   "comment", "defaults", "axes",
+                                            "zip",     "exclude",     "repetitions", "metrics", "quick"};
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!top.count(it.key()))
+      fail(source, it.key(),
+           "unknown key (known: name, description, paper, comment, defaults, axes, zip, exclude, repetitions, metrics, quick)");
+
+  ExperimentConfig e;
+  e.source = source;
+  e.quick = quick;
+  e.study_config = j;
+  e.name = default_name;
+  if (j.contains("name")) {
+    if (!j["name"].is_string() || j["name"].get<std::string>().empty()) fail(source, "name", "expected a non-empty string, got " + j["name"].dump());
+    e.name = j["name"].get<std::string>();
+    if (e.name.find('/') != std::string::npos) fail(source, "name", "must not contain '/' (it names the results folder)");
+  }
+  if (j.contains("description")) {
+    if (!j["description"].is_string()) fail(source, "description", "expected a string, got " + j["description"].dump());
+    e.description = j["description"].get<std::string>();
+  }
+
+  // Structure of both variants is checked whichever is run, so a broken quick section is
+  // found by the full run (and vice versa) rather than months later.
+  json defaults = member(j, "defaults");
+  if (defaults.is_null()) defaults = json::object();
+  check_config_object(defaults, source, "defaults.");
+  check_axes(member(j, "axes"), source, "axes");
+  check_zip(member(j, "zip"), source, "zip");
+  check_exclude(member(j, "exclude"), source, "exclude");
+  e.repetitions = read_repetitions(member(j, "repetitions"), source, "repetitions");
+  e.metrics = read_metrics(member(j, "metrics"), source);
+
+  json axes = member(j, "axes"), zip = member(j, "zip"), exclude = member(j, "exclude");
+  const json& q = member(j, "quick");
+  if (!q.is_null()) {
+    if (!q.is_object()) fail(source, "quick", "expected an object, got " + q.dump());
+    for (auto it = q.begin(); it != q.end(); ++it)
+      if (it.key() != "defaults" && it.key() != "axes" && it.key() != "zip" && it.key() != "exclude" && it.key() != "repetitions")
+        fail(source, "quick." + it.key(), "unknown key (known: defaults, axes, zip, exclude, repetitions)");
+    if (q.contains("defaults")) check_config_object(q["defaults"], source, "quick.defaults.");
+    check_axes(member(q, "axes"), source, "quick.axes");
+    check_zip(member(q, "zip"), source, "quick.zip");
+    check_exclude(member(q, "exclude"), source, "quick.exclude");
+    const int quick_reps = read_repetitions(member(q, "repetitions"), source, "quick.repetitions");
+    if (quick) {
+      // defaults: deep merge; axes: per key (a quick axis replaces the full one);
+      // zip, exclude, repetitions: replaced as a whole.
+      if (q.contains("defaults")) defaults.merge_patch(q["defaults"]);
+      if (q.contains("axes")) {
+        if (axes.is_null()) axes = json::object();
+        for (auto it = q["axes"].begin(); it != q["axes"].end(); ++it) axes[it.key()] = *it;
+      }
+      if (q.contains("zip")) zip = q["zip"];
+      if (q.contains("exclude")) exclude = q["exclude"];
+      if (q.contains("repetitions")) e.repetitions = quick_reps;
+    }
+  }
+
+  std::vector<Dimension> dims;
+  std::set<std::string> varied;
+  const std::string axes_where = quick ? "axes (with quick.axes)" : "axes";
+  if (axes.is_object())
+    for (auto it = axes.begin(); it != axes.end(); ++it) {  // nlohmann keeps keys sorted
+      Dimension d;
+      d.keys = {it.key()};
+      for (const auto& v : *it) d.rows.push_back({v});
+      varied.insert(it.key());
+      dims.push_back(std::move(d));
+    }
+  if (zip.is_array())
+    for (size_t g = 0; g < zip.size(); ++g) {
+      Dimension d;
+      size_t length = 0;
+      for (auto it = zip[g].begin(); it != zip[g].end(); ++it) {
+        if (!varied.insert(it.key()).second)
+          fail(source, "zip[" + std::to_string(g) + "]." + it.key(), "key varies twice (also in axes or another zip group)");
+        d.keys.push_back(it.key());
+        length = it->size();
+      }
+      for (size_t i = 0; i < length; ++i) {
+        std::vector<json> row;
+        for (const auto& k : d.keys) row.push_back(zip[g][k][i]);
+        d.rows.push_back(std::move(row));
+      }
+      dims.push_back(std::move(d));
+    }
+  for (const auto& k : varied)
+    for (const auto& other : varied)
+      if (k != other && other.rfind(k + ".", 0) == 0)
+        fail(source, axes_where, "keys \"" + k + "\" and \"" + other + "\" overlap (one contains the other)");
+
+  // Odometer over the dimensions, the last one fastest.
+  std::vector<size_t> pos(dims.size(), 0);
+  int index = 0;
+  bool done = false;
+  while (!done) {
+    json raw = defaults, assignment = json::object();
+    for (size_t d = 0; d < dims.size(); ++d)
+      for (size_t k = 0; k < dims[d].keys.size(); ++k) {
+        set_json_path(raw, dims[d].keys[k], dims[d].rows[pos[d]][k]);
+        assignment[dims[d].keys[k]] = dims[d].rows[pos[d]][k];
+      }
+    if (!excluded(raw, exclude)) {
+      const std::string where = assignment.empty() ? source + " (defaults)" : source + " (cell " + assignment.dump() + ")";
+      const FlowConfig flow = flow_config_from_json(raw, where);
+      for (int r = 0; r < e.repetitions; ++r) {
+        Cell c;
+        c.index = index++;
+        c.repetition = r;
+        c.assignment = assignment;
+        c.flow = flow;
+        c.config = to_json(flow);
+        e.cells.push_back(std::move(c));
+      }
+    }
+    done = true;
+    for (size_t d = dims.size(); d-- > 0;) {
+      if (++pos[d] < dims[d].rows.size()) {
+        done = false;
+        break;
+      }
+      pos[d] = 0;
+    }
+  }
+  if (e.cells.empty()) fail(source, "exclude", "every cell of the matrix is excluded");
+  // Two cells with the same full config would share one result file (same key): the second
+  // would be "skipped" and `collect` would report it missing. Usually a duplicated axis value.
+  std::map<std::string, const Cell*> seen;
+  for (const Cell& c : e.cells) {
+    auto [it, fresh] = seen.emplace(c.config.dump() + "#" + std::to_string(c.repetition), &c);
+    if (!fresh)
+      fail(source, axes_where, "cells " + it->second->assignment.dump() + " and " + c.assignment.dump() +
+                                   " are the same flow config (duplicate values?)");
+  }
+  if (!e.metrics.reference.is_null() &&
+      std::none_of(e.cells.begin(), e.cells.end(), [&](const Cell& c) { return matches_assignment(c, e.metrics.reference); }))
+    fail(source, "metrics.reference", "matches no cell of the matrix: " + e.metrics.reference.dump());
+  return e;
+}
+
+ExperimentConfig load_experiment_config(const std::string& path, bool quick) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open config file");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& err) {
+    throw ConfigError(path + ": JSON parse error: " + err.what());
+  }
+  return parse_experiment_config(j, path, quick, std::filesystem::path(path).stem().string());
+}
+
+}  // namespace mcf

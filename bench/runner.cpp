@@ -1,0 +1,305 @@
+#include "bench/runner.h"
+
+#include "bench/cell_hash.h"
+#include "bench/environment.h"
+#include "bench/metric_hooks.h"
+#include "datasets/atomic_file.h"
+#include "datasets/mesh_io.h"
+#include "flows/config_reader.h"
+#include "flows/flow.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace mcf {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string frame_name(int step) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.ply", step);
+  return name;
+}
+
+/// Peak memory of one cell, not of the whole process: Linux resets the high-water mark
+/// (VmHWM) when "5" is written to /proc/self/clear_refs. Where that fails the process peak
+/// (getrusage) is recorded and said so.
+bool reset_peak_memory() {
+  std::ofstream f("/proc/self/clear_refs");
+  if (!f) return false;
+  f << "5";
+  f.flush();
+  return bool(f);
+}
+
+long long cell_peak_memory_bytes() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoll(line.substr(6)) * 1024;  // kB
+  return peak_memory_bytes();
+}
+
+json read_json_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw std::runtime_error(path + ": JSON parse error: " + e.what());
+  }
+}
+
+json cell_json(const ExperimentConfig& e, const CellPlan& p) {
+  return {{"index", p.cell.index},
+          {"key", p.key},
+          {"config_key", p.config_key},
+          {"hash", p.hash},
+          {"assignment", p.cell.assignment},
+          {"repetition", p.cell.repetition},
+          {"study", e.name},
+          {"quick", e.quick},
+          {"mesh_fingerprint", p.mesh_fingerprint}};
+}
+
+json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, const fs::path& out) {
+  const auto start = std::chrono::steady_clock::now();
+  const MetricsConfig& m = e.metrics;
+  const FlowConfig& config = p.cell.flow;
+  const std::set<int> frames(m.frames.begin(), m.frames.end());
+  const fs::path frame_dir = out / "frames" / p.hash;
+  std::vector<int> written;
+  std::map<int, json> step_metrics;
+  const bool per_step = m.quasi_conformal || m.sphericity;
+  const MetricHooks& hooks = metric_hooks();
+  const bool peak_per_cell = reset_peak_memory();
+
+  json result;
+  try {
+    const MeshSource& source = meshes.get(config.mesh);
+    if (!frames.empty() || config.save_every > 0) fs::create_directories(frame_dir);  // write_mesh does not
+    TriangleMesh initial;  // X_0 as the flow sees it (after area normalisation, if any)
+    FlowObserver observer;
+    observer.on_step = [&](int step, double, const Positions& V) {
+      if (step == 0) initial = TriangleMesh{V, source.mesh.faces};
+      if (frames.count(step) || (config.save_every > 0 && step % config.save_every == 0)) {
+        write_mesh((frame_dir / frame_name(step)).string(), TriangleMesh{V, source.mesh.faces});
+        written.push_back(step);
+      }
+      // Metrics at step 0 too (the initial sphericity is the baseline of the cMCF plots), then
+      // every `every` steps and at the last step.
+      if (per_step && (step % m.every == 0 || step == config.steps)) {
+        json mj = json::object();
+        if (m.quasi_conformal) mj["quasi_conformal"] = hooks.quasi_conformal_error(initial, V);
+        if (m.sphericity) mj["sphericity"] = hooks.sphericity(V, source.mesh.faces);
+        step_metrics[step] = std::move(mj);
+      }
+    };
+    FlowOutcome outcome = run_flow(config, source, observer);
+    result = std::move(outcome.result);
+    // The observer runs after the flow has recorded the step; attach the metrics by step number.
+    if (step_metrics.count(0)) result["initial_metrics"] = step_metrics[0];
+    for (auto& s : result["steps"]) {
+      auto it = step_metrics.find(s.value("step", -1));
+      if (it != step_metrics.end()) s["metrics"] = it->second;
+    }
+  } catch (const std::exception& ex) {
+    result = {{"schema", 1},
+              {"status", "error"},
+              {"error", ex.what()},
+              {"stop", {{"step", 0}, {"reason", std::string("error: ") + ex.what()}}},
+              {"config", p.cell.config},
+              {"steps", json::array()}};
+  }
+  result["environment"] = environment_json(config.threads);
+  result["peak_memory_bytes"] = peak_per_cell ? cell_peak_memory_bytes() : peak_memory_bytes();
+  result["peak_memory_scope"] = peak_per_cell ? "cell" : "process";
+  result["cell"] = cell_json(e, p);
+  result["study_config"] = e.study_config;
+  if (!written.empty()) result["frames"] = {{"dir", "frames/" + p.hash}, {"steps", written}};
+  result["run_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+/// Distances between this cell's frames and its reference cell's frames at the same steps.
+json reference_distances(const ExperimentConfig& e, const fs::path& out, const CellPlan& cell, const CellPlan& ref) {
+  json list = json::array();
+  for (int step : e.metrics.frames) {
+    const fs::path a = out / "frames" / cell.hash / frame_name(step);
+    const fs::path b = out / "frames" / ref.hash / frame_name(step);
+    if (!fs::exists(a) || !fs::exists(b)) continue;
+    const MeshDistance d = metric_hooks().mesh_distance(read_mesh(a.string()), read_mesh(b.string()), e.metrics.distance_samples);
+    list.push_back({{"step", step},
+                    {"rms", d.rms},
+                    {"max", d.max},
+                    {"rms_forward", d.rms_forward},
+                    {"max_forward", d.max_forward},
+                    {"rms_backward", d.rms_backward},
+                    {"max_backward", d.max_backward},
+                    {"samples", d.samples}});
+  }
+  return list;
+}
+
+}  // namespace
+
+const MeshSource& MeshCache::get(const std::string& spec) {
+  auto it = meshes_.find(spec);
+  if (it == meshes_.end()) it = meshes_.emplace(spec, std::make_shared<MeshSource>(load_mesh_spec(spec))).first;
+  return *it->second;
+}
+
+std::string code_version() {
+  static const std::string v = environment_json(1).value("commit", "unknown");
+  return v;
+}
+
+bool in_shard(int index, int shard_index, int shard_count) { return index % shard_count == shard_index; }
+
+void parse_shard(const std::string& text, int& shard_index, int& shard_count) {
+  const auto slash = text.find('/');
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("");
+    size_t a = 0, b = 0;
+    const int i = std::stoi(text.substr(0, slash), &a);
+    const int n = std::stoi(text.substr(slash + 1), &b);
+    if (a != slash || b != text.size() - slash - 1 || n < 1 || i < 0 || i >= n) throw std::invalid_argument("");
+    shard_index = i;
+    shard_count = n;
+  } catch (const std::logic_error&) {
+    throw std::invalid_argument("--shard: expected i/n with 0 <= i < n (e.g. 3/16), got \"" + text + "\"");
+  }
+}
+
+std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& out_dir, MeshCache& meshes, int threads,
+                                 const std::function<bool(const Cell&)>& wanted) {
+  std::vector<CellPlan> plans;
+  const std::string version = code_version();
+  for (const Cell& c : e.cells) {
+    CellPlan p;
+    p.cell = c;
+    if (threads >= 0) {
+      p.cell.flow.threads = threads;
+      p.cell.config["threads"] = threads;
+    }
+    if (!wanted || wanted(c)) {
+      try {
+        p.mesh_fingerprint = mesh_fingerprint(meshes.get(c.flow.mesh).mesh);
+      } catch (const std::exception& ex) {
+        throw ConfigError(e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + "): mesh: " + ex.what());
+      }
+      p.key = cell_key(p.cell.config, c.repetition, p.mesh_fingerprint);
+      p.config_key = cell_key(p.cell.config, -1, p.mesh_fingerprint);
+      p.hash = cell_hash(p.key, version);
+      p.file = (fs::path(out_dir) / (p.hash + ".json")).string();
+    }
+    plans.push_back(std::move(p));
+  }
+  return plans;
+}
+
+const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans, const CellPlan& cell) {
+  const json& ref = e.metrics.reference;
+  if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
+  const CellPlan* best = nullptr;
+  std::pair<int, int> best_score{-1, -1};
+  for (const CellPlan& p : plans) {
+    if (!matches_assignment(p.cell, ref)) continue;
+    int agree = 0;
+    for (auto it = cell.cell.assignment.begin(); it != cell.cell.assignment.end(); ++it) {
+      const json* v = json_at_path(p.cell.config, it.key());
+      if (v && *v == *it) ++agree;
+    }
+    const std::pair<int, int> score{p.cell.repetition == cell.cell.repetition ? 1 : 0, agree};
+    if (score > best_score) {  // strict: ties keep the lowest index
+      best_score = score;
+      best = &p;
+    }
+  }
+  return best;
+}
+
+RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
+  if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
+    throw std::invalid_argument("--shard: expected i/n with 0 <= i < n");
+  const MetricHooks& hooks = metric_hooks();
+  auto missing = [&](const char* key) {
+    throw ConfigError(e.source + ": metrics." + key +
+                      ": this build has no implementation of the metric (bench/metrics*.cpp missing)");
+  };
+  if (e.metrics.quasi_conformal && !hooks.quasi_conformal_error) missing("quasi_conformal");
+  if (e.metrics.sphericity && !hooks.sphericity) missing("sphericity");
+  if (!e.metrics.reference.is_null() && !hooks.mesh_distance) missing("reference");
+
+  const bool with_reference = !e.metrics.reference.is_null();
+  MeshCache meshes;
+  // Every mesh this shard needs is loaded (and every cell named) before anything is written,
+  // so a bad mesh spec fails the run cleanly. Reference distances need the names of all cells.
+  const std::vector<CellPlan> plans = plan_cells(e, o.out_dir, meshes, o.threads, [&](const Cell& c) {
+    return with_reference || in_shard(c.index, o.shard_index, o.shard_count);
+  });
+
+  RunSummary s;
+  s.total = int(plans.size());
+  for (const auto& p : plans) s.in_shard += in_shard(p.cell.index, o.shard_index, o.shard_count);
+  const fs::path out(o.out_dir);
+  fs::create_directories(out);
+  std::set<std::string> ran_now;
+  int done = 0;
+  for (const CellPlan& p : plans) {
+    if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
+    CellReport report;
+    report.plan = &p;
+    report.total = s.in_shard;
+    if (!o.force && fs::exists(p.file)) {
+      ++s.skipped;
+      report.skipped = true;
+      report.status = "skipped";
+    } else {
+      const auto t0 = std::chrono::steady_clock::now();
+      const json result = run_cell(e, p, meshes, out);
+      write_file_atomic(p.file, result.dump(1) + "\n");
+      ++s.ran;
+      ran_now.insert(p.hash);
+      report.status = result.value("status", "error");
+      report.error = result.value("error", "");
+      if (report.status == "error") ++s.errors;
+      report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    report.done = ++done;
+    if (o.on_cell) o.on_cell(report);
+  }
+
+  // Distances to the reference flow once the cells are there. Only this shard's cells: a cell
+  // file then has exactly one writer even when shards run at once on a shared file system.
+  // A cell whose reference belongs to a shard that had not finished gets its distances on
+  // the next run that includes it (e.g. one unsharded `mcfbench run` after a Slurm array:
+  // every cell is skipped, the missing distances are filled in).
+  if (with_reference) {
+    for (const CellPlan& p : plans) {
+      if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
+      const CellPlan* ref = reference_for(e, plans, p);
+      if (!ref || !fs::exists(p.file) || !fs::exists(ref->file)) continue;
+      json result = read_json_file(p.file);
+      const bool stale = ran_now.count(p.hash) || ran_now.count(ref->hash) || !result.contains("reference_distance");
+      if (!stale || result.value("status", "") == "error") continue;
+      const json ref_result = read_json_file(ref->file);
+      if (ref_result.value("status", "") == "error") continue;
+      result["reference_distance"] = reference_distances(e, out, p, *ref);
+      result["reference_cell"] = {{"index", ref->cell.index}, {"hash", ref->hash}, {"key", ref->key},
+                                  {"assignment", ref->cell.assignment}, {"repetition", ref->cell.repetition}};
+      write_file_atomic(p.file, result.dump(1) + "\n");
+      ++s.distances;
+    }
+  }
+  return s;
+}
+
+}  // namespace mcf

@@ -1,0 +1,80 @@
+#pragma once
+// `mcfbench run`: runs the cells of an experiment matrix (or one shard of them), one result
+// file per cell, named by the cell hash and written atomically, so an interrupted or killed
+// run is resumed by running it again (finished cells are skipped, the killed one is redone).
+
+#include "bench/experiment_config.h"
+#include "datasets/mesh_spec.h"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mcf {
+
+/// A cell with its names: key (no code version; `compare` matches on it), hash (file name).
+struct CellPlan {
+  Cell cell;
+  std::string mesh_fingerprint, key, hash;
+  std::string config_key;  ///< key without the repetition: `compare` pools repetitions under it
+  std::string file;  ///< OUT/<hash>.json
+};
+
+/// Meshes are loaded once per spec per process (hashing needs the loaded mesh's bytes).
+class MeshCache {
+ public:
+  const MeshSource& get(const std::string& spec);
+
+ private:
+  std::map<std::string, std::shared_ptr<MeshSource>> meshes_;
+};
+
+struct CellReport {
+  int done = 0, total = 0;  ///< cells of this shard finished so far (run or skipped) / in the shard
+  const CellPlan* plan = nullptr;
+  bool skipped = false;
+  std::string status;       ///< ok | singular | error | skipped
+  std::string error;
+  double seconds = 0;
+};
+
+struct RunOptions {
+  std::string out_dir;
+  int shard_index = 0, shard_count = 1;
+  bool force = false;
+  int threads = -1;  ///< >= 0 overrides every cell's "threads" (part of the config, so of the key)
+  std::function<void(const CellReport&)> on_cell;  ///< progress (stderr in the CLI)
+};
+
+struct RunSummary {
+  int total = 0, in_shard = 0, ran = 0, skipped = 0, errors = 0, distances = 0;
+};
+
+/// The code version stored in hashes: the git commit the binary was built from.
+std::string code_version();
+/// Shard membership: cell index % n == i.
+bool in_shard(int index, int shard_index, int shard_count);
+/// Parses "i/n" (0 <= i < n); throws std::invalid_argument with a message otherwise.
+void parse_shard(const std::string& text, int& shard_index, int& shard_count);
+
+/// Names every cell (loading the meshes of the cells `wanted` selects, all if empty).
+/// `threads` >= 0 overrides the cells' thread count. A mesh that fails to load throws,
+/// naming the config file and the cell.
+std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& out_dir, MeshCache& meshes,
+                                 int threads = -1, const std::function<bool(const Cell&)>& wanted = {});
+
+/// Runs the shard. Config problems (including metrics whose hooks this build lacks) throw
+/// before anything is written; an exception inside one cell's flow becomes that cell's
+/// result {"status": "error", "error": ...} and the run goes on.
+RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& options);
+
+/// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the
+/// one agreeing with the cell on most assigned keys, then the lowest index); nullptr if none or
+/// if the cell is a reference cell itself.
+const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans, const CellPlan& cell);
+
+}  // namespace mcf

@@ -1,0 +1,121 @@
+// Regression comparison: the Mann–Whitney test, a 2x slowdown flagged (synthetic and on a real
+// run's copy), a set compared with itself or with tiny noise stays quiet, accuracy losses are
+// flagged, history lines are appended.
+
+#include "bench/compare.h"
+
+#include "bench_test_util.h"
+
+#include <cmath>
+#include <random>
+
+namespace mcf {
+namespace {
+
+using namespace mcf::test;
+using nlohmann::json;
+
+TEST(Compare, MannWhitney) {
+  const std::vector<double> a = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  std::vector<double> b;
+  for (double x : a) b.push_back(x + 100);
+  EXPECT_LT(mann_whitney_p(a, b), 1e-3);
+  EXPECT_GT(mann_whitney_p(a, a), 0.9);
+  EXPECT_DOUBLE_EQ(mann_whitney_p({1, 1, 1}, {1, 1, 1}), 1.0);  // all tied
+  EXPECT_DOUBLE_EQ(mann_whitney_p({}, {1}), 1.0);
+  // Reference values: scipy.stats.mannwhitneyu(a, b, method="asymptotic", use_continuity=True).
+  EXPECT_NEAR(mann_whitney_p({1, 2, 3, 5, 8}, {4, 6, 7, 9, 10}), 0.09469294259947589, 1e-12);
+  EXPECT_NEAR(mann_whitney_p({1, 2, 2, 5, 8, 8}, {2, 6, 8, 9, 10}), 0.16304505585423734, 1e-12);  // ties
+  EXPECT_DOUBLE_EQ(median({3, 1, 2}), 2);
+  EXPECT_DOUBLE_EQ(median({4, 1, 3, 2}), 2.5);
+}
+
+/// A synthetic result set: 3 cells, 2 repetitions, 15 steps each; per-step seconds scaled by
+/// `slow` with multiplicative noise of +-noise; final radial error scaled by `error`.
+void make_set(const fs::path& dir, const std::string& commit, double slow, double noise, double error, unsigned seed) {
+  fs::create_directories(dir);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(1 - noise, 1 + noise);
+  for (int cell = 0; cell < 3; ++cell)
+    for (int rep = 0; rep < 2; ++rep) {
+      json steps = json::array();
+      for (int s = 1; s <= 15; ++s)
+        steps.push_back({{"step", s},
+                         {"seconds", {{"total", 0.01 * (cell + 1) * (1 + 0.2 * std::sin(s)) * slow * jitter(rng)}}},
+                         {"radial_error", {{"rms", 1e-3 * (cell + 1) * s * error}}}});
+      const std::string key = "cellkey" + std::to_string(cell);
+      const json r = {{"status", "ok"},
+                      {"environment", {{"commit", commit}}},
+                      {"cell", {{"key", key + "r" + std::to_string(rep)}, {"config_key", key}, {"index", cell * 2 + rep},
+                                {"repetition", rep}, {"study", "synthetic"},
+                                {"assignment", {{"solver.name", "solver" + std::to_string(cell)}}}}},
+                      {"steps", steps}};
+      std::ofstream(dir / (commit + std::to_string(cell) + std::to_string(rep) + ".json")) << r.dump();
+    }
+}
+
+TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
+  const fs::path dir = fresh_dir("compare");
+  make_set(dir / "old", "aaaa", 1.0, 0.03, 1.0, 1);
+  make_set(dir / "same", "bbbb", 1.0, 0.03, 1.0, 2);   // a second run of the same code: tiny noise
+  make_set(dir / "slow", "cccc", 2.0, 0.03, 1.0, 3);
+  make_set(dir / "worse", "dddd", 1.0, 0.03, 1.5, 4);
+  Command c = mcfbench("compare old old", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("3 cells compared, 0 changed"), std::string::npos) << c.out;
+  c = mcfbench("compare old same --all", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("same |"), std::string::npos) << "unchanged rows are listed with --all: " << c.out;
+  EXPECT_NE(c.out.find("| solver.name=solver2 |"), std::string::npos) << c.out;
+  c = mcfbench("compare old slow --history hist/h.jsonl", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("solver.name=solver1"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("**slower**"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("| 2.0"), std::string::npos) << c.out;  // the ratio column
+  c = mcfbench("compare slow old", dir);  // faster is not a regression
+  EXPECT_EQ(c.status, 0) << c.out;
+  EXPECT_NE(c.out.find("faster"), std::string::npos) << c.out;
+  c = mcfbench("compare old worse --threshold 0.2", dir);
+  EXPECT_EQ(c.status, 1) << c.out;
+  EXPECT_NE(c.out.find("less accurate"), std::string::npos) << c.out;
+  c = mcfbench("compare old same --history hist/h.jsonl", dir);
+  const std::string hist = slurp(dir / "hist" / "h.jsonl");
+  ASSERT_EQ(std::count(hist.begin(), hist.end(), '\n'), 2);
+  const json line = json::parse(hist.substr(hist.find('\n') + 1));
+  EXPECT_EQ(line["commit"], "bbbb");
+  EXPECT_EQ(line["cells"].size(), 3u);
+  EXPECT_TRUE(line.contains("date"));
+  // A folder holding two commits needs DIR@COMMIT.
+  for (const auto& f : result_files(dir / "slow")) fs::copy_file(f, dir / "same" / f.filename());
+  c = mcfbench("compare old same", dir);
+  EXPECT_NE(c.status, 0);
+  EXPECT_NE(c.err.find("@COMMIT"), std::string::npos) << c.err;
+  c = mcfbench("compare old same@cccc", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  c = mcfbench("compare old same@bbbb", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+}
+
+TEST(CompareCli, InjectedSlowdownOnARealRun) {
+  const fs::path dir = fresh_dir("compare_real");
+  write_text(dir / "c.json", R"({"name": "c", "defaults": {"mesh": "icosphere:level=3", "steps": 30, "dt": 1e-4, "threads": 1}})");
+  Command c = mcfbench("run c.json --out old", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  fs::create_directories(dir / "new");
+  for (const auto& f : result_files(dir / "old")) {
+    json r = read_json(f);
+    for (auto& s : r["steps"])
+      for (auto& [k, v] : s["seconds"].items()) v = v.get<double>() * 2;
+    std::ofstream(dir / "new" / f.filename()) << r.dump();
+  }
+  c = mcfbench("compare old new", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("**slower**"), std::string::npos) << c.out;
+  c = mcfbench("compare old old", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  c = mcfbench("compare old new --metric radial_error.rms", dir);  // same accuracy, other metric
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+}
+
+}  // namespace
+}  // namespace mcf

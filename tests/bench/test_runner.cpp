@@ -1,0 +1,294 @@
+// The runner in-process (per-step metric hooks, frames, reference distances, a failing cell)
+// and end to end through the binary (resume after a deleted file, after SIGKILL, shards +
+// collect, config errors that write nothing).
+
+#include "bench/metric_hooks.h"
+#include "bench/runner.h"
+#include "flows/config_reader.h"
+
+#include "bench_test_util.h"
+
+#include <chrono>
+#include <csignal>
+#include <map>
+#include <set>
+#include <thread>
+
+namespace mcf {
+namespace {
+
+using namespace mcf::test;
+using nlohmann::json;
+
+/// Cheap stand-ins for the real metrics: deterministic and easy to check.
+MetricHooks fake_hooks() {
+  MetricHooks h;
+  h.quasi_conformal_error = [](const TriangleMesh& initial, const Positions& V) {
+    return 1.0 + (V - initial.vertices).norm();
+  };
+  h.sphericity = [](const Positions& V, const Triangles&) { return double(V.rows()); };
+  h.mesh_distance = [](const TriangleMesh& a, const TriangleMesh& b, long long samples) {
+    MeshDistance d;
+    d.rms = d.rms_forward = d.rms_backward = (a.vertices - b.vertices).norm();
+    d.max = d.max_forward = d.max_backward = (a.vertices - b.vertices).cwiseAbs().maxCoeff();
+    d.samples = samples;
+    return d;
+  };
+  return h;
+}
+
+struct HookGuard {  // restores the defaults so other tests see the build's hooks
+  explicit HookGuard(MetricHooks h) { set_metric_hooks(std::move(h)); }
+  ~HookGuard() { set_metric_hooks(default_metric_hooks()); }
+};
+
+TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
+  HookGuard guard(fake_hooks());
+  const fs::path out = fresh_dir("metrics");
+  const json j = {{"name", "m"},
+                  {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 4}, {"dt", 1e-3}}},
+                  {"axes", {{"dt", {1e-3, 4e-3}}}},
+                  {"metrics", {{"quasi_conformal", true}, {"sphericity", true}, {"every", 2},
+                               {"frames", {0, 2, 4}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 500}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "m.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  const RunSummary s = run_experiment(e, o);
+  EXPECT_EQ(s.ran, 2);
+  EXPECT_EQ(s.errors, 0);
+  EXPECT_EQ(s.distances, 1);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  const json ref = read_json(plans[0].file), other = read_json(plans[1].file);
+  for (const json* r : {&ref, &other}) {
+    ASSERT_EQ((*r)["status"], "ok");
+    ASSERT_EQ((*r)["steps"].size(), 4u);
+    EXPECT_FALSE((*r)["steps"][0].contains("metrics"));  // step 1: not a multiple of every=2
+    EXPECT_EQ((*r)["steps"][1]["metrics"]["sphericity"], 42.0);
+    EXPECT_GT((*r)["steps"][3]["metrics"]["quasi_conformal"].get<double>(), 1.0);
+    EXPECT_EQ((*r)["initial_metrics"]["quasi_conformal"], 1.0);
+    EXPECT_EQ((*r)["frames"]["steps"], (json{0, 2, 4}));
+    for (int step : {0, 2, 4}) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05d.ply", step);
+      EXPECT_TRUE(fs::exists(out / (*r)["frames"]["dir"].get<std::string>() / name));
+    }
+    EXPECT_EQ((*r)["cell"]["study"], "m");
+    EXPECT_EQ((*r)["study_config"], j);
+    EXPECT_TRUE((*r).contains("environment"));
+    EXPECT_GT((*r)["peak_memory_bytes"].get<long long>(), 0);
+  }
+  EXPECT_FALSE(ref.contains("reference_distance"));  // the reference itself
+  ASSERT_TRUE(other.contains("reference_distance"));
+  const json& d = other["reference_distance"];
+  ASSERT_EQ(d.size(), 3u);
+  EXPECT_EQ(d[0]["step"], 0);
+  EXPECT_NEAR(d[0]["rms"].get<double>(), 0.0, 1e-6);  // same input mesh (frames are float PLY)
+  EXPECT_GT(d[2]["rms"].get<double>(), 1e-4);          // 4x the time step: visibly further along
+  EXPECT_EQ(d[2]["samples"], 500);
+  EXPECT_EQ(other["reference_cell"]["hash"], plans[0].hash);
+}
+
+TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
+  HookGuard guard(fake_hooks());
+  const fs::path out = fresh_dir("sharded_ref");
+  const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
+                  {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
+                  {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  o.shard_count = 2;
+  o.shard_index = 1;  // cell 1 only: its reference (cell 0) is not there yet
+  EXPECT_EQ(run_experiment(e, o).distances, 0);
+  o.shard_index = 0;  // cells 0 and 2: cell 2 gets its distance, cell 1 belongs to shard 1
+  EXPECT_EQ(run_experiment(e, o).distances, 1);
+  o.shard_count = 1;  // unsharded rerun: nothing runs, the missing distance is added
+  const RunSummary s = run_experiment(e, o);
+  EXPECT_EQ(s.ran, 0);
+  EXPECT_EQ(s.distances, 1);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  for (int i : {1, 2}) EXPECT_EQ(read_json(plans[size_t(i)].file)["reference_distance"].size(), 1u) << i;
+  EXPECT_EQ(run_experiment(e, o).distances, 0);  // nothing stale any more
+}
+
+TEST(Runner, ACellErrorIsRecordedAndTheRunGoesOn) {
+  MetricHooks h = fake_hooks();
+  h.sphericity = [](const Positions& V, const Triangles&) -> double {
+    if (V.rows() > 42) throw std::runtime_error("injected failure");
+    return 0;
+  };
+  HookGuard guard(h);
+  const fs::path out = fresh_dir("error");
+  const json j = {{"defaults", {{"steps", 2}}},
+                  {"axes", {{"mesh", {"icosphere:level=2", "icosphere:level=1"}}}},
+                  {"metrics", {{"sphericity", true}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "e.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  const RunSummary s = run_experiment(e, o);
+  EXPECT_EQ(s.ran, 2);
+  EXPECT_EQ(s.errors, 1);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  const json bad = read_json(plans[0].file), good = read_json(plans[1].file);
+  EXPECT_EQ(bad["status"], "error");
+  EXPECT_NE(bad["error"].get<std::string>().find("injected failure"), std::string::npos);
+  EXPECT_EQ(bad["cell"]["index"], 0);
+  EXPECT_EQ(good["status"], "ok");
+}
+
+TEST(Runner, MissingMetricImplementationIsAConfigErrorBeforeAnything) {
+  HookGuard guard(MetricHooks{});
+  const fs::path out = fresh_dir("nohooks") / "out";
+  const ExperimentConfig e = parse_experiment_config(
+      {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 1}}}, {"metrics", {{"quasi_conformal", true}}}}, "q.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  EXPECT_THROW(run_experiment(e, o), ConfigError);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+const char* tiny_config = R"({
+  "name": "tiny",
+  "defaults": {"mesh": "icosphere:level=1", "steps": 2, "basis": "hat", "solver": {"name": "cholmod"}},
+  "axes": {"dt": [0.001, 0.002, 0.003]}
+})";
+
+std::map<std::string, fs::file_time_type> age_files(const fs::path& dir) {
+  // Back-date the results so a rewrite shows as a newer mtime whatever the clock resolution.
+  std::map<std::string, fs::file_time_type> times;
+  const auto old = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (const auto& f : result_files(dir)) {
+    fs::last_write_time(f, old);
+    times[f.filename().string()] = fs::last_write_time(f);
+  }
+  return times;
+}
+
+TEST(RunnerCli, RerunRedoesExactlyTheMissingCell) {
+  const fs::path dir = fresh_dir("resume");
+  write_text(dir / "tiny.json", tiny_config);
+  Command c = mcfbench("run tiny.json --out out", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_NE(c.out.find("3 ran, 0 skipped, 0 errors"), std::string::npos) << c.out;
+  auto files = result_files(dir / "out");
+  ASSERT_EQ(files.size(), 3u);
+  // `expand` names the same files.
+  const Command x = mcfbench("expand tiny.json", dir);
+  ASSERT_EQ(x.status, 0) << x.err;
+  for (const auto& f : files) EXPECT_NE(x.out.find(f.stem().string()), std::string::npos) << x.out;
+
+  auto before = age_files(dir / "out");
+  const std::string victim = files[1].filename().string();
+  fs::remove(files[1]);
+  // A temporary file left by a killed writer must not count as a result.
+  write_text(dir / "out" / (files[0].filename().string() + ".tmp.12345"), "{\"trunc");
+  c = mcfbench("run tiny.json --out out", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_NE(c.out.find("1 ran, 2 skipped"), std::string::npos) << c.out;
+  files = result_files(dir / "out");
+  ASSERT_EQ(files.size(), 3u);
+  for (const auto& f : files) {
+    const std::string name = f.filename().string();
+    if (name == victim) EXPECT_GT(fs::last_write_time(f), before.begin()->second) << "not recomputed";
+    else EXPECT_EQ(fs::last_write_time(f), before[name]) << name << " recomputed";
+  }
+  c = mcfbench("run tiny.json --out out --force", dir);
+  EXPECT_NE(c.out.find("3 ran, 0 skipped"), std::string::npos) << c.out;
+  // Default output folder: results/<name>, and results/<name>-quick with --quick.
+  c = mcfbench("run tiny.json --shard 0/3", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(result_files(dir / "results" / "tiny").size(), 1u);
+}
+
+TEST(RunnerCli, KilledRunLosesNoFinishedCellAndRepeatsNone) {
+  const fs::path dir = fresh_dir("killed");
+  write_text(dir / "slow.json", R"({
+    "name": "slow",
+    "defaults": {"mesh": "icosphere:level=4", "steps": 40, "dt": 1e-4, "threads": 1},
+    "axes": {"dt": [1e-4, 2e-4, 3e-4, 4e-4, 5e-4, 6e-4]}})");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) _exit(127);
+    std::freopen("/dev/null", "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", "slow.json", "--out", "out", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (result_files(dir / "out").size() < 2 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const auto finished = result_files(dir / "out");
+  ASSERT_GE(finished.size(), 2u);
+  if (finished.size() == 6u) GTEST_SKIP() << "the run finished before it could be killed";
+  for (const auto& f : finished) EXPECT_NO_THROW(read_json(f)) << f << " is partial";
+  auto before = age_files(dir / "out");
+
+  const Command c = mcfbench("run slow.json --out out", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  const size_t redo = 6 - finished.size();
+  EXPECT_NE(c.out.find(std::to_string(redo) + " ran, " + std::to_string(finished.size()) + " skipped"), std::string::npos)
+      << c.out;
+  EXPECT_EQ(result_files(dir / "out").size(), 6u);
+  for (const auto& [name, t] : before) EXPECT_EQ(fs::last_write_time(dir / "out" / name), t) << name << " recomputed";
+}
+
+TEST(RunnerCli, ShardsThenCollect) {
+  const fs::path dir = fresh_dir("shards");
+  write_text(dir / "tiny.json", tiny_config);
+  for (int i = 0; i < 3; ++i) {
+    const Command c = mcfbench("run tiny.json --out s" + std::to_string(i) + " --shard " + std::to_string(i) + "/3", dir);
+    ASSERT_EQ(c.status, 0) << c.err;
+    EXPECT_EQ(result_files(dir / ("s" + std::to_string(i))).size(), 1u);
+  }
+  Command c = mcfbench("collect s0 s1 --out partial.json", dir);
+  EXPECT_NE(c.status, 0) << "a missing cell must be reported";
+  EXPECT_NE(c.out.find("1 missing"), std::string::npos) << c.out;
+  c = mcfbench("collect s0 s1 s2 --out index.json", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  const json index = read_json(dir / "index.json");
+  EXPECT_EQ(index["files"].size(), 3u);
+  EXPECT_EQ(index["studies"][0]["cells_expected"], 3);
+  EXPECT_TRUE(index["studies"][0]["missing"].empty());
+  // The same cell in two folders is a duplicate.
+  fs::copy_file(result_files(dir / "s0")[0], dir / "s1" / result_files(dir / "s0")[0].filename());
+  c = mcfbench("collect s0 s1 s2 --out dup.json", dir);
+  EXPECT_NE(c.status, 0);
+  EXPECT_EQ(read_json(dir / "dup.json")["duplicates"].size(), 1u);
+}
+
+TEST(RunnerCli, ConfigErrorsNameFileAndKeyAndWriteNothing) {
+  const fs::path dir = fresh_dir("cfgerr");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"defaults": {"mesh": "icosphere:level=1", "solver": {"cycels": 2}}})", "defaults.solver.cycels"},
+      {R"({"defaults": {"mesh": "icosphere:level=1"}, "zip": [{"dt": [0.1, 0.2], "steps": [1]}]})", "zip[0].steps"},
+      {R"({"defaults": {"mesh": "icosphere:level=1"}, "axes": {"octree.deep": [1]}})", "axes.octree.deep"},
+      {R"({"defaults": {"mesh": "icosphere:level=1"}, "bogus": 1})", "bogus"},
+      {R"({"defaults": {"mesh": "icosphere:level=1"}, "axes": {"dt": [0.1]}, "exclude": [{"dtx": 0.1}]})", "exclude[0].dtx"},
+      {R"({"defaults": {"mesh": "no_such_generator:x=1"}})", "mesh"},
+  };
+  int n = 0;
+  for (const auto& [text, key] : cases) {
+    const std::string file = "bad" + std::to_string(n++) + ".json";
+    write_text(dir / file, text);
+    const Command c = mcfbench("run " + file + " --out out", dir);
+    EXPECT_NE(c.status, 0) << text;
+    EXPECT_NE(c.err.find(file), std::string::npos) << c.err;
+    EXPECT_NE(c.err.find(key), std::string::npos) << c.err;
+    EXPECT_FALSE(fs::exists(dir / "out")) << "wrote output for " << text;
+  }
+  write_text(dir / "tiny.json", tiny_config);
+  const Command c = mcfbench("run tiny.json --shard 3/3 --out out", dir);
+  EXPECT_NE(c.status, 0);
+  EXPECT_NE(c.err.find("--shard"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+}  // namespace
+}  // namespace mcf

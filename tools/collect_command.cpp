@@ -1,0 +1,149 @@
+// `mcfbench collect DIR...`: merge result folders (e.g. the shards of a Slurm array) into one
+// index file and check them against the matrix stored in the results: every cell present once.
+
+#include "bench/experiment_config.h"
+#include "datasets/atomic_file.h"
+#include "flows/config_reader.h"
+#include "tools/commands.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+
+namespace mcf {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct CollectArgs {
+  std::vector<std::string> dirs;
+  std::string out;
+};
+
+struct Group {  // results of one study variant at one commit
+  json study_config;
+  std::string study, commit, source;
+  bool quick = false;
+  std::map<int, std::vector<std::string>> files_by_index;
+  std::vector<int> without_distance;  ///< candidates; reference cells themselves are filtered below
+};
+
+}  // namespace
+
+void add_collect_command(CLI::App& app, std::function<int()>& run) {
+  auto a = std::make_shared<CollectArgs>();
+  CLI::App* cmd = app.add_subcommand("collect", "Merge result folders (shards) into an index file; check for missing and duplicate cells.");
+  cmd->add_option("dirs", a->dirs, "Result folders")->required();
+  cmd->add_option("--out", a->out, "Index file (default FIRST_DIR/index.json)");
+  cmd->callback([a, &run] {
+    run = [a]() -> int {
+      json files = json::array();
+      std::map<std::string, Group> groups;
+      std::set<std::string> seen_hash;
+      json duplicates = json::array();
+      for (const auto& dir : a->dirs) {
+        if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder");
+        std::vector<fs::path> paths;
+        for (const auto& entry : fs::directory_iterator(dir))
+          if (entry.is_regular_file() && entry.path().extension() == ".json" && entry.path().filename() != "index.json")
+            paths.push_back(entry.path());
+        std::sort(paths.begin(), paths.end());
+        for (const auto& path : paths) {
+          json r;
+          try {
+            std::ifstream in(path);
+            r = json::parse(in);
+          } catch (const json::parse_error& e) {
+            throw std::runtime_error(path.string() + ": JSON parse error: " + e.what());
+          }
+          if (!r.is_object() || !r.contains("cell")) continue;
+          const json& c = r["cell"];
+          const std::string commit = r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
+          const std::string hash = c.value("hash", path.stem().string());
+          json entry = {{"file", path.string()},        {"hash", hash},
+                        {"key", c.value("key", "")},     {"config_key", c.value("config_key", "")},
+                        {"index", c.value("index", -1)}, {"repetition", c.value("repetition", 0)},
+                        {"study", c.value("study", "")}, {"quick", c.value("quick", false)},
+                        {"commit", commit},              {"status", r.value("status", "")},
+                        {"assignment", c.value("assignment", json::object())}};
+          if (r.contains("frames")) entry["frames"] = (path.parent_path() / r["frames"].value("dir", "")).string();
+          files.push_back(entry);
+          // The same hash in two folders is the same cell computed twice (overlapping shards).
+          if (!seen_hash.insert(hash).second) duplicates.push_back({{"hash", hash}, {"file", path.string()}});
+          Group& g = groups[entry["study"].get<std::string>() + (entry["quick"].get<bool>() ? "-quick" : "") + "@" + commit];
+          if (g.study_config.is_null() && r.contains("study_config")) {
+            g.study_config = r["study_config"];
+            g.source = path.string() + " (study_config)";
+          }
+          g.study = entry["study"];
+          g.commit = commit;
+          g.quick = entry["quick"];
+          g.files_by_index[entry["index"].get<int>()].push_back(path.string());
+          // Cells of a study with a reference flow that still lack their distances (their
+          // reference was not finished when they ran; an unsharded rerun fills them in).
+          if (r.contains("study_config") && r["study_config"].contains("metrics") &&
+              r["study_config"]["metrics"].contains("reference") && !r.contains("reference_distance") &&
+              !r.contains("reference_cell") && r.value("status", "") != "error")
+            g.without_distance.push_back(c.value("index", -1));
+        }
+      }
+      json studies = json::array();
+      bool problems = !duplicates.empty();
+      for (auto& [name, g] : groups) {
+        json s = {{"study", g.study}, {"quick", g.quick}, {"commit", g.commit}, {"cells_found", g.files_by_index.size()}};
+        json missing = json::array(), dup = json::array();
+        for (const auto& [index, list] : g.files_by_index)
+          if (list.size() > 1) dup.push_back({{"index", index}, {"files", list}});
+        std::optional<ExperimentConfig> e;
+        if (!g.study_config.is_null()) {
+          // Re-expanding the stored matrix tells which cells should be there. Results of an older
+          // binary may hold a config this one rejects: say so instead of failing the whole index.
+          try {
+            e = parse_experiment_config(g.study_config, g.source, g.quick, g.study);
+          } catch (const ConfigError& err) {
+            s["expand_error"] = err.what();
+            std::printf("%s: cannot re-expand the stored matrix: %s\n", name.c_str(), err.what());
+          }
+        }
+        if (e) {
+          s["cells_expected"] = e->cells.size();
+          for (const Cell& c : e->cells)
+            if (!g.files_by_index.count(c.index)) missing.push_back(c.index);
+        }
+        if (e && !g.without_distance.empty()) {
+          json lacking = json::array();
+          for (int index : g.without_distance)
+            if (index >= 0 && index < int(e->cells.size()) && !matches_assignment(e->cells[size_t(index)], e->metrics.reference))
+              lacking.push_back(index);
+          if (!lacking.empty()) {
+            s["without_reference_distance"] = lacking;
+            std::printf("%s: %zu cells lack their reference distance (rerun `mcfbench run` without --shard to add them)\n",
+                        name.c_str(), lacking.size());
+          }
+        }
+        s["missing"] = missing;
+        s["duplicates"] = dup;
+        problems = problems || !missing.empty() || !dup.empty();
+        std::printf("%s: %zu cells found%s, %zu missing, %zu duplicated\n", name.c_str(), g.files_by_index.size(),
+                    s.contains("cells_expected") ? (" of " + std::to_string(s["cells_expected"].get<size_t>())).c_str() : "",
+                    missing.size(), dup.size());
+        if (!missing.empty()) std::printf("  missing cell indices: %s\n", missing.dump().c_str());
+        studies.push_back(s);
+      }
+      const std::string out = !a->out.empty() ? a->out : (fs::path(a->dirs.front()) / "index.json").string();
+      write_file_atomic(out, json{{"schema", 1}, {"dirs", a->dirs}, {"studies", studies}, {"duplicates", duplicates}, {"files", files}}.dump(1) + "\n");
+      std::printf("wrote %s (%zu result files)%s\n", out.c_str(), files.size(), problems ? "; INCOMPLETE or DUPLICATED cells" : "");
+      return problems ? 1 : 0;
+    };
+  });
+}
+
+}  // namespace mcf
