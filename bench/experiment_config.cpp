@@ -253,14 +253,20 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
   if (!q.is_null()) {
     if (!q.is_object()) fail(source, "quick", "expected an object, got " + q.dump());
     for (auto it = q.begin(); it != q.end(); ++it)
-      if (it.key() != "defaults" && it.key() != "axes" && it.key() != "zip" && it.key() != "exclude" && it.key() != "repetitions")
-        fail(source, "quick." + it.key(), "unknown key (known: defaults, axes, zip, exclude, repetitions)");
+      if (it.key() != "defaults" && it.key() != "axes" && it.key() != "zip" && it.key() != "exclude" &&
+          it.key() != "repetitions" && it.key() != "metrics")
+        fail(source, "quick." + it.key(), "unknown key (known: defaults, axes, zip, exclude, repetitions, metrics)");
     if (q.contains("defaults")) check_config_object(q["defaults"], source, "quick.defaults.");
     check_axes(member(q, "axes"), source, "quick.axes");
     check_zip(member(q, "zip"), source, "quick.zip");
     check_exclude(member(q, "exclude"), source, "quick.exclude");
     const int quick_reps = read_repetitions(member(q, "repetitions"), source, "quick.repetitions");
+    // quick.metrics replaces metrics as a whole (smaller frame lists and sample counts).
+    const bool quick_metrics = q.contains("metrics");
+    const MetricsConfig quick_metric_config =
+        quick_metrics ? read_metrics(q["metrics"], source) : MetricsConfig{};
     if (quick) {
+      if (quick_metrics) e.metrics = quick_metric_config;
       // defaults: deep merge; axes: per key (a quick axis replaces the full one);
       // zip, exclude, repetitions: replaced as a whole.
       if (q.contains("defaults")) defaults.merge_patch(q["defaults"]);

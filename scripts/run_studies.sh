@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Runs studies of bench/configs (all by default) and regenerates their report.
+#   scripts/run_studies.sh [--quick] [--out DIR] [STUDY ...]
+# Results: DIR/results/<study>/ (one JSON per cell; reruns skip finished cells),
+# report: DIR/report/index.md. Default DIR: out/studies (out/studies-quick with --quick).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${MCFBENCH_BUILD:-$root/build}
+quick=""; out=""; studies=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick) quick="--quick" ;;
+    --out) out="$2"; shift ;;
+    *) studies+=("$1") ;;
+  esac
+  shift
+done
+[ -n "$out" ] || out="$root/out/studies${quick:+-quick}"
+if [ ${#studies[@]} -eq 0 ]; then
+  studies=(table1 sphere_error model_error depth_cycles cubature cmcf time_order)
+fi
+status=0
+dirs=()
+for s in "${studies[@]}"; do
+  echo "== study $s ${quick}" >&2
+  "$build/mcfbench" run "$root/bench/configs/$s.json" $quick --out "$out/results/$s" || status=1
+  dirs+=("$out/results/$s")
+done
+/usr/bin/python3 "$root/reports/make_report.py" "${dirs[@]}" "$out/report" --references "$root/bench/configs" || status=1
+echo "report: $out/report/index.md" >&2
+exit $status
