@@ -1,5 +1,7 @@
 #include "bases/octree_basis.h"
 
+#include "datasets/subdivide.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -76,33 +78,6 @@ std::vector<int> boundary_functions(const Octree& octree, const Positions& verti
   return out;
 }
 
-TriangleMesh split_1_to_4(const TriangleMesh& mesh) {
-  const Eigen::Index n = mesh.num_vertices(), m = mesh.num_faces();
-  std::unordered_map<std::uint64_t, int> mid;
-  mid.reserve(static_cast<std::size_t>(3 * m));
-  std::vector<Eigen::Vector3d> extra;
-  Triangles F(4 * m, 3);
-  for (Eigen::Index f = 0; f < m; ++f) {
-    int e[3];
-    for (int c = 0; c < 3; ++c) {
-      const int a = mesh.faces(f, c), b = mesh.faces(f, (c + 1) % 3);
-      auto [it, inserted] = mid.try_emplace(edge_key(a, b), static_cast<int>(n + static_cast<Eigen::Index>(extra.size())));
-      if (inserted) extra.push_back(0.5 * (mesh.vertices.row(a) + mesh.vertices.row(b)).transpose());
-      e[c] = it->second;
-    }
-    const int v0 = mesh.faces(f, 0), v1 = mesh.faces(f, 1), v2 = mesh.faces(f, 2);
-    F.row(4 * f + 0) << v0, e[0], e[2];
-    F.row(4 * f + 1) << e[0], v1, e[1];
-    F.row(4 * f + 2) << e[2], e[1], v2;
-    F.row(4 * f + 3) << e[0], e[1], e[2];
-  }
-  TriangleMesh out;
-  out.vertices.resize(n + static_cast<Eigen::Index>(extra.size()), 3);
-  out.vertices.topRows(n) = mesh.vertices;
-  for (std::size_t i = 0; i < extra.size(); ++i) out.vertices.row(n + static_cast<Eigen::Index>(i)) = extra[i].transpose();
-  out.faces = std::move(F);
-  return out;
-}
 
 RebuiltOctreeBasis::RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions options) : options_(options) {
   if (options_.depth < 4 || options_.depth > 10)
@@ -110,7 +85,7 @@ RebuiltOctreeBasis::RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   (void)cubature_rule(options_.cubature);  // validates
   if (mesh.num_faces() == 0) throw std::invalid_argument("RebuiltOctreeBasis: mesh has no faces");
   input_vertices_ = mesh.num_vertices();
-  mesh_ = options_.refine_input ? split_1_to_4(mesh) : mesh;
+  mesh_ = options_.refine_input ? subdivide_midpoint(mesh) : mesh;
   rebuild(mesh.vertices);
 }
 
@@ -126,11 +101,11 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
       mesh_.vertices = last_evaluated_;
     } else {
       mesh_.vertices.topRows(n) = vertices;  // midpoints of the current edges
-      // Midpoint vertex of edge (a,b) is the one shared by the four sub-faces; recompute from the
-      // corner faces: sub-face 4f+0 = (v0, e01, e20), 4f+1 = (e01, v1, e12).
+      // Midpoint vertices from the corner sub-faces of subdivide_midpoint:
+      // 4f+0 = (v0, m01, m20), 4f+1 = (v1, m12, m01), 4f+2 = (v2, m20, m12).
       for (Eigen::Index f = 0; f < mesh_.num_faces() / 4; ++f) {
-        const int v0 = mesh_.faces(4 * f, 0), v1 = mesh_.faces(4 * f + 1, 1), v2 = mesh_.faces(4 * f + 2, 2);
-        const int e01 = mesh_.faces(4 * f, 1), e20 = mesh_.faces(4 * f, 2), e12 = mesh_.faces(4 * f + 1, 2);
+        const int v0 = mesh_.faces(4 * f, 0), v1 = mesh_.faces(4 * f + 1, 0), v2 = mesh_.faces(4 * f + 2, 0);
+        const int e01 = mesh_.faces(4 * f, 1), e20 = mesh_.faces(4 * f, 2), e12 = mesh_.faces(4 * f + 1, 1);
         mesh_.vertices.row(e01) = 0.5 * (vertices.row(v0) + vertices.row(v1));
         mesh_.vertices.row(e12) = 0.5 * (vertices.row(v1) + vertices.row(v2));
         mesh_.vertices.row(e20) = 0.5 * (vertices.row(v2) + vertices.row(v0));

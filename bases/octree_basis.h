@@ -31,9 +31,6 @@ std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces);
 /// of every finest cell a boundary edge passes through. Sorted, unique.
 std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices, const Triangles& faces);
 
-/// One 1-to-4 midpoint split (original vertices keep their indices 0..n-1, then one vertex per edge).
-TriangleMesh split_1_to_4(const TriangleMesh& mesh);
-
 class RebuiltOctreeBasis : public Basis {
  public:
   /// Builds from the mesh's initial positions (faces are fixed from now on).
