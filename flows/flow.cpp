@@ -165,6 +165,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
   Coefficients x = basis->initial_coefficients(), x_prev;
   bool has_prev = false;
   const double area0 = surface_area(mesh);
+  double previous_area = area0;
   std::optional<SphereReference> sphere;
   if (source.sphere_radius && !config.normalize_area) sphere.emplace(*source.sphere_radius, config.flow == "heat");
 
@@ -226,10 +227,12 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
       stop(step, "collapsed area (" + std::to_string(area) + ")");
       break;
     }
-    if (area > 1e3 * area0) {
-      // MCF, cMCF and heat flow never increase the area: this is an unstable (explicit) step.
+    if (area > 1.05 * previous_area) {
+      // MCF, cMCF and heat flow never increase the area; a step that grows it by more than 5%
+      // is an unstable (explicit) step, not a flow.
       steps.push_back(record);
-      stop(step, "diverged: area grew to " + std::to_string(area / area0) + "x the initial area");
+      stop(step, "diverged: the area grew by " + std::to_string(int(std::lround(100 * (area / previous_area - 1)))) +
+                     "% in one step (unstable time step)");
       break;
     }
     double step_difference = 0;
@@ -240,6 +243,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
       apply(n, x);  // becomes X_{n-1}: same frame as X_n for two-step schemes
     }
     step_difference = (V_new - V).norm();
+    previous_area = config.normalize_area ? 1.0 : area;
     const double evaluate_seconds = seconds_since(eval_start);
 
     record["area"] = area;
@@ -252,6 +256,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
                                 {"max", d.max},
                                 {"rms_continuous", c.rms},
                                 {"max_continuous", c.max},
+                                {"mean_radius", V_new.rowwise().norm().mean()},
                                 {"radius_semi_implicit", sphere->discrete},
                                 {"radius_continuous", sphere->continuous(t)}};
     }

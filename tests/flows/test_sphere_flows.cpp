@@ -102,6 +102,16 @@ TEST(SphereFlows, PinchStopsCleanly) {
   EXPECT_FALSE(o.result["stop"]["reason"].get<std::string>().empty());
 }
 
+TEST(SphereFlows, UnstableExplicitStepStopsAsDiverged) {
+  // Beyond its stability limit (~h²) explicit Euler amplifies the highest frequencies and the
+  // area grows: the flow stops and says why, instead of producing a plausible-looking radius.
+  const auto o = run(json{{"mesh", "icosphere:level=3"}, {"integrator", "explicit-euler"}, {"dt", 0.01}, {"steps", 50}});
+  EXPECT_EQ(o.result["status"], "singular");
+  EXPECT_NE(o.result["stop"]["reason"].get<std::string>().find("diverged"), std::string::npos);
+  const auto stable = run(json{{"mesh", "icosphere:level=3"}, {"integrator", "explicit-euler"}, {"dt", 5e-4}, {"steps", 50}});
+  EXPECT_EQ(stable.result["status"], "ok");
+}
+
 TEST(SphereFlows, NormalizationKeepsUnitArea) {
   const auto o = run(json{{"mesh", "icosphere:level=3,radius=2"}, {"normalize_area", true}, {"dt", 1e-2}, {"steps", 5}});
   const Positions& V = o.final_mesh.vertices;
