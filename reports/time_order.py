@@ -109,7 +109,8 @@ def make(results, out_dir, reference, written):
         unstable = [common.get(r, "config.dt") for r in with_dt if not stable(r, threshold, refs)]
         rows.append([name, common.fmt(slope, "%.2f"), len(pts), common.fmt(max(stable_dts) if stable_dts else None),
                      common.fmt(min(unstable) if unstable else None),
-                     str(expected.get(name.split(": ")[-1], expected.get(name.split(": ")[-1].split(" ")[0], "—")))])
+                     str(expected.get(name, expected.get(name.split(": ")[-1],
+                                                          expected.get(name.split(": ")[-1].split(" ")[0], "—"))))])
     ax.set_xscale("log")
     common.log_if_positive(ax, values)
     ax.set_xlabel("time step δ")
