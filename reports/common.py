@@ -200,9 +200,14 @@ def log_if_positive(ax, values, axis="y"):
         (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
 
 
-def sources_line(results):
-    """Caption text naming the result files a figure/table came from."""
-    return "Sources: " + ", ".join(os.path.basename(r["_path"]) for r in results)
+def sources_line(results, limit=6):
+    """Caption text naming the result files a figure/table came from; long lists are shortened
+    (the full list is always in the NAME.sources.txt sidecar) so the caption fits the figure."""
+    names = [os.path.basename(r["_path"]) for r in results]
+    if len(names) <= limit:
+        return "Sources: " + ", ".join(names)
+    return "Sources: %s, … (%d result files; full list in the .sources.txt beside this file)" % (
+        ", ".join(names[:3]), len(names))
 
 
 def write_sources(out_path, results):
