@@ -16,7 +16,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   {
     auto o = r.child("octree");
     c.octree.tracking = o.get_string("tracking", c.octree.tracking, {"tracked", "rebuilt"});
-    c.octree.depth = int(o.get_integer("depth", c.octree.depth, 2, 10));
+    c.octree.depth = int(o.get_integer("depth", c.octree.depth, 4, 10));
     c.octree.cubature = int(o.get_integer("cubature", c.octree.cubature, 1, 6));
     if (c.octree.cubature != 1 && c.octree.cubature != 3 && c.octree.cubature != 6)
       o.fail("cubature", "must be 1, 3 or 6, got " + std::to_string(c.octree.cubature));
