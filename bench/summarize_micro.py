@@ -16,7 +16,10 @@ def load(path):
     for b in data.get("benchmarks", []):
         if b.get("run_type", "iteration") != "iteration":
             continue
-        out[b["run_name"] if "run_name" in b else b["name"]] = b
+        name = b.get("run_name", b["name"])
+        # "BM_X/threads:2/iterations:5/real_time" -> "BM_X/threads:2"
+        name = "/".join(p for p in name.split("/") if p != "real_time" and not p.startswith("iterations:"))
+        out[name] = b
     return data.get("context", {}), out
 
 
