@@ -367,6 +367,22 @@ void BM_Step_Tracked(benchmark::State& state) {
 }
 BENCHMARK(BM_Step_Tracked)->ArgName("threads")->Arg(2)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 
+// The tracked update alone, by matrix (range(0): 1 = mass, 2 = stiffness, 3 = both), 1 thread:
+// shows how the per-step update splits between the shared per-point geometry and each matrix.
+void BM_Tracked_Update(benchmark::State& state) {
+  auto& f = tracked_fixture();
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
+  const bool mass = state.range(0) & 1, stiffness = state.range(0) & 2;
+  for (auto _ : state) {
+    f.basis->update(f.x, mass, stiffness);
+    benchmark::DoNotOptimize(f.basis->stiffness().valuePtr());
+  }
+  f.basis->update(f.x, true, true);  // leave both matrices current for the step benchmarks
+  state.SetLabel(mass && stiffness ? "mass+stiffness" : mass ? "mass" : "stiffness");
+  step_counters(state, f.c, *f.source, f.basis->stats());
+}
+BENCHMARK(BM_Tracked_Update)->ArgName("matrices")->Arg(3)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
 struct RebuiltStepFixture {
   Case c;
   const MeshSource* source = nullptr;
