@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""Turns the Google Benchmark JSON of mcfbench_micro (bench/micro_octree.cpp) into the Markdown
+tables of the README: rebuilt phases per mesh, and the per-step ratios (tracked vs rebuilt,
+tracked vs hat + CHOLMOD, 2 vs 1 threads, W-cycle / SpMV, bytes per cubature point) with their
+targets and the paper's values. Ratios only compare benchmarks of the same JSON file (same run).
+
+Usage: bench/summarize_micro.py micro_octree.json [> table.md]
+"""
+import json
+import sys
+
+
+def load(path):
+    data = json.load(open(path))
+    out = {}
+    for b in data.get("benchmarks", []):
+        if b.get("run_type", "iteration") != "iteration":
+            continue
+        name = b.get("run_name", b["name"])
+        # "BM_X/threads:2/iterations:5/real_time" -> "BM_X/threads:2"
+        name = "/".join(p for p in name.split("/") if p != "real_time" and not p.startswith("iterations:"))
+        out[name] = b
+    return data.get("context", {}), out
+
+
+def ms(b):
+    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b.get("time_unit", "ns")]
+    return b["real_time"] * scale
+
+
+def fmt(x, digits=3):
+    if x is None:
+        return "—"
+    if isinstance(x, float) and (abs(x) >= 1e4 or (abs(x) < 1e-2 and x != 0)):
+        return f"{x:.{digits}g}"
+    if isinstance(x, float):
+        return f"{x:.{digits}g}" if abs(x) < 100 else f"{x:.0f}"
+    return str(x)
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__, file=sys.stderr)
+        sys.exit(2)
+    ctx, b = load(sys.argv[1])
+    get = b.get
+    lines = []
+    lines.append(f"Machine: {ctx.get('host_name', '?')}, {ctx.get('num_cpus', '?')} CPUs "
+                 f"@ {ctx.get('mhz_per_cpu', '?')} MHz, run {ctx.get('date', '?')}\n")
+
+    # Rebuilt phases, one column per mesh.
+    meshes = [(0, "armadillo"), (1, "sphere")]
+    phases = [("octree build", "BM_Rebuilt_Octree/mesh:{m}"), ("clipping", "BM_Rebuilt_Clip/mesh:{m}"),
+              ("integration", "BM_Rebuilt_Integrate/mesh:{m}"),
+              ("hierarchy (prolongations + colours)", "BM_Rebuilt_Hierarchy/mesh:{m}"),
+              ("multigrid set_matrix (numeric)", "BM_Rebuilt_SetMatrix/mesh:{m}"),
+              ("one V-cycle (5 GS)", "BM_Rebuilt_Cycle/mesh:{m}/W:0"),
+              ("one W-cycle (5 GS)", "BM_Rebuilt_Cycle/mesh:{m}/W:1"),
+              ("one fine SpMV (3 columns)", "BM_Rebuilt_SpMV/mesh:{m}")]
+    present = [(m, n) for m, n in meshes if any(k.format(m=m) in b for _, k in phases)]
+    if present:
+        def any_bench(m):
+            for _, k in phases:
+                if k.format(m=m) in b:
+                    return b[k.format(m=m)]
+            return {}
+        head = []
+        for m, n in present:
+            x = any_bench(m)
+            head.append(f"{x.get('label', n)} depth {int(x.get('depth', 0))}")
+        lines.append("| rebuilt phase (ms) | " + " | ".join(head) + " |")
+        lines.append("|---|" + "---:|" * len(present))
+        for name, k in phases:
+            row = [fmt(ms(b[k.format(m=m)])) if k.format(m=m) in b else "—" for m, _ in present]
+            lines.append(f"| {name} | " + " | ".join(row) + " |")
+        for cname, label in [("vertices", "input vertices"), ("split_triangles", "split triangles"),
+                             ("dimension", "dimension"), ("cubature_points", "cubature points"),
+                             ("levels", "levels"), ("nnz", "fine nonzeros")]:
+            row = [fmt(float(any_bench(m).get(cname, 0)), 3) for m, _ in present]
+            lines.append(f"| {label} | " + " | ".join(row) + " |")
+        row = []
+        for m, _ in present:
+            w = get(f"BM_Rebuilt_Cycle/mesh:{m}/W:1")
+            row.append(fmt(w.get("wcycle_over_spmv")) if w else "—")
+        lines.append("| W-cycle / SpMV (target ≤ 20) | " + " | ".join(row) + " |")
+        lines.append("")
+        sph = get("BM_Rebuilt_Clip/mesh:1") or get("BM_Rebuilt_Cycle/mesh:1/W:1")
+        if sph:
+            lines.append(f"Sphere at depth {int(sph['depth'])}: {int(sph['vertices'])} vertices, "
+                         f"{int(sph['split_triangles'])} split triangles, dimension {int(sph['dimension'])} "
+                         f"(paper, 3.7e5-vertex sphere at depth 8: 3.8e6 split triangles, dimension 5.1e5).\n")
+
+    # Per-step comparisons.
+    t2, t1 = get("BM_Step_Tracked/threads:2"), get("BM_Step_Tracked/threads:1")
+    rb, hat = get("BM_Step_Rebuilt/threads:2"), get("BM_Step_HatCholmod/threads:2")
+    lines.append("| per step (armadillo, one W-cycle, 5 GS) | ms | breakdown (ms) |")
+    lines.append("|---|---:|---|")
+    if t2:
+        lines.append(f"| tracked, 2 threads | {fmt(ms(t2))} | update {fmt(t2['update_ms'])}, set_matrix "
+                     f"{fmt(t2['set_matrix_ms'])}, solve {fmt(t2['solve_ms'])}, evaluate {fmt(t2['evaluate_ms'])} |")
+    if t1:
+        lines.append(f"| tracked, 1 thread | {fmt(ms(t1))} | update {fmt(t1['update_ms'])}, set_matrix "
+                     f"{fmt(t1['set_matrix_ms'])}, solve {fmt(t1['solve_ms'])}, evaluate {fmt(t1['evaluate_ms'])} |")
+    if rb:
+        lines.append(f"| rebuilt, 2 threads | {fmt(ms(rb))} | rebuild {fmt(rb['rebuild_ms'])}, set_matrix "
+                     f"{fmt(rb['set_matrix_ms'])}, solve {fmt(rb['solve_ms'])}, evaluate {fmt(rb['evaluate_ms'])} |")
+    if hat:
+        lines.append(f"| hat + CHOLMOD, 2 threads | {fmt(ms(hat))} | update {fmt(hat['update_ms'])}, "
+                     f"refactorize {fmt(hat['factorize_ms'])}, solve {fmt(hat['solve_ms'])} |")
+    lines.append("")
+    lines.append("| ratio | ours | target | paper |")
+    lines.append("|---|---:|---:|---:|")
+
+    def ratio(a, c):
+        return ms(a) / ms(c) if a and c else None
+
+    lines.append(f"| rebuilt / tracked per step | {fmt(ratio(rb, t2))}× | — | ~7× |")
+    r = ratio(hat, t2)
+    lines.append(f"| hat+CHOLMOD / tracked per step | {fmt(r)}× | ≥ 3× | — |")
+    lines.append(f"| tracked 1 thread / 2 threads | {fmt(ratio(t1, t2))}× | ≥ 1.7× | — |")
+    for m, n in meshes:
+        w = get(f"BM_Rebuilt_Cycle/mesh:{m}/W:1")
+        if w:
+            lines.append(f"| W-cycle / fine SpMV ({n}) | {fmt(w['wcycle_over_spmv'])} | ≤ 20 | — |")
+    tb = t2 or t1
+    if tb:
+        lines.append(f"| bytes of preprocessed data per cubature point | {fmt(tb['bytes_per_cubature_point'])} "
+                     f"| ≤ 33 | 100 |")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
