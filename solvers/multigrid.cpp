@@ -102,10 +102,10 @@ inline void residual_rows(const Csc& A, const double* b, const double* x, double
   }
 }
 
-/// y = Mᵀ v restricted to output rows [begin, end) = columns of M (gather along columns).
-template <int K>
-inline void transpose_apply_rows(const Csc& M, const double* v, double* y, std::size_t s, int o,
-                                 int begin, int end) {
+/// y = Mᵀ v (or y += Mᵀ v when Add) on output rows [begin, end) = columns of M (gather along
+/// columns, so parallel output ranges never write the same entry).
+template <int K, bool Add>
+inline void transpose_rows(const Csc& M, const double* v, double* y, std::size_t s, int o, int begin, int end) {
   for (int J = begin; J < end; ++J) {
     double acc[K] = {};
     for (int p = M.outer[J]; p < M.outer[J + 1]; ++p) {
@@ -114,23 +114,7 @@ inline void transpose_apply_rows(const Csc& M, const double* v, double* y, std::
       for (int c = 0; c < K; ++c) acc[c] += w * vi[c];
     }
     double* yJ = y + std::size_t(J) * s + o;
-    for (int c = 0; c < K; ++c) yJ[c] = acc[c];
-  }
-}
-
-/// y += Mᵀ v (rows [begin, end) of the output).
-template <int K>
-inline void transpose_add_rows(const Csc& M, const double* v, double* y, std::size_t s, int o,
-                               int begin, int end) {
-  for (int J = begin; J < end; ++J) {
-    double acc[K] = {};
-    for (int p = M.outer[J]; p < M.outer[J + 1]; ++p) {
-      const double w = M.val[p];
-      const double* vi = v + std::size_t(M.inner[p]) * s + o;
-      for (int c = 0; c < K; ++c) acc[c] += w * vi[c];
-    }
-    double* yJ = y + std::size_t(J) * s + o;
-    for (int c = 0; c < K; ++c) yJ[c] += acc[c];
+    for (int c = 0; c < K; ++c) yJ[c] = Add ? yJ[c] + acc[c] : acc[c];
   }
 }
 
@@ -417,7 +401,7 @@ struct MultigridSolver::Impl {
     const Csc P(C.P), PT(C.PT);
     for_column_chunks(k, [&](auto KC, int o) {
       constexpr int K = decltype(KC)::value;
-      for_rows(P.cols, [&](int b, int e) { transpose_apply_rows<K>(P, F.r.data(), C.b.data(), s, o, b, e); });
+      for_rows(P.cols, [&](int b, int e) { transpose_rows<K, false>(P, F.r.data(), C.b.data(), s, o, b, e); });
     });
     std::fill(C.x.begin(), C.x.end(), 0.0);
     // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
@@ -426,7 +410,7 @@ struct MultigridSolver::Impl {
     // Prolongation: x_F += P x_C (gather over the columns of Pᵀ = rows of P).
     for_column_chunks(k, [&](auto KC, int o) {
       constexpr int K = decltype(KC)::value;
-      for_rows(PT.cols, [&](int b, int e) { transpose_add_rows<K>(PT, C.x.data(), F.x.data(), s, o, b, e); });
+      for_rows(PT.cols, [&](int b, int e) { transpose_rows<K, true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
     });
     for (int i = 0; i < opt.post_smooth; ++i) sweep(l, true);
   }
