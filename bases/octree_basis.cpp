@@ -1,6 +1,7 @@
 #include "bases/octree_basis.h"
 
 #include "datasets/subdivide.h"
+#include "datasets/validate.h"
 
 #include <tbb/parallel_for.h>
 
@@ -9,7 +10,6 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 namespace mcf {
 namespace {
@@ -17,28 +17,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-std::uint64_t edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
-
 }  // namespace
-
-std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces) {
-  std::vector<std::uint64_t> e;
-  e.reserve(static_cast<std::size_t>(3 * faces.rows()));
-  for (Eigen::Index f = 0; f < faces.rows(); ++f)
-    for (int c = 0; c < 3; ++c) e.push_back(edge_key(faces(f, c), faces(f, (c + 1) % 3)));
-  std::sort(e.begin(), e.end());
-  std::vector<std::array<int, 2>> out;
-  for (std::size_t i = 0; i < e.size();) {
-    std::size_t j = i;
-    while (j < e.size() && e[j] == e[i]) ++j;
-    if (j - i == 1) out.push_back({static_cast<int>(e[i] >> 32), static_cast<int>(e[i] & 0xffffffffu)});
-    i = j;
-  }
-  return out;
-}
 
 std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices, const Triangles& faces) {
   const OctreeLevel& L = octree.finest();

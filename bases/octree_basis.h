@@ -8,6 +8,7 @@
 #include "bases/cubature.h"
 #include "bases/octree.h"
 #include "bases/octree_system.h"
+#include "datasets/validate.h"  // boundary_edges
 
 #include <array>
 #include <memory>
@@ -23,9 +24,6 @@ struct OctreeOptions {
   bool refine_input = false;              ///< 1-to-4 split of the initial mesh first
   int coarsest_depth = 2;                 ///< coarsest multigrid level (clamped to depth)
 };
-
-/// Boundary edges (edges with exactly one incident face) as vertex pairs (smaller index first).
-std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces);
 
 /// Finest-level functions whose support meets a boundary edge (or a boundary vertex): the corners
 /// of every finest cell a boundary edge passes through. Sorted, unique.

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
@@ -41,13 +42,13 @@ struct EdgeUse {
   bool operator<(const EdgeUse& o) const { return key < o.key || (key == o.key && face < o.face); }
 };
 
-std::vector<EdgeUse> sorted_edge_uses(const TriangleMesh& mesh) {
-  const Eigen::Index m = mesh.num_faces();
+std::vector<EdgeUse> sorted_edge_uses(const Triangles& faces) {
+  const Eigen::Index m = faces.rows();
   std::vector<EdgeUse> uses(3 * m);
   for (Eigen::Index f = 0; f < m; ++f)
     for (int c = 0; c < 3; ++c) {
-      std::uint64_t a = static_cast<std::uint32_t>(mesh.faces(f, c));
-      std::uint64_t b = static_cast<std::uint32_t>(mesh.faces(f, (c + 1) % 3));
+      std::uint64_t a = static_cast<std::uint32_t>(faces(f, c));
+      std::uint64_t b = static_cast<std::uint32_t>(faces(f, (c + 1) % 3));
       const bool forward = a < b;
       if (!forward) std::swap(a, b);
       uses[3 * f + c] = {(a << 32) | b, f, forward};
@@ -108,7 +109,7 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
   }
 
   // Edges: a run of equal keys in the sorted list is one undirected edge and its faces.
-  const auto uses = sorted_edge_uses(mesh);
+  const auto uses = sorted_edge_uses(mesh.faces);
   UnionFind uf(static_cast<size_t>(n));
   for (Eigen::Index f = 0; f < m; ++f) {
     uf.unite(mesh.faces(f, 0), mesh.faces(f, 1));
@@ -162,17 +163,23 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
   return report;
 }
 
-std::vector<int> boundary_vertices(const TriangleMesh& mesh) {
-  const auto uses = sorted_edge_uses(mesh);
-  std::vector<int> out;
+std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces) {
+  const auto uses = sorted_edge_uses(faces);
+  std::vector<std::array<int, 2>> out;
   for (size_t i = 0; i < uses.size();) {
     size_t j = i;
     while (j < uses.size() && uses[j].key == uses[i].key) ++j;
-    if (j - i == 1) {
-      out.push_back(edge_a(uses[i].key));
-      out.push_back(edge_b(uses[i].key));
-    }
+    if (j - i == 1) out.push_back({edge_a(uses[i].key), edge_b(uses[i].key)});
     i = j;
+  }
+  return out;
+}
+
+std::vector<int> boundary_vertices(const TriangleMesh& mesh) {
+  std::vector<int> out;
+  for (const auto& e : boundary_edges(mesh.faces)) {
+    out.push_back(e[0]);
+    out.push_back(e[1]);
   }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());

@@ -5,6 +5,7 @@
 #include "datasets/mesh.h"
 #include "datasets/mesh_error.h"
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name);
 
 /// Unreferenced vertices do not count in χ or components. Boundary loops are the connected
 /// components of the boundary-edge graph (two holes touching at one vertex count as one).
+
+/// Edges with exactly one incident face, as vertex pairs (smaller index first), sorted.
+std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces);
 
 /// Vertices on a boundary loop (sorted, unique).
 std::vector<int> boundary_vertices(const TriangleMesh& mesh);
