@@ -31,6 +31,7 @@ class HatBasis final : public Basis {
   MassKind mass_kind_;
   FixedPattern pattern_;  // 9 slots per face, gathered per nonzero
   SparseMatrix mass_, stiffness_;
+  std::vector<double> local_mass_, local_stiffness_;  // per-face 3x3 blocks, reused every step
   std::vector<int> boundary_;
   BasisStats stats_;
 };
