@@ -21,6 +21,12 @@ ReducedSystem::ReducedSystem(const Basis& basis, LinearSolver& solver)
   std::sort(base_fixed_.begin(), base_fixed_.end());
 }
 
+bool ReducedSystem::shares_pattern(const SparseMatrix& M, const SparseMatrix& K) {
+  // Checked once: the pattern never changes while this object lives.
+  if (shares_pattern_ < 0) shares_pattern_ = same_pattern(M, K) ? 1 : 0;
+  return shares_pattern_ == 1;
+}
+
 Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, const Coefficients& fixed_values,
                                   const Coefficients& warm) {
   const SparseMatrix& M = basis_.mass();
@@ -30,8 +36,8 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   if (b == 0.0) {
     sum_ = M;
     if (a != 1.0) sum_ *= a;
-  } else if (same_pattern(M, K)) {
-    if (!same_pattern(sum_, M)) sum_ = M;
+  } else if (shares_pattern(M, K)) {
+    if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) sum_ = M;
     const double *m = M.valuePtr(), *k = K.valuePtr();
     double* s = sum_.valuePtr();
     const Eigen::Index nnz = M.nonZeros();
@@ -67,7 +73,9 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     return X;
   }
 
-  if (!reduction_valid_ || fixed != fixed_ || !same_pattern(pattern_, sum_)) {
+  // The basis's pattern is fixed for this object's lifetime (a rebuilt basis gets a new
+  // ReducedSystem), so only a change of the fixed set needs a new reduction.
+  if (!reduction_valid_ || fixed != fixed_) {
     fixed_ = std::move(fixed);
     rebuild_reduction(sum_);
   }
@@ -146,7 +154,6 @@ void ReducedSystem::rebuild_reduction(const SparseMatrix& S) {
       colours_.back() = std::move(finest);
     }
   }
-  pattern_ = S;
   reduction_valid_ = true;
 }
 

@@ -3,7 +3,9 @@
 // system the solver sees stays symmetric positive definite (open boundaries, DESIGN.md), and
 // functions whose row is empty this step (no cubature point contributes: the paper's
 // "anchoring" through a pinch) are held too instead of making the matrix singular.
-// The reduced pattern and the restricted hierarchy are rebuilt only when the fixed set changes.
+// The reduced pattern and the restricted hierarchy are rebuilt only when the fixed set changes;
+// the basis's own pattern must stay fixed while a ReducedSystem lives (make a new one after a
+// rebuild).
 
 #include "bases/basis.h"
 #include "solvers/linear_solver.h"
@@ -25,6 +27,7 @@ class ReducedSystem {
 
  private:
   void rebuild_reduction(const SparseMatrix& S);
+  bool shares_pattern(const SparseMatrix& M, const SparseMatrix& K);
 
   const Basis& basis_;
   LinearSolver& solver_;
@@ -37,7 +40,7 @@ class ReducedSystem {
   std::vector<SparseMatrix> prolongations_;            // finest one row-restricted
   std::vector<std::vector<std::uint8_t>> colours_;
   bool reduction_valid_ = false;
-  SparseMatrix pattern_;               // the full matrix the reduction was built for
+  int shares_pattern_ = -1;            // M and K on one pattern? (-1: not yet checked)
   SolveReport report_;
 };
 
