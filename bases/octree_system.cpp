@@ -1,5 +1,7 @@
 #include "bases/octree_system.h"
 
+#include "bases/cell_blocks.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -34,6 +36,41 @@ Octree build_octree(const GridCube& cube, const std::vector<ClippedTriangle>& pi
   return build_octree(cube, std::move(keys), coarsest_depth);
 }
 
+namespace {
+/// Cells grouped by (tile colour, tile key), ascending cell index inside a tile.
+OctreeSystem::CellTiles build_cell_tiles(const OctreeLevel& L) {
+  constexpr int kShift = std::countr_zero(unsigned(OctreeSystem::CellTiles::kTileSide));
+  static_assert((1 << kShift) == OctreeSystem::CellTiles::kTileSide, "tile side must be a power of two");
+  const std::size_t nc = L.cells.size();
+  // Sort key: colour in the top bits, then the tile's grid key, then the cell index (stable).
+  std::vector<std::pair<std::uint64_t, int>> order(nc);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 8192), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c != r.end(); ++c) {
+      const auto ijk = grid_index(L.cells[c]);
+      const int ti = ijk[0] >> kShift, tj = ijk[1] >> kShift, tk = ijk[2] >> kShift;
+      const std::uint64_t colour = std::uint64_t((ti & 1) + 2 * (tj & 1) + 4 * (tk & 1));
+      order[c] = {(colour << 60) | grid_key(ti, tj, tk), static_cast<int>(c)};
+    }
+  });
+  std::sort(order.begin(), order.end());
+  OctreeSystem::CellTiles t;
+  t.cells.resize(nc);
+  t.colour_start.fill(0);
+  std::uint64_t previous = ~std::uint64_t(0);
+  for (std::size_t i = 0; i < nc; ++i) {
+    t.cells[i] = order[i].second;
+    if (order[i].first != previous) {
+      previous = order[i].first;
+      t.tile_start.push_back(static_cast<int>(i));
+      ++t.colour_start[static_cast<std::size_t>(previous >> 60) + 1];
+    }
+  }
+  t.tile_start.push_back(static_cast<int>(nc));
+  for (std::size_t q = 0; q < 8; ++q) t.colour_start[q + 1] += t.colour_start[q];
+  return t;
+}
+}  // namespace
+
 OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<ClippedTriangle>& pieces,
                            const std::vector<int>& piece_finest_cell)
     : octree_(&octree), pieces_(&pieces), level_(level) {
@@ -56,11 +93,7 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
     std::vector<int> next(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t p = 0; p < np; ++p) piece_order_[static_cast<std::size_t>(next[static_cast<std::size_t>(piece_cell_[p])]++)] = static_cast<int>(p);
   }
-  colour_cells_.assign(8, {});
-  for (std::size_t c = 0; c < nc; ++c) {
-    const auto ijk = grid_index(L.cells[c]);
-    colour_cells_[static_cast<std::size_t>((ijk[0] & 1) + 2 * (ijk[1] & 1) + 4 * (ijk[2] & 1))].push_back(static_cast<int>(c));
-  }
+  tiles_ = build_cell_tiles(L);
 
   // Incident cells: function J is corner b of at most one cell, incident[8J+b] (-1 if none).
   std::vector<int> incident(8 * nf, -1);
@@ -129,7 +162,7 @@ SparseMatrix OctreeSystem::pattern() const {
 void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, SparseMatrix& stiffness) const {
   const OctreeLevel& L = octree_->levels[static_cast<std::size_t>(level_)];
   const GridCube& cube = octree_->cube;
-  const double h = cube.cell_size(L.depth);
+  const double h = cube.cell_size(L.depth), inv_h = 1.0 / h;
   set_pattern(mass, outer_, inner_);
   set_pattern(stiffness, outer_, inner_);
   double* Mv = mass.valuePtr();
@@ -137,57 +170,59 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
   const int nq = rule.size();
   const auto& pieces = *pieces_;
 
+  const CellTiles& T = tiles_;
   for (int colour = 0; colour < 8; ++colour) {
-    const auto& cells = colour_cells_[static_cast<std::size_t>(colour)];
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t ci = r.begin(); ci != r.end(); ++ci) {
-        const int c = cells[ci];
-        if (ci + 2 < r.end()) {  // pieces are in triangle order: prefetch a later cell's pieces
-          const auto cn = static_cast<std::size_t>(cells[ci + 2]);
-          for (int s = cell_start_[cn]; s < cell_start_[cn + 1]; ++s) {
-            const char* p = reinterpret_cast<const char*>(&pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])]);
-            __builtin_prefetch(p);
-            __builtin_prefetch(p + 64);
+    tbb::parallel_for(tbb::blocked_range<int>(T.colour_start[std::size_t(colour)], T.colour_start[std::size_t(colour) + 1], 1),
+                      [&](const tbb::blocked_range<int>& r) {
+      CellBlocks<true, true> blocks;
+      for (int tile = r.begin(); tile != r.end(); ++tile) {
+        const int first = T.tile_start[std::size_t(tile)], last = T.tile_start[std::size_t(tile) + 1];
+        for (int ci = first; ci < last; ++ci) {
+          const int c = T.cells[std::size_t(ci)];
+          if (ci + 2 < last) {  // pieces are in triangle order: prefetch a later cell's pieces
+            const auto cn = static_cast<std::size_t>(T.cells[std::size_t(ci) + 2]);
+            for (int s = cell_start_[cn]; s < cell_start_[cn + 1]; ++s) {
+              const char* p = reinterpret_cast<const char*>(&pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])]);
+              __builtin_prefetch(p);
+              __builtin_prefetch(p + 64);
+            }
           }
-        }
-        double m[8][8] = {}, k[8][8] = {};
-        const auto ijk = grid_index(L.cells[static_cast<std::size_t>(c)]);
-        double cell_origin[3];
-        for (int a = 0; a < 3; ++a) cell_origin[a] = cube.origin[a] + h * ijk[a];
-        for (int s = cell_start_[static_cast<std::size_t>(c)]; s < cell_start_[static_cast<std::size_t>(c) + 1]; ++s) {
-          const ClippedTriangle& t = pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])];
-          const Eigen::Vector3d cr = t.cross();
-          const double len = cr.norm();
-          if (!(len > 0.0)) continue;
-          const Eigen::Vector3d n = cr / len;
-          const double area = 0.5 * len;
-          for (int q = 0; q < nq; ++q) {
-            CubatureSample cs;
-            sample_piece(t, n, area, cell_origin, h, rule.points[static_cast<std::size_t>(q)],
-                         rule.weights[static_cast<std::size_t>(q)], cs);
-            const double w = cs.weight;
-            const double(&v)[8] = cs.value;
-            const double(&g)[8][3] = cs.gradient;
-            for (int a = 0; a < 8; ++a) {
-              const double wa = w * v[a];
-              for (int e = a; e < 8; ++e) {
-                m[a][e] += wa * v[e];
-                k[a][e] += w * (g[a][0] * g[e][0] + g[a][1] * g[e][1] + g[a][2] * g[e][2]);
+          blocks.clear();
+          const auto ijk = grid_index(L.cells[static_cast<std::size_t>(c)]);
+          double cell_origin[3];
+          for (int a = 0; a < 3; ++a) cell_origin[a] = cube.origin[a] + h * ijk[a];
+          for (int s = cell_start_[static_cast<std::size_t>(c)]; s < cell_start_[static_cast<std::size_t>(c) + 1]; ++s) {
+            const ClippedTriangle& t = pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])];
+            const Eigen::Vector3d cr = t.cross();
+            const double len = cr.norm();
+            if (!(len > 0.0)) continue;
+            // Orthonormal frame of the piece's plane; identity metric: S = w I.
+            const Eigen::Vector3d n = cr / len;
+            const Eigen::Vector3d e1 = (t.corner(1) - t.corner(0)).normalized();
+            const Eigen::Vector3d e2 = n.cross(e1);
+            const double f1[3] = {e1[0] * inv_h, e1[1] * inv_h, e1[2] * inv_h};
+            const double f2[3] = {e2[0] * inv_h, e2[1] * inv_h, e2[2] * inv_h};
+            const double area = 0.5 * len;
+            for (int q = 0; q < nq; ++q) {
+              const auto& bc = rule.points[static_cast<std::size_t>(q)];
+              double local[3];
+              for (int a = 0; a < 3; ++a) {
+                const double x = bc[0] * t.corners[0][a] + bc[1] * t.corners[1][a] + bc[2] * t.corners[2][a];
+                local[a] = std::clamp((x - cell_origin[a]) * inv_h, 0.0, 1.0);
               }
+              const double w = area * rule.weights[static_cast<std::size_t>(q)];
+              blocks.add(local, f1, f2, w, w, 0.0, w);
             }
           }
-        }
-        for (int a = 0; a < 8; ++a) {
-          for (int e = a; e < 8; ++e) {
-            const int s1 = slot(c, a, e);
-            Mv[s1] += m[a][e];
-            Kv[s1] += k[a][e];
-            if (e != a) {
-              const int s2 = slot(c, e, a);
-              Mv[s2] += m[a][e];
-              Kv[s2] += k[a][e];
+          blocks.finish();
+          int slots[64];
+          cell_slots(c, slots);
+          for (int a = 0; a < 8; ++a)
+            for (int e = 0; e < 8; ++e) {
+              const int lo = std::min(a, e), hi = std::max(a, e);
+              Mv[slots[8 * a + e]] += blocks.mass(lo, hi);
+              Kv[slots[8 * a + e]] += blocks.stiffness(lo, hi);
             }
-          }
         }
       }
     });

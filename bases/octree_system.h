@@ -1,8 +1,8 @@
 #pragma once
 // Integration of trilinear B-splines over clipped pieces (DESIGN.md "Octree trilinear B-spline
 // basis"): per piece and cubature point the weight w = area·ω, the 8 values of the cell's corner
-// functions and their 3-D gradients projected onto the piece's plane; mass and stiffness are
-// accumulated into a sparsity pattern built once per octree level. Also the multigrid hierarchy
+// functions and their gradients in an orthonormal frame of the piece's plane (cell_blocks.h);
+// mass and stiffness are accumulated into a sparsity pattern built once per octree level. Also the multigrid hierarchy
 // (prolongations, parity colours) and vertex evaluation. The pieces are exposed so the tracked
 // basis can reuse them.
 
@@ -31,34 +31,6 @@ inline void trilinear_values(const double t[3], double inv_h, double value[8], d
     gradient[c][1] = bx * sy * bz;
     gradient[c][2] = bx * by * sz;
   }
-}
-
-/// One cubature point of a piece: weight w = area·ω, the 8 corner-function values and their 3-D
-/// gradients projected onto the piece's plane (world units), and the point's local coordinates in
-/// the cell. cell_origin is the world position of the cell's corner 0, h its size.
-struct CubatureSample {
-  double weight;
-  double local[3];
-  double value[8];
-  double gradient[8][3];
-};
-/// unit_normal = cross / |cross| of the piece, area = |cross| / 2 (pass them in to share them
-/// between the points of a piece).
-inline void sample_piece(const ClippedTriangle& t, const Eigen::Vector3d& unit_normal, double area,
-                         const double cell_origin[3], double h, const std::array<double, 3>& bary, double omega,
-                         CubatureSample& s) {
-  const double inv_h = 1.0 / h;
-  for (int a = 0; a < 3; ++a) {
-    const double x = bary[0] * t.corners[0][a] + bary[1] * t.corners[1][a] + bary[2] * t.corners[2][a];
-    const double u = (x - cell_origin[a]) * inv_h;
-    s.local[a] = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-  }
-  trilinear_values(s.local, inv_h, s.value, s.gradient);
-  for (int c = 0; c < 8; ++c) {
-    const double gn = s.gradient[c][0] * unit_normal[0] + s.gradient[c][1] * unit_normal[1] + s.gradient[c][2] * unit_normal[2];
-    for (int e = 0; e < 3; ++e) s.gradient[c][e] -= gn * unit_normal[e];
-  }
-  s.weight = area * omega;
 }
 
 /// Offset bit (0..26) of row function I relative to column function J, both corners of one cell:
@@ -96,8 +68,30 @@ class OctreeSystem {
   /// Pieces of cell c: piece_order()[cell_start()[c] .. cell_start()[c+1]).
   const std::vector<int>& cell_start() const { return cell_start_; }
   const std::vector<int>& piece_order() const { return piece_order_; }
-  /// Cells of parity colour q = (i%2)+2(j%2)+4(k%2); cells of one colour share no function.
-  const std::vector<std::vector<int>>& colour_cells() const { return colour_cells_; }
+  /// The lock-free accumulation order (SetSystemMatrices), shared by the rebuilt assembly and the
+  /// tracked update: the level's cells cut into tiles of kTileSide³ cells, tiles grouped by the
+  /// parity colour (I%2)+2(J%2)+4(K%2) of their tile index. Tiles of one colour are a whole tile
+  /// apart, so they share no function and are accumulated in parallel; the cells of one tile are
+  /// accumulated serially in index order, so the result does not depend on the thread count.
+  /// Why tiles and not a parity colour per cell: a tile's cells touch the same few hundred matrix
+  /// rows, which stay in cache, while 8 passes of single-cell colours each swept both matrices.
+  struct CellTiles {
+    static constexpr int kTileSide = 8;
+    std::vector<int> cells;             ///< cell indices, grouped by colour, then tile, ascending inside a tile
+    std::vector<int> tile_start;        ///< tile t: cells[tile_start[t] .. tile_start[t+1])
+    std::array<int, 9> colour_start{};  ///< colour q: tiles [colour_start[q], colour_start[q+1])
+  };
+  const CellTiles& tiles() const { return tiles_; }
+  /// The 64 value slots of cell c's 8x8 block: slots[8a+b] = slot(c, a, b).
+  void cell_slots(int cell, int slots[64]) const {
+    const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];
+    for (int b = 0; b < 8; ++b) {
+      const auto J = static_cast<std::size_t>(f[static_cast<std::size_t>(b)]);
+      const int base = outer_[J];
+      const std::uint32_t m = mask_[J];
+      for (int a = 0; a < 8; ++a) slots[8 * a + b] = base + std::popcount(m & ((1u << neighbour_bit(a, b)) - 1u));
+    }
+  }
   const std::vector<int>& piece_cell() const { return piece_cell_; }
 
   /// Mass and stiffness with the identity metric (the pieces' own geometry), any cubature rule.
@@ -111,7 +105,7 @@ class OctreeSystem {
   int level_;
   std::vector<int> piece_cell_;
   std::vector<int> cell_start_, piece_order_;
-  std::vector<std::vector<int>> colour_cells_;
+  CellTiles tiles_;
   std::vector<std::uint32_t> mask_;
   std::vector<int> outer_, inner_;  // the pattern (no values stored: M and K carry their own)
 };

@@ -1,10 +1,13 @@
 #include "bases/tracked_octree_basis.h"
 
+#include "bases/cell_blocks.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -67,13 +70,132 @@ std::size_t TrackedOctreeBasis::preprocessed_bytes() const {
   return local_corners_.size() * sizeof(double) + cell_start_.size() * sizeof(int);
 }
 
+namespace {
+
+/// One cell of SetSystemMatrices at the coefficients xc of its 8 corners: every cubature point of
+/// its pieces (corners in cell-local coordinates) goes into `blocks`. Returns the number of
+/// degenerate points, which contribute nothing.
+template <class Blocks>
+int integrate_cell(const double xc[8][3], const double* corners, int pieces, const CubatureRule& rule, double h,
+                   Blocks& blocks) {
+  const double inv_h = 1.0 / h;
+  // Edge differences of the trilinear map X(t) = Σ_c xc_c β_c(t) along each axis a, one per
+  // cell edge: ∂X/∂t_a at t is their bilinear interpolation in the two other coordinates.
+  double edge[3][4][3];
+  for (int a = 0; a < 3; ++a) {
+    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+    for (int e = 0; e < 4; ++e) {
+      const int lo = ((e & 1) << b1) | (((e >> 1) & 1) << b2);
+      for (int d = 0; d < 3; ++d) edge[a][e][d] = xc[lo | (1 << a)][d] - xc[lo][d];
+    }
+  }
+  int degenerate = 0;
+  const int nq = rule.size();
+  for (int s = 0; s < pieces; ++s) {
+    const double* p = corners + 9 * s;
+    // Orthonormal frame (e1, e2) of the piece's plane on X_0 (ComputeDifferential), in cell units.
+    const double u[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
+    const double v[3] = {p[6] - p[0], p[7] - p[1], p[8] - p[2]};
+    double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0.0)) continue;
+    const double area = 0.5 * len * h * h;
+    const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    const double e1[3] = {u[0] / ul, u[1] / ul, u[2] / ul};
+    for (double& ni : n) ni /= len;
+    const double e2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]};
+    // Tangent derivatives in world units: ∂/∂e = (e / h) · ∇_t.
+    const double f1[3] = {e1[0] * inv_h, e1[1] * inv_h, e1[2] * inv_h};
+    const double f2[3] = {e2[0] * inv_h, e2[1] * inv_h, e2[2] * inv_h};
+    for (int q = 0; q < nq; ++q) {
+      const auto& bc = rule.points[std::size_t(q)];
+      double t[3];
+      for (int a = 0; a < 3; ++a) t[a] = std::clamp(bc[0] * p[a] + bc[1] * p[3 + a] + bc[2] * p[6 + a], 0.0, 1.0);
+      // dX = D (f1, f2) with D = ∂X/∂t, the Jacobian of the trilinear map (3x3).
+      double D[3][3];
+      for (int a = 0; a < 3; ++a) {
+        const double s1 = t[(a + 1) % 3], s2 = t[(a + 2) % 3];
+        const double w[4] = {(1 - s1) * (1 - s2), s1 * (1 - s2), (1 - s1) * s2, s1 * s2};
+        for (int d = 0; d < 3; ++d)
+          D[d][a] = w[0] * edge[a][0][d] + w[1] * edge[a][1][d] + w[2] * edge[a][2][d] + w[3] * edge[a][3][d];
+      }
+      double Ju[3], Jv[3];
+      for (int d = 0; d < 3; ++d) {
+        Ju[d] = D[d][0] * f1[0] + D[d][1] * f1[1] + D[d][2] * f1[2];
+        Jv[d] = D[d][0] * f2[0] + D[d][1] * f2[1] + D[d][2] * f2[2];
+      }
+      // Metric g = dXᵀdX in the frame of X_0 (identity at t = 0).
+      const double g11 = Ju[0] * Ju[0] + Ju[1] * Ju[1] + Ju[2] * Ju[2];
+      const double g12 = Ju[0] * Jv[0] + Ju[1] * Jv[1] + Ju[2] * Jv[2];
+      const double g22 = Jv[0] * Jv[0] + Jv[1] * Jv[1] + Jv[2] * Jv[2];
+      const double det = g11 * g22 - g12 * g12;
+      if (!(det > kDegenerateDeterminant) || !(det > kDegenerateRelative * g11 * g22) || !std::isfinite(det)) {
+        ++degenerate;
+        continue;
+      }
+      // M: w √|g|;  K: w √|g| g⁻¹ = (w √|g| / det) [g22, -g12; -g12, g11].
+      const double wm = area * rule.weights[std::size_t(q)] * std::sqrt(det);
+      const double sc = wm / det;
+      blocks.add(t, f1, f2, wm, sc * g22, -sc * g12, sc * g11);
+    }
+  }
+  blocks.finish();
+  return degenerate;
+}
+
+/// The per-step update over all cells in tile order (OctreeSystem::tiles()): tiles of one colour
+/// share no function, so the loop is lock-free and sums in the same order for any thread count.
+template <bool Mass, bool Stiffness>
+long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const Coefficients& x,
+                       const std::vector<double>& local_corners, const std::vector<int>& cell_start,
+                       const CubatureRule& rule, double h, double* Mv, double* Kv) {
+  const double* X = x.data();
+  const Eigen::Index ld = x.rows();  // column-major n x 3
+  const auto& T = system.tiles();
+  long long degenerate = 0;
+  for (int colour = 0; colour < 8; ++colour) {
+    degenerate += tbb::parallel_reduce(
+        tbb::blocked_range<int>(T.colour_start[std::size_t(colour)], T.colour_start[std::size_t(colour) + 1], 1), 0LL,
+        [&](const tbb::blocked_range<int>& r, long long count) {
+          CellBlocks<Mass, Stiffness> blocks;
+          for (int tile = r.begin(); tile != r.end(); ++tile) {
+            for (int ci = T.tile_start[std::size_t(tile)]; ci < T.tile_start[std::size_t(tile) + 1]; ++ci) {
+              const int c = T.cells[std::size_t(ci)];
+              const auto& f = L.cell_functions[std::size_t(c)];
+              double xc[8][3];
+              for (int a = 0; a < 8; ++a)
+                for (int d = 0; d < 3; ++d) xc[a][d] = X[d * ld + f[std::size_t(a)]];
+              blocks.clear();
+              const int first = cell_start[std::size_t(c)];
+              count += integrate_cell(xc, &local_corners[9 * std::size_t(first)], cell_start[std::size_t(c) + 1] - first,
+                                      rule, h, blocks);
+              // Add the cell's blocks to the fixed pattern; the upper triangle mirrored.
+              int slots[64];
+              system.cell_slots(c, slots);
+              for (int a = 0; a < 8; ++a)
+                for (int b = 0; b < 8; ++b) {
+                  const int lo = std::min(a, b), hi = std::max(a, b);
+                  if constexpr (Mass) Mv[slots[8 * a + b]] += blocks.mass(lo, hi);
+                  if constexpr (Stiffness) Kv[slots[8 * a + b]] += blocks.stiffness(lo, hi);
+                }
+            }
+          }
+          return count;
+        },
+        [](long long a, long long b) { return a + b; });
+  }
+  return degenerate;
+}
+
+}  // namespace
+
 void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool update_stiffness) {
   if (!update_mass && !update_stiffness) return;
   if (x.rows() != dimension())
     throw std::invalid_argument("TrackedOctreeBasis::update: coefficient count does not match the dimension");
   const Octree& octree = initial_->octree();
   const OctreeLevel& L = octree.finest();
-  const double h = octree.cube.cell_size(L.depth), inv_h = 1.0 / h;
+  const double h = octree.cube.cell_size(L.depth);
   const OctreeSystem& system = initial_->system();
   // The pattern never changes: after the first update only the values are reset (no reallocation
   // and copy of the pattern every step, ~12 bytes per nonzero per matrix).
@@ -87,92 +209,12 @@ void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool up
   if (update_stiffness) reset(stiffness_);
   double* Mv = update_mass ? mass_.valuePtr() : nullptr;
   double* Kv = update_stiffness ? stiffness_.valuePtr() : nullptr;
-  const int nq = rule_->size();
-  const double* X = x.data();
-  const Eigen::Index ld = x.rows();  // column-major n x 3
-
-  long long degenerate = 0;
-  for (int colour = 0; colour < 8; ++colour) {
-    const auto& cells = system.colour_cells()[std::size_t(colour)];
-    degenerate += tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, cells.size(), 32), 0LL,
-        [&](const tbb::blocked_range<std::size_t>& r, long long count) {
-          for (std::size_t ci = r.begin(); ci != r.end(); ++ci) {
-            const int c = cells[ci];
-            const auto& f = L.cell_functions[std::size_t(c)];
-            double xc[8][3];
-            for (int a = 0; a < 8; ++a)
-              for (int d = 0; d < 3; ++d) xc[a][d] = X[d * ld + f[std::size_t(a)]];
-            double m[8][8] = {}, k[8][8] = {};
-            for (int s = cell_start_[std::size_t(c)]; s < cell_start_[std::size_t(c) + 1]; ++s) {
-              const double* p = &local_corners_[9 * std::size_t(s)];
-              // Orthonormal frame (e1, e2) of the piece's plane on X_0 (ComputeDifferential).
-              const double u[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
-              const double v[3] = {p[6] - p[0], p[7] - p[1], p[8] - p[2]};
-              double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-              const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-              if (!(len > 0.0)) continue;
-              const double area = 0.5 * len * h * h;
-              const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-              const double e1[3] = {u[0] / ul, u[1] / ul, u[2] / ul};
-              for (double& ni : n) ni /= len;
-              const double e2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]};
-              for (int q = 0; q < nq; ++q) {
-                const auto& b = rule_->points[std::size_t(q)];
-                double t[3];
-                for (int a = 0; a < 3; ++a) t[a] = std::clamp(b[0] * p[a] + b[1] * p[3 + a] + b[2] * p[6 + a], 0.0, 1.0);
-                double val[8], grad[8][3];
-                trilinear_values(t, inv_h, val, grad);
-                double eta[8], mu[8];
-                double Ju[3] = {0, 0, 0}, Jv[3] = {0, 0, 0};
-                for (int a = 0; a < 8; ++a) {
-                  eta[a] = grad[a][0] * e1[0] + grad[a][1] * e1[1] + grad[a][2] * e1[2];
-                  mu[a] = grad[a][0] * e2[0] + grad[a][1] * e2[1] + grad[a][2] * e2[2];
-                  for (int d = 0; d < 3; ++d) {
-                    Ju[d] += eta[a] * xc[a][d];
-                    Jv[d] += mu[a] * xc[a][d];
-                  }
-                }
-                // Metric g = dXᵀdX in the frame of X_0 (identity at t = 0).
-                const double g11 = Ju[0] * Ju[0] + Ju[1] * Ju[1] + Ju[2] * Ju[2];
-                const double g12 = Ju[0] * Jv[0] + Ju[1] * Jv[1] + Ju[2] * Jv[2];
-                const double g22 = Jv[0] * Jv[0] + Jv[1] * Jv[1] + Jv[2] * Jv[2];
-                const double det = g11 * g22 - g12 * g12;
-                if (!(det > kDegenerateDeterminant) || !(det > kDegenerateRelative * g11 * g22) || !std::isfinite(det)) {
-                  ++count;
-                  continue;
-                }
-                const double sq = std::sqrt(det);
-                const double w = area * rule_->weights[std::size_t(q)] * sq;
-                if (Mv)
-                  for (int a = 0; a < 8; ++a) {
-                    const double wa = w * val[a];
-                    for (int bb = a; bb < 8; ++bb) m[a][bb] += wa * val[bb];
-                  }
-                if (Kv) {
-                  // (η,μ)_a g⁻¹ (η,μ)_bᵀ √|g| w = P_a η_b + Q_a μ_b.
-                  const double s = w / det;
-                  for (int a = 0; a < 8; ++a) {
-                    const double P = s * (g22 * eta[a] - g12 * mu[a]);
-                    const double Q = s * (g11 * mu[a] - g12 * eta[a]);
-                    for (int bb = a; bb < 8; ++bb) k[a][bb] += P * eta[bb] + Q * mu[bb];
-                  }
-                }
-              }
-            }
-            // Add the cell's blocks to the fixed pattern (SetSystemMatrices); symmetric halves mirrored.
-            for (int a = 0; a < 8; ++a)
-              for (int bb = 0; bb < 8; ++bb) {
-                const int lo = std::min(a, bb), hi = std::max(a, bb);
-                const int slot = system.slot(c, a, bb);
-                if (Mv) Mv[slot] += m[lo][hi];
-                if (Kv) Kv[slot] += k[lo][hi];
-              }
-          }
-          return count;
-        },
-        [](long long a, long long b) { return a + b; });
-  }
+  const auto& corners = local_corners_;
+  const long long degenerate =
+      update_mass && update_stiffness
+          ? update_cells<true, true>(system, L, x, corners, cell_start_, *rule_, h, Mv, Kv)
+      : update_mass ? update_cells<true, false>(system, L, x, corners, cell_start_, *rule_, h, Mv, Kv)
+                    : update_cells<false, true>(system, L, x, corners, cell_start_, *rule_, h, Mv, Kv);
   degenerate_points_ = degenerate;
 }
 

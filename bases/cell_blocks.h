@@ -1,0 +1,138 @@
+#pragma once
+// The per-cell kernel of SetSystemMatrices (Chuang & Kazhdan 2011, Sec. 4; DESIGN.md "Octree
+// trilinear B-spline basis"): the 8x8 mass and stiffness blocks of one cell's corner functions,
+// summed over the cell's cubature points,
+//   M_ab += w_m β_a β_b,      K_ab += (η_a, μ_a) S (η_b, μ_b)ᵀ,
+// where β are the trilinear values and (η, μ) the gradients in an orthonormal frame (e1, e2) of
+// the piece's plane. The rebuilt basis integrates with the identity metric (w_m = w, S = w I); the
+// tracked basis with the metric g of the current coefficients (w_m = w √|g|, S = w √|g| g⁻¹).
+//
+// Why a kernel of its own: this is the hot loop of both bases (one call per cubature point,
+// ~2e7 per step at depth 9). Points are buffered, one lane per corner, and the blocks are
+// accumulated over a batch of points with the accumulators held in vector registers (4-wide
+// double vectors, GCC/Clang vector extensions: AVX2 or wider when compiled for it); only the
+// upper triangles are summed (b ≥ a) and read. The order of the sums depends only on the order
+// of the points, so results do not depend on threads.
+
+#include <cstring>
+
+namespace mcf {
+
+template <bool Mass, bool Stiffness>
+class CellBlocks {
+ public:
+  static constexpr int kBatch = 16;
+
+  CellBlocks() { clear(); }
+
+  /// Zeroes the blocks (start of a cell).
+  void clear() {
+    std::memset(m_, 0, sizeof(m_));
+    std::memset(k_, 0, sizeof(k_));
+    count_ = 0;
+  }
+
+  /// One cubature point at local cell coordinates t ∈ [0,1]^3. f1, f2 = e1/h, e2/h: the frame
+  /// vectors divided by the cell size, so that η_a = f1 · ∇_t β_a (world units). wm weights the
+  /// mass; (s11, s12, s22) is the symmetric 2x2 form S of the stiffness.
+  void add(const double t[3], const double f1[3], const double f2[3], double wm, double s11, double s12,
+           double s22) {
+    // Corner c = x + 2y + 4z: lanes lo = corners 0..3 (z = 0), hi = corners 4..7 (z = 1).
+    const double u = t[0], v = t[1], z = t[2];
+    const v4 bx = {1 - u, u, 1 - u, u}, by = {1 - v, 1 - v, v, v};
+    const v4 sx = {-1, 1, -1, 1}, sy = {-1, -1, 1, 1};
+    const v4 bxy = bx * by;
+    const v4 z0 = splat(1 - z), z1 = splat(z);
+    double* slot = lanes_[count_];
+    if constexpr (Mass) {
+      const v4 val_lo = bxy * z0, val_hi = bxy * z1;
+      store(slot + kVal, val_lo);
+      store(slot + kVal + 4, val_hi);
+      store(slot + kWVal, splat(wm) * val_lo);
+      store(slot + kWVal + 4, splat(wm) * val_hi);
+    }
+    if constexpr (Stiffness) {
+      // ∇_t β = (sx by bz, bx sy bz, bx by sz) with sz = -1 (lo) / +1 (hi).
+      const v4 gxy1 = splat(f1[0]) * sx * by + splat(f1[1]) * sy * bx;
+      const v4 gxy2 = splat(f2[0]) * sx * by + splat(f2[1]) * sy * bx;
+      const v4 eta_lo = gxy1 * z0 - splat(f1[2]) * bxy, eta_hi = gxy1 * z1 + splat(f1[2]) * bxy;
+      const v4 mu_lo = gxy2 * z0 - splat(f2[2]) * bxy, mu_hi = gxy2 * z1 + splat(f2[2]) * bxy;
+      store(slot + kEta, eta_lo);
+      store(slot + kEta + 4, eta_hi);
+      store(slot + kMu, mu_lo);
+      store(slot + kMu + 4, mu_hi);
+      const v4 a11 = splat(s11), a12 = splat(s12), a22 = splat(s22);
+      store(slot + kP, a11 * eta_lo + a12 * mu_lo);
+      store(slot + kP + 4, a11 * eta_hi + a12 * mu_hi);
+      store(slot + kQ, a12 * eta_lo + a22 * mu_lo);
+      store(slot + kQ + 4, a12 * eta_hi + a22 * mu_hi);
+    }
+    if (++count_ == kBatch) accumulate();
+  }
+
+  /// Sums the buffered points; then mass(a,b) / stiffness(a,b) for a ≤ b are the cell's blocks.
+  void finish() { accumulate(); }
+  double mass(int a, int b) const { return m_[a][b]; }
+  double stiffness(int a, int b) const { return k_[a][b]; }
+
+ private:
+  using v4 = double __attribute__((vector_size(32)));
+  static v4 splat(double x) { return v4{x, x, x, x}; }
+  static v4 load(const double* p) {
+    v4 r;
+    std::memcpy(&r, p, sizeof(r));
+    return r;
+  }
+  static void store(double* p, v4 x) { std::memcpy(p, &x, sizeof(x)); }
+
+  // Per buffered point: 8 lanes each of β, w_m β, η, μ, P = S₁₁η + S₁₂μ, Q = S₁₂η + S₂₂μ.
+  enum { kVal = 0, kWVal = 8, kEta = 16, kMu = 24, kP = 32, kQ = 40, kLanes = 48 };
+
+  /// Row a of a block is updated in lanes b = 0..3 (only for a < 4: upper triangle) and b = 4..7.
+  void accumulate() {
+    if (count_ == 0) return;
+    if constexpr (Mass) {
+      v4 lo[4], hi[8];
+      for (int a = 0; a < 4; ++a) lo[a] = load(&m_[a][0]);
+      for (int a = 0; a < 8; ++a) hi[a] = load(&m_[a][4]);
+      for (int p = 0; p < count_; ++p) {
+        const double* s = lanes_[p];
+        const v4 vlo = load(s + kVal), vhi = load(s + kVal + 4);
+#pragma GCC unroll 8
+        for (int a = 0; a < 8; ++a) {
+          const v4 wa = splat(s[kWVal + a]);
+          if (a < 4) lo[a] += wa * vlo;
+          hi[a] += wa * vhi;
+        }
+      }
+      for (int a = 0; a < 4; ++a) store(&m_[a][0], lo[a]);
+      for (int a = 0; a < 8; ++a) store(&m_[a][4], hi[a]);
+    }
+    if constexpr (Stiffness) {
+      v4 lo[4], hi[8];
+      for (int a = 0; a < 4; ++a) lo[a] = load(&k_[a][0]);
+      for (int a = 0; a < 8; ++a) hi[a] = load(&k_[a][4]);
+      for (int p = 0; p < count_; ++p) {
+        const double* s = lanes_[p];
+        const v4 elo = load(s + kEta), ehi = load(s + kEta + 4);
+        const v4 mlo = load(s + kMu), mhi = load(s + kMu + 4);
+#pragma GCC unroll 8
+        for (int a = 0; a < 8; ++a) {
+          const v4 pa = splat(s[kP + a]), qa = splat(s[kQ + a]);
+          if (a < 4) lo[a] += pa * elo + qa * mlo;
+          hi[a] += pa * ehi + qa * mhi;
+        }
+      }
+      for (int a = 0; a < 4; ++a) store(&k_[a][0], lo[a]);
+      for (int a = 0; a < 8; ++a) store(&k_[a][4], hi[a]);
+    }
+    count_ = 0;
+  }
+
+  alignas(32) double m_[8][8];
+  alignas(32) double k_[8][8];
+  alignas(32) double lanes_[kBatch][kLanes];
+  int count_ = 0;
+};
+
+}  // namespace mcf
