@@ -95,8 +95,8 @@ class OctreeSystem {
   const std::vector<int>& piece_cell() const { return piece_cell_; }
 
   /// Mass and stiffness with the identity metric (the pieces' own geometry), any cubature rule.
-  /// M and K get this system's pattern; accumulation is lock-free (8 parity passes, parallel over
-  /// cells inside a pass), deterministic.
+  /// M and K get this system's pattern; accumulation is lock-free (tiles(): 8 colour passes,
+  /// parallel over the tiles of a pass) and deterministic.
   void assemble(const CubatureRule& rule, SparseMatrix& mass, SparseMatrix& stiffness) const;
 
  private:

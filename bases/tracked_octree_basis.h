@@ -28,9 +28,10 @@ class TrackedOctreeBasis final : public Basis {
 
   /// Re-integrates M and/or K at coefficients x: for each cubature point, dX = Σ_I x^I (η^I, μ^I),
   /// g = dXᵀdX, M_IJ += β_I β_J √|g| w, K_IJ += (η_I,μ_I) g⁻¹ (η_J,μ_J)ᵀ √|g| w. Points with a
-  /// degenerate metric (pinching) contribute nothing. Lock-free: cells are visited in 8 parity
-  /// colours (cells of one colour share no function), each cell's 8×8 blocks accumulated in
-  /// registers then added to the fixed pattern; the result is independent of the thread count.
+  /// degenerate metric (pinching) contribute nothing. Lock-free: cells are visited in the tiles
+  /// of OctreeSystem::tiles() (tiles of one colour share no function), each cell's 8×8 blocks
+  /// summed by CellBlocks then added to the fixed pattern; the result is independent of the
+  /// thread count.
   void update(const Coefficients& x, bool update_mass, bool update_stiffness) override;
   const SparseMatrix& mass() const override { return mass_; }
   const SparseMatrix& stiffness() const override { return stiffness_; }
