@@ -4,6 +4,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -52,7 +53,7 @@ OctreeSystem::CellTiles build_cell_tiles(const OctreeLevel& L) {
       order[c] = {(colour << 60) | grid_key(ti, tj, tk), static_cast<int>(c)};
     }
   });
-  std::sort(order.begin(), order.end());
+  tbb::parallel_sort(order.begin(), order.end());  // keys are unique: same order as std::sort
   OctreeSystem::CellTiles t;
   t.cells.resize(nc);
   t.colour_start.fill(0);
@@ -215,14 +216,7 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
             }
           }
           blocks.finish();
-          int slots[64];
-          cell_slots(c, slots);
-          for (int a = 0; a < 8; ++a)
-            for (int e = 0; e < 8; ++e) {
-              const int lo = std::min(a, e), hi = std::max(a, e);
-              Mv[slots[8 * a + e]] += blocks.mass(lo, hi);
-              Kv[slots[8 * a + e]] += blocks.stiffness(lo, hi);
-            }
+          add_cell_blocks(c, blocks, Mv, Kv);
         }
       }
     });

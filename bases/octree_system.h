@@ -65,6 +65,20 @@ class OctreeSystem {
     const std::uint32_t below = (1u << neighbour_bit(corner_row, corner_col)) - 1u;
     return outer_[static_cast<std::size_t>(J)] + std::popcount(mask_[static_cast<std::size_t>(J)] & below);
   }
+  /// Adds a cell's summed blocks (blocks.mass(a,b), blocks.stiffness(a,b), read for a ≤ b) into
+  /// the value arrays of this pattern, the upper triangle mirrored so both halves are equal
+  /// (SetSystemMatrices). A null array is skipped.
+  template <class Blocks>
+  void add_cell_blocks(int cell, const Blocks& blocks, double* mass, double* stiffness) const {
+    int slots[64];
+    cell_slots(cell, slots);
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) {
+        const int lo = a < b ? a : b, hi = a < b ? b : a;
+        if (mass) mass[slots[8 * a + b]] += blocks.mass(lo, hi);
+        if (stiffness) stiffness[slots[8 * a + b]] += blocks.stiffness(lo, hi);
+      }
+  }
   /// Pieces of cell c: piece_order()[cell_start()[c] .. cell_start()[c+1]).
   const std::vector<int>& cell_start() const { return cell_start_; }
   const std::vector<int>& piece_order() const { return piece_order_; }

@@ -169,15 +169,7 @@ long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const C
               const int first = cell_start[std::size_t(c)];
               count += integrate_cell(xc, &local_corners[9 * std::size_t(first)], cell_start[std::size_t(c) + 1] - first,
                                       rule, h, blocks);
-              // Add the cell's blocks to the fixed pattern; the upper triangle mirrored.
-              int slots[64];
-              system.cell_slots(c, slots);
-              for (int a = 0; a < 8; ++a)
-                for (int b = 0; b < 8; ++b) {
-                  const int lo = std::min(a, b), hi = std::max(a, b);
-                  if constexpr (Mass) Mv[slots[8 * a + b]] += blocks.mass(lo, hi);
-                  if constexpr (Stiffness) Kv[slots[8 * a + b]] += blocks.stiffness(lo, hi);
-                }
+              system.add_cell_blocks(c, blocks, Mass ? Mv : nullptr, Stiffness ? Kv : nullptr);
             }
           }
           return count;
