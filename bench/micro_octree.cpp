@@ -259,6 +259,25 @@ void BM_Rebuilt_Cycle(benchmark::State& state) {
   label(state, f);
 }
 
+// One forward Gauss-Seidel sweep (timed as 5) on the finest level (3 right-hand sides), in fine SpMVs: the
+// unit the W-cycle's cost is made of (a W-cycle is 10 fine sweeps + 1 residual + coarse work).
+void BM_Rebuilt_Sweep(benchmark::State& state) {
+  auto& f = phase_fixture(int(state.range(0)));
+  MultigridSolver solver(mg_options(MultigridCycle::W));
+  solver.set_matrix(f.A, {f.basis->prolongations(), f.basis->colours()});
+  Eigen::MatrixXd X = f.C;
+  const int fine = solver.levels() - 1;
+  double seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    solver.gauss_seidel(fine, f.B, X, 5);  // 5 sweeps amortize the copy in and out
+    seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  seconds /= 5.0 * double(state.iterations());
+  state.counters["sweep_over_spmv"] = seconds / best_spmv_seconds(f);
+  label(state, f);
+}
+
 void BM_Rebuilt_SetMatrix(benchmark::State& state) {
   auto& f = phase_fixture(int(state.range(0)));
   MultigridSolver solver(mg_options(MultigridCycle::W));
@@ -278,6 +297,7 @@ void phase_args(benchmark::internal::Benchmark* b) { b->ArgName("mesh")->Unit(be
   BENCHMARK(BM_Rebuilt_Hierarchy)->Arg(mesh_id)->Apply(phase_args)->Iterations(mesh_id == 0 ? 2 : 3);   \
   BENCHMARK(BM_Rebuilt_SpMV)->Arg(mesh_id)->Apply(phase_args);                                          \
   BENCHMARK(BM_Rebuilt_SetMatrix)->Arg(mesh_id)->Apply(phase_args)->Iterations(3);                       \
+  BENCHMARK(BM_Rebuilt_Sweep)->Arg(mesh_id)->Apply(phase_args)->Iterations(5);                          \
   BENCHMARK(BM_Rebuilt_Cycle)->Args({mesh_id, 0})->ArgNames({"mesh", "W"})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3); \
   BENCHMARK(BM_Rebuilt_Cycle)->Args({mesh_id, 1})->ArgNames({"mesh", "W"})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 

@@ -12,6 +12,13 @@
 // functions are independent, so their order does not change the result. With pre_smooth ==
 // post_smooth the cycle, started from zero, is a symmetric operator (precondition()).
 //
+// Internal numbering: every coloured level is stored colour-major (colour 0's functions first,
+// each colour in index order), so one colour pass streams a contiguous block of rows; the
+// permutation is applied when right-hand sides and solutions are copied in and out, and to the
+// finest matrix's values in set_matrix (one block copy per column). Only the order in which a
+// row's terms are added differs from the caller's numbering; level_matrix() converts back. A level
+// whose given colouring is invalid keeps the colour-major order and is relaxed serially in it.
+//
 // Layout and cost: right-hand sides are interleaved (row-major n x k) in preallocated per-level
 // buffers, all columns are relaxed in the same sweep (chunks of up to 4 columns). Per cycle on
 // level l: pre + post sweeps, one residual, restriction b_c = Pᵀ r (gather over P's columns),
@@ -74,7 +81,8 @@ class MultigridSolver : public LinearSolver {
 
   // --- introspection (tests, benchmarks) ---
   int levels() const;                              ///< 0 before set_matrix
-  const SparseMatrix& level_matrix(int l) const;   ///< l = 0 coarsest, levels()-1 finest
+  /// Level l's operator (l = 0 coarsest, levels()-1 finest) in the caller's numbering (a copy).
+  SparseMatrix level_matrix(int l) const;
   bool level_is_coloured(int l) const;             ///< false: serial Gauss-Seidel fallback
   std::int64_t symbolic_builds() const;            ///< how often the Galerkin pattern was built
   std::int64_t numeric_builds() const;             ///< how often coarse values were computed
