@@ -24,6 +24,7 @@ namespace {
 
 constexpr int kGrain = 256;            // rows per TBB task
 constexpr int kSerialBelow = 2048;     // loops shorter than this run serially (same result)
+constexpr int kTile = MultigridSolver::tile_size;
 
 /// Runs f(begin, end) over [0, n), in parallel when n is large enough. Every kernel writes
 /// disjoint outputs and reads nothing that the same loop writes, so the split is irrelevant.
@@ -165,27 +166,43 @@ SparseMatrix symbolic_product(const SparseMatrix& Xm, const SparseMatrix& Ym) {
 
 using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 
-/// Values of M = X * Y on M's precomputed pattern. Parallel over the columns of M, each column
-/// accumulated in a fixed order in a thread-local dense accumulator: deterministic.
-void numeric_product(const SparseMatrix& Xm, const SparseMatrix& Ym, SparseMatrix& Mm, Spa& spa) {
-  const Csc X(Xm), Y(Ym);
-  const int m = X.rows;
-  const int* Mouter = Mm.outerIndexPtr();
-  const int* Minner = Mm.innerIndexPtr();
-  double* Mval = Mm.valuePtr();
-  tbb::parallel_for(tbb::blocked_range<int>(0, Y.cols, 64), [&](const tbb::blocked_range<int>& r) {
-    auto& acc = spa.local();
-    if (acc.size() < std::size_t(m)) acc.assign(std::size_t(m), 0.0);
-    for (int J = r.begin(); J < r.end(); ++J) {
-      for (int p = Y.outer[J]; p < Y.outer[J + 1]; ++p) {
-        const int t = Y.inner[p];
-        const double w = Y.val[p];
-        for (int a = X.outer[t]; a < X.outer[t + 1]; ++a) acc[std::size_t(X.inner[a])] += X.val[a] * w;
+/// Values of the Galerkin operator A_c = Pᵀ A P on its precomputed (sorted, symmetric) pattern.
+/// Per coarse column J, v = A P e_J is accumulated in a thread-local dense vector, and each entry
+/// (I, J) with I <= J is the sparse dot product P e_I · v, written to (I, J) and to its mirror
+/// (J, I): A_c is exactly symmetric, the intermediate A P is never stored, and only half of the
+/// dot products are formed. Every entry is computed by one task in a fixed order: deterministic.
+/// Columns are visited in `column_order` (internal column of the caller's column jj; empty:
+/// identity), i.e. in grid order, so consecutive columns share most of their fine support:
+/// visiting them colour-major measured 2x slower.
+void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatrix& Cm,
+                     const std::vector<int>& transpose_pos, const std::vector<int>& column_order, Spa& spa) {
+  const Csc A(Am), P(Pm);
+  const int m = A.rows;
+  const int* Couter = Cm.outerIndexPtr();
+  const int* Cinner = Cm.innerIndexPtr();
+  double* Cval = Cm.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<int>(0, P.cols, 64), [&](const tbb::blocked_range<int>& r) {
+    auto& v = spa.local();
+    if (v.size() < std::size_t(m)) v.assign(std::size_t(m), 0.0);
+    for (int jj = r.begin(); jj < r.end(); ++jj) {
+      const int J = column_order.empty() ? jj : column_order[std::size_t(jj)];
+      for (int p = P.outer[J]; p < P.outer[J + 1]; ++p) {
+        const int t = P.inner[p];
+        const double w = P.val[p];
+        for (int a = A.outer[t]; a < A.outer[t + 1]; ++a) v[std::size_t(A.inner[a])] += A.val[a] * w;
       }
-      for (int e = Mouter[J]; e < Mouter[J + 1]; ++e) {
-        double& v = acc[std::size_t(Minner[e])];
-        Mval[e] = v;
-        v = 0.0;
+      for (int e = Couter[J]; e < Couter[J + 1]; ++e) {
+        const int I = Cinner[e];
+        if (I > J) break;  // sorted: the rest is the mirror of columns > J
+        double sum = 0.0;
+        for (int q = P.outer[I]; q < P.outer[I + 1]; ++q) sum += P.val[q] * v[std::size_t(P.inner[q])];
+        Cval[e] = sum;
+        const int t = transpose_pos[std::size_t(e)];
+        if (t >= 0) Cval[t] = sum;
+      }
+      for (int p = P.outer[J]; p < P.outer[J + 1]; ++p) {
+        const int t = P.inner[p];
+        for (int a = A.outer[t]; a < A.outer[t + 1]; ++a) v[std::size_t(A.inner[a])] = 0.0;
       }
     }
   });
@@ -193,12 +210,14 @@ void numeric_product(const SparseMatrix& Xm, const SparseMatrix& Ym, SparseMatri
 
 // ---- the solver's internal numbering -------------------------------------------------------
 //
-// Each coloured level is stored colour-major: the functions of colour 0 first, then colour 1, …,
-// each colour in the caller's index order. A colour pass of Gauss-Seidel then reads one
-// contiguous block of rows instead of every eighth row of the whole matrix, which measured 3-4x
-// faster per sweep on the armadillo at depth 9 (the interleaved rows defeated the hardware
-// prefetchers; DESIGN.md's 8-colour ordering and its results are unchanged). `perm[r]` is the
-// caller's index of internal row r, `inv` its inverse; both are empty for the identity.
+// Each coloured level is stored in tiles of kTile consecutive caller indices, colour-major inside
+// each tile (colour 0's functions of the tile first, each colour in index order). A colour pass of
+// Gauss-Seidel then streams one contiguous segment per tile instead of every eighth row of the
+// whole matrix (the interleaved rows defeated the hardware prefetchers: 3-4x slower per sweep on
+// the armadillo at depth 9), and the rows a coarse function's support touches stay within a few
+// tiles, which keeps the Galerkin product's accumulators in cache (a global colour-major order
+// made it 2x slower). DESIGN.md's 8-colour ordering and its iterates are unchanged. `perm[r]`
+// is the caller's index of internal row r, `inv` its inverse; both are empty for the identity.
 
 int old_index(const std::vector<int>& perm, int r) { return perm.empty() ? r : perm[std::size_t(r)]; }
 int new_index(const std::vector<int>& inv, int i) { return inv.empty() ? i : inv[std::size_t(i)]; }
@@ -275,12 +294,12 @@ struct MultigridSolver::Impl {
     std::vector<double> inv_diag;
     std::vector<int> diag_pos;         // position of the diagonal entry of each column, -1 if none
     bool coloured = false;
-    std::array<int, 9> colour_start{}; // colour c is internal rows [colour_start[c], colour_start[c+1])
+    std::vector<std::uint8_t> colour;  // colour of each internal row
+    std::vector<int> segment_start;    // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
     // Transfer to the next finer level (absent on the finest level).
     SparseMatrix P;                    // n_{l+1} x n_l
     SparseMatrix PT;                   // n_l x n_{l+1}
-    SparseMatrix R;                    // A_{l+1} P (pattern fixed after the symbolic build)
-    Spa spa_R, spa_A;
+    Spa spa;                           // dense accumulators of the Galerkin product
     // Work buffers (interleaved n x k).
     std::vector<double> x, b, r;
     int n() const { return int(A.rows()); }
@@ -307,27 +326,31 @@ struct MultigridSolver::Impl {
     coarse_sol.resize(levels.front().n(), k);
   }
 
-  /// The colour-major numbering of a level from its given colours (identity when none are given,
-  /// their count is wrong or a colour is out of 0..7).
+  /// The level's internal numbering from its given colours: blocks of kTile consecutive caller
+  /// indices, colour-major inside each block (identity when no colours are given, their count is
+  /// wrong or a colour is out of 0..7). Segment (t, c) = rows of colour c in block t.
   static void number_by_colour(Level& L, int n, const std::vector<std::uint8_t>* given) {
     L.perm.clear();
     L.inv.clear();
-    L.colour_start = {};
+    L.colour.clear();
+    L.segment_start.clear();
     if (given == nullptr || int(given->size()) != n) return;
     const auto& col = *given;
     for (int i = 0; i < n; ++i)
       if (col[std::size_t(i)] > 7) return;
-    std::array<int, 9> start{};
-    for (int i = 0; i < n; ++i) ++start[col[std::size_t(i)] + 1u];
-    for (int c = 0; c < 8; ++c) start[std::size_t(c) + 1] += start[std::size_t(c)];
-    L.colour_start = start;
+    const int tiles = (n + kTile - 1) / kTile;
+    L.segment_start.assign(std::size_t(tiles) * 8 + 1, 0);
+    for (int i = 0; i < n; ++i) ++L.segment_start[std::size_t(i / kTile) * 8 + col[std::size_t(i)] + 1];
+    for (std::size_t q = 1; q < L.segment_start.size(); ++q) L.segment_start[q] += L.segment_start[q - 1];
     L.perm.resize(std::size_t(n));
     L.inv.resize(std::size_t(n));
-    auto fill = start;
+    L.colour.resize(std::size_t(n));
+    std::vector<int> fill(L.segment_start.begin(), L.segment_start.end() - 1);
     for (int i = 0; i < n; ++i) {
-      const int r = fill[col[std::size_t(i)]]++;
+      const int r = fill[std::size_t(i / kTile) * 8 + col[std::size_t(i)]]++;
       L.perm[std::size_t(r)] = i;
       L.inv[std::size_t(i)] = r;
+      L.colour[std::size_t(r)] = col[std::size_t(i)];
     }
   }
 
@@ -337,19 +360,17 @@ struct MultigridSolver::Impl {
     L.coloured = false;
     if (L.perm.empty()) return;
     const Csc A(L.A);
-    const auto& st = L.colour_start;
     const bool ok = tbb::parallel_reduce(
-        tbb::blocked_range<int>(0, 8, 1), true,
-        [&](const tbb::blocked_range<int>& cs, bool good) {
-          for (int c = cs.begin(); good && c < cs.end(); ++c)
-            for (int r = st[std::size_t(c)]; good && r < st[std::size_t(c) + 1]; ++r)
-              for (int p = A.outer[r]; p < A.outer[r + 1]; ++p) {
-                const int q = A.inner[p];
-                if (q != r && q >= st[std::size_t(c)] && q < st[std::size_t(c) + 1]) {
-                  good = false;
-                  break;
-                }
+        tbb::blocked_range<int>(0, L.n(), 4096), true,
+        [&](const tbb::blocked_range<int>& rows, bool good) {
+          for (int r = rows.begin(); good && r < rows.end(); ++r)
+            for (int p = A.outer[r]; p < A.outer[r + 1]; ++p) {
+              const int q = A.inner[p];
+              if (q != r && L.colour[std::size_t(q)] == L.colour[std::size_t(r)]) {
+                good = false;
+                break;
               }
+            }
           return good;
         },
         [](bool x, bool y) { return x && y; });
@@ -395,8 +416,7 @@ struct MultigridSolver::Impl {
     }
     for (std::size_t l = nl - 1; l-- > 0;) {
       Level& C = levels[l];
-      C.R = symbolic_product(levels[l + 1].A, C.P);
-      C.A = symbolic_product(C.PT, C.R);
+      C.A = symbolic_product(C.PT, symbolic_product(levels[l + 1].A, C.P));  // pattern of Pᵀ (A P)
       // Positions of transposed entries, to symmetrize the computed values exactly.
       const Csc M(C.A);
       C.transpose_pos.assign(std::size_t(C.A.nonZeros()), -1);
@@ -437,20 +457,7 @@ struct MultigridSolver::Impl {
   bool numeric() {
     for (std::size_t l = levels.size() - 1; l-- > 0;) {
       Level& C = levels[l];
-      numeric_product(levels[l + 1].A, C.P, C.R, C.spa_R);
-      numeric_product(C.PT, C.R, C.A, C.spa_A);
-      double* v = C.A.valuePtr();
-      const Csc M(C.A);
-      tbb::parallel_for(0, M.cols, [&](int J) {
-        for (int e = M.outer[J]; e < M.outer[J + 1]; ++e) {
-          const int t = C.transpose_pos[std::size_t(e)];
-          if (M.inner[e] > J && t >= 0) {
-            const double s = 0.5 * (v[e] + v[t]);
-            v[e] = s;
-            v[t] = s;
-          }
-        }
-      });
+      galerkin_values(levels[l + 1].A, C.P, C.A, C.transpose_pos, C.inv, C.spa);
     }
     bool ok = true;
     for (auto& L : levels) {
@@ -482,11 +489,19 @@ struct MultigridSolver::Impl {
       if (L.coloured) {
         for (int ci = 0; ci < 8; ++ci) {
           const int c = reverse ? 7 - ci : ci;
-          const int first = L.colour_start[std::size_t(c)];
-          const int count = L.colour_start[std::size_t(c) + 1] - first;
-          for_rows(count, [&](int bgn, int end) {
-            for (int r = first + bgn; r < first + end; ++r) gs_row<K>(A, dp, id, b, x, s, o, r);
-          });
+          const int tiles = int(L.segment_start.size() / 8);
+          const auto relax_tiles = [&](int t0, int t1) {
+            for (int t = t0; t < t1; ++t) {
+              const std::size_t q = std::size_t(t) * 8 + std::size_t(c);
+              for (int r = L.segment_start[q]; r < L.segment_start[q + 1]; ++r) gs_row<K>(A, dp, id, b, x, s, o, r);
+            }
+          };
+          if (tiles == 1) {
+            relax_tiles(0, 1);
+          } else {
+            tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1),
+                              [&](const tbb::blocked_range<int>& r) { relax_tiles(r.begin(), r.end()); });
+          }
         }
       } else if (!reverse) {
         for (int i = 0; i < A.cols; ++i) gs_row<K>(A, dp, id, b, x, s, o, i);

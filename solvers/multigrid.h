@@ -12,23 +12,22 @@
 // functions are independent, so their order does not change the result. With pre_smooth ==
 // post_smooth the cycle, started from zero, is a symmetric operator (precondition()).
 //
-// Internal numbering: every coloured level is stored colour-major (colour 0's functions first,
-// each colour in index order), so one colour pass streams a contiguous block of rows; the
+// Internal numbering: every coloured level is stored in tiles of `tile_size` consecutive indices,
+// colour-major inside each tile, so a colour pass streams contiguous segments of rows; the
 // permutation is applied when right-hand sides and solutions are copied in and out, and to the
 // finest matrix's values in set_matrix (one block copy per column). Only the order in which a
-// row's terms are added differs from the caller's numbering; level_matrix() converts back. A level
-// whose given colouring is invalid keeps the colour-major order and is relaxed serially in it.
+// row's terms are added differs from the caller's numbering (the finest level keeps the caller's
+// entry order, coarse levels add in internal order); level_matrix() converts back. A level whose
+// given colouring is invalid keeps the internal order and is relaxed serially in it.
 //
 // Layout and cost: right-hand sides are interleaved (row-major n x k) in preallocated per-level
 // buffers, all columns are relaxed in the same sweep (chunks of up to 4 columns). Per cycle on
 // level l: pre + post sweeps, one residual, restriction b_c = Pᵀ r (gather over P's columns),
-// prolongation x += P x_c (gather over the columns of the stored Pᵀ). The Galerkin product is
-// two-stage, R = A_{l+1} P then A_l = Pᵀ R, with both patterns built once (symbolic_builds());
-// later set_matrix calls only recompute values, column-parallel with thread-local dense
-// accumulators, then symmetrize A_l exactly. Measured on a 65^3 grid (7.2M nonzeros, 3 columns,
-// 1 thread, shared noisy machine): one W-cycle (5+5 sweeps, 6 levels) ~ 11.8-13.5 Eigen SpMVs
-// (A * X) ~ 18-22 of the solver's own fused residual evaluations; a numeric set_matrix ~ 3-5
-// Eigen SpMVs.
+// prolongation x += P x_c (gather over the columns of the stored Pᵀ). The Galerkin pattern of
+// Pᵀ (A_{l+1} P) is built once (symbolic_builds()); later set_matrix calls only recompute values:
+// per coarse column J, v = A_{l+1} P e_J in a thread-local dense accumulator, then the upper
+// entries (I <= J) as dot products P e_I · v, mirrored, so A_l is exactly symmetric and A P is
+// never stored. Measured numbers: README "Benchmarks" (bench/micro_octree.cpp).
 
 #include "solvers/linear_solver.h"
 
@@ -52,6 +51,9 @@ const char* to_string(MultigridCycle c);
 
 class MultigridSolver : public LinearSolver {
  public:
+  /// Consecutive function indices per tile of a coloured level's internal numbering.
+  static constexpr int tile_size = 4096;
+
   explicit MultigridSolver(MultigridOptions options = {});
   ~MultigridSolver() override;
   MultigridSolver(const MultigridSolver&) = delete;

@@ -345,9 +345,9 @@ TEST(Multigrid, BitwiseIdenticalForOneAndTwoThreads) {
 }
 
 /// Serial Gauss-Seidel over `order`, the same arithmetic as the solver's sweep. A row's terms are
-/// added in the matrix's index order, or, with `term_colour`, ordered by (colour, index) of the
-/// column: the solver's coarse levels are stored colour-major with sorted columns, while its
-/// finest level keeps the caller's entry order.
+/// added in the matrix's index order, or, with `term_colour`, ordered by (tile, colour, index) of
+/// the column: the solver's coarse levels are stored tile-wise colour-major with sorted columns,
+/// while its finest level keeps the caller's entry order.
 void reference_gs(const SparseMatrix& A, const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const std::vector<int>& order,
                   const std::vector<std::uint8_t>* term_colour = nullptr) {
   for (int i : order) {
@@ -362,7 +362,9 @@ void reference_gs(const SparseMatrix& A, const Eigen::MatrixXd& B, Eigen::Matrix
     }
     if (term_colour != nullptr)
       std::stable_sort(terms.begin(), terms.end(), [&](const auto& a, const auto& b) {
-        return (*term_colour)[std::size_t(a.first)] < (*term_colour)[std::size_t(b.first)];
+        const int tile = MultigridSolver::tile_size;
+        return std::pair(a.first / tile, (*term_colour)[std::size_t(a.first)]) <
+               std::pair(b.first / tile, (*term_colour)[std::size_t(b.first)]);
       });
     Eigen::RowVectorXd acc = B.row(i);
     for (const auto& [j, v] : terms) acc -= v * X.row(j);
