@@ -263,16 +263,19 @@ bool same_permuted(const SparseMatrix& stored, const SparseMatrix& given, const 
   return tbb::parallel_reduce(
       tbb::blocked_range<int>(0, S.cols, 1024), true,
       [&](const tbb::blocked_range<int>& range, bool ok) {
-        std::vector<std::pair<int, double>> col;
         for (int r = range.begin(); ok && r < range.end(); ++r) {
           const int j = old_index(col_perm, r);
-          if (G.outer[j + 1] - G.outer[j] != S.outer[r + 1] - S.outer[r]) return false;
-          col.clear();
-          for (int p = G.outer[j]; p < G.outer[j + 1]; ++p) col.emplace_back(new_index(row_inv, G.inner[p]), G.val[p]);
-          if (sort) std::sort(col.begin(), col.end());
-          for (std::size_t t = 0; t < col.size(); ++t) {
-            const int e = S.outer[r] + int(t);
-            if (S.inner[e] != col[t].first || (values && S.val[e] != col[t].second)) return false;
+          const int n = G.outer[j + 1] - G.outer[j];
+          if (n != S.outer[r + 1] - S.outer[r]) return false;
+          const int* sb = S.inner + S.outer[r];
+          const int* se = sb + n;
+          for (int t = 0; t < n; ++t) {
+            const int p = G.outer[j] + t;
+            const int i = new_index(row_inv, G.inner[p]);
+            // Unsorted: entry t in place. Sorted: somewhere in the column (rows are distinct and
+            // the counts equal, so finding every given entry proves equality).
+            const int* it = sort ? std::lower_bound(sb, se, i) : sb + t;
+            if (it == se || *it != i || (values && S.val[it - S.inner] != G.val[p])) return false;
           }
         }
         return ok;

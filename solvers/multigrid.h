@@ -52,7 +52,7 @@ const char* to_string(MultigridCycle c);
 class MultigridSolver : public LinearSolver {
  public:
   /// Consecutive function indices per tile of a coloured level's internal numbering.
-  static constexpr int tile_size = 4096;
+  static constexpr int tile_size = 1024;
 
   explicit MultigridSolver(MultigridOptions options = {});
   ~MultigridSolver() override;
