@@ -56,6 +56,7 @@ def main():
               ("multigrid set_matrix (numeric)", "BM_Rebuilt_SetMatrix/mesh:{m}"),
               ("one V-cycle (5 GS)", "BM_Rebuilt_Cycle/mesh:{m}/W:0"),
               ("one W-cycle (5 GS)", "BM_Rebuilt_Cycle/mesh:{m}/W:1"),
+              ("five fine Gauss-Seidel sweeps", "BM_Rebuilt_Sweep/mesh:{m}"),
               ("one fine SpMV (3 columns)", "BM_Rebuilt_SpMV/mesh:{m}")]
     present = [(m, n) for m, n in meshes if any(k.format(m=m) in b for _, k in phases)]
     if present:
@@ -83,6 +84,11 @@ def main():
             w = get(f"BM_Rebuilt_Cycle/mesh:{m}/W:1")
             row.append(fmt(w.get("wcycle_over_spmv")) if w else "—")
         lines.append("| W-cycle / SpMV (target ≤ 20) | " + " | ".join(row) + " |")
+        row = []
+        for m, _ in present:
+            w = get(f"BM_Rebuilt_Sweep/mesh:{m}")
+            row.append(fmt(w.get("sweep_over_spmv")) if w else "—")
+        lines.append("| one fine sweep / SpMV | " + " | ".join(row) + " |")
         lines.append("")
         sph = get("BM_Rebuilt_Clip/mesh:1") or get("BM_Rebuilt_Cycle/mesh:1/W:1")
         if sph:
