@@ -173,7 +173,7 @@ using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 /// dot products are formed. Every entry is computed by one task in a fixed order: deterministic.
 /// Columns are visited in `column_order` (internal column of the caller's column jj; empty:
 /// identity), i.e. in grid order, so consecutive columns share most of their fine support:
-/// visiting them colour-major measured 2x slower.
+/// visiting them colour-major measured 1.3x slower.
 void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatrix& Cm,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order, Spa& spa) {
   const Csc A(Am), P(Pm);
@@ -213,10 +213,10 @@ void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatri
 // Each coloured level is stored in tiles of kTile consecutive caller indices, colour-major inside
 // each tile (colour 0's functions of the tile first, each colour in index order). A colour pass of
 // Gauss-Seidel then streams one contiguous segment per tile instead of every eighth row of the
-// whole matrix (the interleaved rows defeated the hardware prefetchers: 3-4x slower per sweep on
-// the armadillo at depth 9), and the rows a coarse function's support touches stay within a few
-// tiles, which keeps the Galerkin product's accumulators in cache (a global colour-major order
-// made it 2x slower). DESIGN.md's 8-colour ordering and its iterates are unchanged. `perm[r]`
+// whole matrix (the interleaved rows defeated the hardware prefetchers: a sweep on the armadillo
+// at depth 9 took 2.1x as long in the solver, 3.5x in a stand-alone kernel benchmark), and the
+// rows a coarse function's support touches stay within a few tiles, which keeps the Galerkin
+// product's accumulators in cache (a global colour-major order made it 1.6x slower). DESIGN.md's 8-colour ordering and its iterates are unchanged. `perm[r]`
 // is the caller's index of internal row r, `inv` its inverse; both are empty for the identity.
 
 int old_index(const std::vector<int>& perm, int r) { return perm.empty() ? r : perm[std::size_t(r)]; }
@@ -289,8 +289,8 @@ bool same_permuted(const SparseMatrix& stored, const SparseMatrix& given, const 
 
 struct MultigridSolver::Impl {
   struct Level {
-    // All matrices and buffers of a level are in its internal numbering (colour-major when the
-    // level is coloured; see permuted()).
+    // All matrices and buffers of a level are in its internal numbering (tile-wise colour-major
+    // when colours were given; see number_by_colour()).
     SparseMatrix A;                    // compressed, symmetric pattern; coarse levels sorted
     std::vector<int> perm, inv;        // internal row r <-> caller's index perm[r]; empty: identity
     std::vector<int> transpose_pos;    // entry e=(i,J) -> position of (J,i) (coarse levels)
