@@ -216,8 +216,9 @@ void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatri
 // whole matrix (the interleaved rows defeated the hardware prefetchers: a sweep on the armadillo
 // at depth 9 took 2.1x as long in the solver, 3.5x in a stand-alone kernel benchmark), and the
 // rows a coarse function's support touches stay within a few tiles, which keeps the Galerkin
-// product's accumulators in cache (a global colour-major order made it 1.6x slower). DESIGN.md's 8-colour ordering and its iterates are unchanged. `perm[r]`
-// is the caller's index of internal row r, `inv` its inverse; both are empty for the identity.
+// product's accumulators in cache (a global colour-major order made it 1.6x slower). DESIGN.md's
+// 8-colour ordering and its iterates are unchanged. `perm[r]` is the caller's index of internal
+// row r, `inv` its inverse; both are empty for the identity.
 
 int old_index(const std::vector<int>& perm, int r) { return perm.empty() ? r : perm[std::size_t(r)]; }
 int new_index(const std::vector<int>& inv, int i) { return inv.empty() ? i : inv[std::size_t(i)]; }
@@ -297,7 +298,6 @@ struct MultigridSolver::Impl {
     std::vector<double> inv_diag;
     std::vector<int> diag_pos;         // position of the diagonal entry of each column, -1 if none
     bool coloured = false;
-    std::vector<std::uint8_t> colour;  // colour of each internal row
     std::vector<int> segment_start;    // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
     // Transfer to the next finer level (absent on the finest level).
     SparseMatrix P;                    // n_{l+1} x n_l
@@ -335,7 +335,6 @@ struct MultigridSolver::Impl {
   static void number_by_colour(Level& L, int n, const std::vector<std::uint8_t>* given) {
     L.perm.clear();
     L.inv.clear();
-    L.colour.clear();
     L.segment_start.clear();
     if (given == nullptr || int(given->size()) != n) return;
     const auto& col = *given;
@@ -347,21 +346,21 @@ struct MultigridSolver::Impl {
     for (std::size_t q = 1; q < L.segment_start.size(); ++q) L.segment_start[q] += L.segment_start[q - 1];
     L.perm.resize(std::size_t(n));
     L.inv.resize(std::size_t(n));
-    L.colour.resize(std::size_t(n));
     std::vector<int> fill(L.segment_start.begin(), L.segment_start.end() - 1);
     for (int i = 0; i < n; ++i) {
       const int r = fill[std::size_t(i / kTile) * 8 + col[std::size_t(i)]]++;
       L.perm[std::size_t(r)] = i;
       L.inv[std::size_t(i)] = r;
-      L.colour[std::size_t(r)] = col[std::size_t(i)];
     }
   }
 
   /// A numbered level is coloured when no two functions of one colour couple (checked on the
-  /// level's matrix pattern); otherwise it is relaxed serially in its internal order.
-  static void check_colouring(Level& L) {
+  /// level's matrix pattern with its given colours); otherwise it is relaxed serially in its
+  /// internal order.
+  static void check_colouring(Level& L, const std::vector<std::uint8_t>* given) {
     L.coloured = false;
     if (L.perm.empty()) return;
+    const auto colour = [&](int r) { return (*given)[std::size_t(L.perm[std::size_t(r)])]; };
     const Csc A(L.A);
     const bool ok = tbb::parallel_reduce(
         tbb::blocked_range<int>(0, L.n(), 4096), true,
@@ -369,7 +368,7 @@ struct MultigridSolver::Impl {
           for (int r = rows.begin(); good && r < rows.end(); ++r)
             for (int p = A.outer[r]; p < A.outer[r + 1]; ++p) {
               const int q = A.inner[p];
-              if (q != r && L.colour[std::size_t(q)] == L.colour[std::size_t(r)]) {
+              if (q != r && colour(q) == colour(r)) {
                 good = false;
                 break;
               }
@@ -433,9 +432,9 @@ struct MultigridSolver::Impl {
         }
       });
     }
-    for (auto& L : levels) {
-      check_colouring(L);
-      find_diagonal(L);
+    for (std::size_t l = 0; l < nl; ++l) {
+      check_colouring(levels[l], l < colours.size() ? &colours[l] : nullptr);
+      find_diagonal(levels[l]);
     }
     k = 0;
     ++symbolic_builds;
