@@ -14,9 +14,32 @@
 // upper triangles are summed (b ≥ a) and read. The order of the sums depends only on the order
 // of the points, so results do not depend on threads.
 
+#include <cmath>
 #include <cstring>
 
 namespace mcf {
+
+/// The frame CellBlocks::add expects for a piece with corners p0, p1, p2 (any one length unit):
+/// f1 = scale e1, f2 = scale e2, where e1 = (p1 - p0) / |p1 - p0| and e2 = n × e1 span the
+/// piece's plane (n its unit normal). Returns |(p1 - p0) × (p2 - p0)|, twice the area; 0 for a
+/// degenerate piece, whose frame is left unset.
+inline double piece_frame(const double p0[3], const double p1[3], const double p2[3], double scale,
+                          double f1[3], double f2[3]) {
+  const double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+  const double v[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+  double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(len > 0.0)) return 0.0;
+  for (double& ni : n) ni /= len;
+  const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  const double e1[3] = {u[0] / ul, u[1] / ul, u[2] / ul};
+  const double e2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]};
+  for (int a = 0; a < 3; ++a) {
+    f1[a] = e1[a] * scale;
+    f2[a] = e2[a] * scale;
+  }
+  return len;
+}
 
 template <bool Mass, bool Stiffness>
 class CellBlocks {
@@ -88,13 +111,29 @@ class CellBlocks {
   // Per buffered point: 8 lanes each of β, w_m β, η, μ, P = S₁₁η + S₁₂μ, Q = S₁₂η + S₂₂μ.
   enum { kVal = 0, kWVal = 8, kEta = 16, kMu = 24, kP = 32, kQ = 40, kLanes = 48 };
 
-  /// Row a of a block is updated in lanes b = 0..3 (only for a < 4: upper triangle) and b = 4..7.
+  /// The upper triangle of an 8x8 block as vector lanes: row a in lanes b = 0..3 (only for
+  /// a < 4) and b = 4..7.
+  struct Upper {
+    v4 lo[4], hi[8];
+  };
+  static Upper load_upper(const double (&block)[8][8]) {
+    Upper u;
+    for (int a = 0; a < 4; ++a) u.lo[a] = load(&block[a][0]);
+    for (int a = 0; a < 8; ++a) u.hi[a] = load(&block[a][4]);
+    return u;
+  }
+  static void store_upper(double (&block)[8][8], const Upper& u) {
+    for (int a = 0; a < 4; ++a) store(&block[a][0], u.lo[a]);
+    for (int a = 0; a < 8; ++a) store(&block[a][4], u.hi[a]);
+  }
+
+  /// Sums the buffered points into the blocks' upper triangles, held in registers meanwhile.
   void accumulate() {
     if (count_ == 0) return;
     if constexpr (Mass) {
-      v4 lo[4], hi[8];
-      for (int a = 0; a < 4; ++a) lo[a] = load(&m_[a][0]);
-      for (int a = 0; a < 8; ++a) hi[a] = load(&m_[a][4]);
+      Upper m = load_upper(m_);
+      v4(&lo)[4] = m.lo;
+      v4(&hi)[8] = m.hi;
       for (int p = 0; p < count_; ++p) {
         const double* s = lanes_[p];
         const v4 vlo = load(s + kVal), vhi = load(s + kVal + 4);
@@ -105,13 +144,12 @@ class CellBlocks {
           hi[a] += wa * vhi;
         }
       }
-      for (int a = 0; a < 4; ++a) store(&m_[a][0], lo[a]);
-      for (int a = 0; a < 8; ++a) store(&m_[a][4], hi[a]);
+      store_upper(m_, m);
     }
     if constexpr (Stiffness) {
-      v4 lo[4], hi[8];
-      for (int a = 0; a < 4; ++a) lo[a] = load(&k_[a][0]);
-      for (int a = 0; a < 8; ++a) hi[a] = load(&k_[a][4]);
+      Upper k = load_upper(k_);
+      v4(&lo)[4] = k.lo;
+      v4(&hi)[8] = k.hi;
       for (int p = 0; p < count_; ++p) {
         const double* s = lanes_[p];
         const v4 elo = load(s + kEta), ehi = load(s + kEta + 4);
@@ -123,8 +161,7 @@ class CellBlocks {
           hi[a] += pa * ehi + qa * mhi;
         }
       }
-      for (int a = 0; a < 4; ++a) store(&k_[a][0], lo[a]);
-      for (int a = 0; a < 8; ++a) store(&k_[a][4], hi[a]);
+      store_upper(k_, k);
     }
     count_ = 0;
   }

@@ -194,15 +194,10 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
           for (int a = 0; a < 3; ++a) cell_origin[a] = cube.origin[a] + h * ijk[a];
           for (int s = cell_start_[static_cast<std::size_t>(c)]; s < cell_start_[static_cast<std::size_t>(c) + 1]; ++s) {
             const ClippedTriangle& t = pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])];
-            const Eigen::Vector3d cr = t.cross();
-            const double len = cr.norm();
-            if (!(len > 0.0)) continue;
             // Orthonormal frame of the piece's plane; identity metric: S = w I.
-            const Eigen::Vector3d n = cr / len;
-            const Eigen::Vector3d e1 = (t.corner(1) - t.corner(0)).normalized();
-            const Eigen::Vector3d e2 = n.cross(e1);
-            const double f1[3] = {e1[0] * inv_h, e1[1] * inv_h, e1[2] * inv_h};
-            const double f2[3] = {e2[0] * inv_h, e2[1] * inv_h, e2[2] * inv_h};
+            double f1[3], f2[3];
+            const double len = piece_frame(t.corners[0], t.corners[1], t.corners[2], inv_h, f1, f2);
+            if (!(len > 0.0)) continue;
             const double area = 0.5 * len;
             for (int q = 0; q < nq; ++q) {
               const auto& bc = rule.points[static_cast<std::size_t>(q)];

@@ -93,20 +93,12 @@ int integrate_cell(const double xc[8][3], const double* corners, int pieces, con
   const int nq = rule.size();
   for (int s = 0; s < pieces; ++s) {
     const double* p = corners + 9 * s;
-    // Orthonormal frame (e1, e2) of the piece's plane on X_0 (ComputeDifferential), in cell units.
-    const double u[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
-    const double v[3] = {p[6] - p[0], p[7] - p[1], p[8] - p[2]};
-    double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    // Orthonormal frame (e1, e2) of the piece's plane on X_0 (ComputeDifferential), in cell
+    // units; tangent derivatives in world units: ∂/∂e = (e / h) · ∇_t.
+    double f1[3], f2[3];
+    const double len = piece_frame(p, p + 3, p + 6, inv_h, f1, f2);
     if (!(len > 0.0)) continue;
     const double area = 0.5 * len * h * h;
-    const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    const double e1[3] = {u[0] / ul, u[1] / ul, u[2] / ul};
-    for (double& ni : n) ni /= len;
-    const double e2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]};
-    // Tangent derivatives in world units: ∂/∂e = (e / h) · ∇_t.
-    const double f1[3] = {e1[0] * inv_h, e1[1] * inv_h, e1[2] * inv_h};
-    const double f2[3] = {e2[0] * inv_h, e2[1] * inv_h, e2[2] * inv_h};
     for (int q = 0; q < nq; ++q) {
       const auto& bc = rule.points[std::size_t(q)];
       double t[3];
