@@ -171,51 +171,45 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
   const int nq = rule.size();
   const auto& pieces = *pieces_;
 
-  const CellTiles& T = tiles_;
-  for (int colour = 0; colour < 8; ++colour) {
-    tbb::parallel_for(tbb::blocked_range<int>(T.colour_start[std::size_t(colour)], T.colour_start[std::size_t(colour) + 1], 1),
-                      [&](const tbb::blocked_range<int>& r) {
-      CellBlocks<true, true> blocks;
-      for (int tile = r.begin(); tile != r.end(); ++tile) {
-        const int first = T.tile_start[std::size_t(tile)], last = T.tile_start[std::size_t(tile) + 1];
-        for (int ci = first; ci < last; ++ci) {
-          const int c = T.cells[std::size_t(ci)];
-          if (ci + 2 < last) {  // pieces are in triangle order: prefetch a later cell's pieces
-            const auto cn = static_cast<std::size_t>(T.cells[std::size_t(ci) + 2]);
-            for (int s = cell_start_[cn]; s < cell_start_[cn + 1]; ++s) {
-              const char* p = reinterpret_cast<const char*>(&pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])]);
-              __builtin_prefetch(p);
-              __builtin_prefetch(p + 64);
-            }
-          }
-          blocks.clear();
-          const auto ijk = grid_index(L.cells[static_cast<std::size_t>(c)]);
-          double cell_origin[3];
-          for (int a = 0; a < 3; ++a) cell_origin[a] = cube.origin[a] + h * ijk[a];
-          for (int s = cell_start_[static_cast<std::size_t>(c)]; s < cell_start_[static_cast<std::size_t>(c) + 1]; ++s) {
-            const ClippedTriangle& t = pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])];
-            // Orthonormal frame of the piece's plane; identity metric: S = w I.
-            double f1[3], f2[3];
-            const double len = piece_frame(t.corners[0], t.corners[1], t.corners[2], inv_h, f1, f2);
-            if (!(len > 0.0)) continue;
-            const double area = 0.5 * len;
-            for (int q = 0; q < nq; ++q) {
-              const auto& bc = rule.points[static_cast<std::size_t>(q)];
-              double local[3];
-              for (int a = 0; a < 3; ++a) {
-                const double x = bc[0] * t.corners[0][a] + bc[1] * t.corners[1][a] + bc[2] * t.corners[2][a];
-                local[a] = std::clamp((x - cell_origin[a]) * inv_h, 0.0, 1.0);
-              }
-              const double w = area * rule.weights[static_cast<std::size_t>(q)];
-              blocks.add(local, f1, f2, w, w, 0.0, w);
-            }
-          }
-          blocks.finish();
-          add_cell_blocks(c, blocks, Mv, Kv);
+  for_each_tile([&](const int* cells, int n) {
+    CellBlocks<true, true> blocks;
+    for (int i = 0; i < n; ++i) {
+      const int c = cells[i];
+      if (i + 2 < n) {  // pieces are in triangle order: prefetch a later cell's pieces
+        const auto cn = static_cast<std::size_t>(cells[i + 2]);
+        for (int s = cell_start_[cn]; s < cell_start_[cn + 1]; ++s) {
+          const char* p = reinterpret_cast<const char*>(&pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])]);
+          __builtin_prefetch(p);
+          __builtin_prefetch(p + 64);
         }
       }
-    });
-  }
+      blocks.clear();
+      const auto ijk = grid_index(L.cells[static_cast<std::size_t>(c)]);
+      double cell_origin[3];
+      for (int a = 0; a < 3; ++a) cell_origin[a] = cube.origin[a] + h * ijk[a];
+      for (int s = cell_start_[static_cast<std::size_t>(c)]; s < cell_start_[static_cast<std::size_t>(c) + 1]; ++s) {
+        const ClippedTriangle& t = pieces[static_cast<std::size_t>(piece_order_[static_cast<std::size_t>(s)])];
+        // Orthonormal frame of the piece's plane; identity metric: S = w I.
+        double f1[3], f2[3];
+        const double len = piece_frame(t.corners[0], t.corners[1], t.corners[2], inv_h, f1, f2);
+        if (!(len > 0.0)) continue;
+        const double area = 0.5 * len;
+        for (int q = 0; q < nq; ++q) {
+          const auto& bc = rule.points[static_cast<std::size_t>(q)];
+          double local[3];
+          for (int a = 0; a < 3; ++a) {
+            const double x = bc[0] * t.corners[0][a] + bc[1] * t.corners[1][a] + bc[2] * t.corners[2][a];
+            local[a] = std::clamp((x - cell_origin[a]) * inv_h, 0.0, 1.0);
+          }
+          const double w = area * rule.weights[static_cast<std::size_t>(q)];
+          blocks.add(local, f1, f2, w, w, 0.0, w);
+        }
+      }
+      blocks.finish();
+      add_cell_blocks(c, blocks, Mv, Kv);
+    }
+    return 0LL;
+  });
 }
 
 std::vector<SparseMatrix> build_prolongations(const Octree& octree) {

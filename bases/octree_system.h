@@ -11,6 +11,9 @@
 #include "bases/cubature.h"
 #include "bases/octree.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -96,6 +99,25 @@ class OctreeSystem {
     std::array<int, 9> colour_start{};  ///< colour q: tiles [colour_start[q], colour_start[q+1])
   };
   const CellTiles& tiles() const { return tiles_; }
+  /// Runs `count = f(cells, n)` on every tile (its n cell indices in accumulation order) in the
+  /// order above: 8 colour passes, the tiles of a pass in parallel. Returns the sum of the counts.
+  template <class F>
+  long long for_each_tile(F&& f) const {
+    const CellTiles& T = tiles_;
+    long long total = 0;
+    for (std::size_t colour = 0; colour < 8; ++colour)
+      total += tbb::parallel_reduce(
+          tbb::blocked_range<int>(T.colour_start[colour], T.colour_start[colour + 1], 1), 0LL,
+          [&](const tbb::blocked_range<int>& r, long long count) {
+            for (int tile = r.begin(); tile != r.end(); ++tile) {
+              const int first = T.tile_start[std::size_t(tile)];
+              count += f(T.cells.data() + first, T.tile_start[std::size_t(tile) + 1] - first);
+            }
+            return count;
+          },
+          [](long long a, long long b) { return a + b; });
+    return total;
+  }
   /// The 64 value slots of cell c's 8x8 block: slots[8a+b] = slot(c, a, b).
   void cell_slots(int cell, int slots[64]) const {
     const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];

@@ -143,32 +143,23 @@ long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const C
                        const CubatureRule& rule, double h, double* Mv, double* Kv) {
   const double* X = x.data();
   const Eigen::Index ld = x.rows();  // column-major n x 3
-  const auto& T = system.tiles();
-  long long degenerate = 0;
-  for (int colour = 0; colour < 8; ++colour) {
-    degenerate += tbb::parallel_reduce(
-        tbb::blocked_range<int>(T.colour_start[std::size_t(colour)], T.colour_start[std::size_t(colour) + 1], 1), 0LL,
-        [&](const tbb::blocked_range<int>& r, long long count) {
-          CellBlocks<Mass, Stiffness> blocks;
-          for (int tile = r.begin(); tile != r.end(); ++tile) {
-            for (int ci = T.tile_start[std::size_t(tile)]; ci < T.tile_start[std::size_t(tile) + 1]; ++ci) {
-              const int c = T.cells[std::size_t(ci)];
-              const auto& f = L.cell_functions[std::size_t(c)];
-              double xc[8][3];
-              for (int a = 0; a < 8; ++a)
-                for (int d = 0; d < 3; ++d) xc[a][d] = X[d * ld + f[std::size_t(a)]];
-              blocks.clear();
-              const int first = cell_start[std::size_t(c)];
-              count += integrate_cell(xc, &local_corners[9 * std::size_t(first)], cell_start[std::size_t(c) + 1] - first,
-                                      rule, h, blocks);
-              system.add_cell_blocks(c, blocks, Mass ? Mv : nullptr, Stiffness ? Kv : nullptr);
-            }
-          }
-          return count;
-        },
-        [](long long a, long long b) { return a + b; });
-  }
-  return degenerate;
+  return system.for_each_tile([&](const int* cells, int n) {
+    CellBlocks<Mass, Stiffness> blocks;
+    long long degenerate = 0;
+    for (int i = 0; i < n; ++i) {
+      const int c = cells[i];
+      const auto& f = L.cell_functions[std::size_t(c)];
+      double xc[8][3];
+      for (int a = 0; a < 8; ++a)
+        for (int d = 0; d < 3; ++d) xc[a][d] = X[d * ld + f[std::size_t(a)]];
+      blocks.clear();
+      const int first = cell_start[std::size_t(c)];
+      degenerate += integrate_cell(xc, &local_corners[9 * std::size_t(first)], cell_start[std::size_t(c) + 1] - first,
+                                   rule, h, blocks);
+      system.add_cell_blocks(c, blocks, Mass ? Mv : nullptr, Stiffness ? Kv : nullptr);
+    }
+    return degenerate;
+  });
 }
 
 }  // namespace
