@@ -6,6 +6,7 @@
 #include "datasets/mesh_spec.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/pcg_solver.h"
+#include "solvers/symmetric_multiply.h"
 
 #include <benchmark/benchmark.h>
 
@@ -28,7 +29,7 @@ struct HatFixture {
       h.source = load_mesh_spec(spec ? spec : "cgal:armadillo@faces=832000");
       h.basis = std::make_unique<HatBasis>(h.source.mesh);
       h.system = h.basis->mass() + 1e-3 * h.basis->stiffness();
-      h.rhs = h.basis->mass() * h.source.mesh.vertices;
+      symmetric_multiply(h.basis->mass(), h.source.mesh.vertices, h.rhs);
       return h;
     }();
     return f;

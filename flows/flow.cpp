@@ -7,6 +7,7 @@
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
 #include "flows/sphere_reference.h"
+#include "solvers/symmetric_multiply.h"
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -48,8 +49,12 @@ class FlowStepContext final : public StepContext {
     assembled_ = true;
     update_seconds_ += seconds_since(t0);
   }
-  Coefficients apply_mass(const Coefficients& X) const override { return basis_.mass() * X; }
-  Coefficients apply_stiffness(const Coefficients& X) const override { return basis_.stiffness() * X; }
+  // M and K are symmetric: a parallel, thread-count independent gather instead of Eigen's serial
+  // scatter (solvers/symmetric_multiply.h).
+  Coefficients apply_mass(const Coefficients& X) const override { return symmetric_multiply(basis_.mass(), X); }
+  Coefficients apply_stiffness(const Coefficients& X) const override {
+    return symmetric_multiply(basis_.stiffness(), X);
+  }
 
   Coefficients solve(double a, double b, const Coefficients& R, const Coefficients& fixed,
                      const Coefficients& warm) override {

@@ -1,5 +1,7 @@
 #include "flows/reduced_system.h"
 
+#include "solvers/symmetric_multiply.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -84,12 +86,15 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   {
     double* rv = reduced_.valuePtr();
     const double* sv = sum_.valuePtr();
-    for (std::size_t i = 0; i < source_nz_.size(); ++i) rv[i] = sv[source_nz_[i]];
+    const int* src = source_nz_.data();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_nz_.size(), 1 << 14), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) rv[i] = sv[src[i]];
+    });
   }
   // Right-hand side: R_f - S_fl Y_l.
   Coefficients Yfixed = Coefficients::Zero(n, 3);
   for (int i : fixed_) Yfixed.row(i) = fixed_values.row(i);
-  const Coefficients coupling = sum_ * Yfixed;
+  const Coefficients coupling = symmetric_multiply(sum_, Yfixed);  // S is symmetric
   const Eigen::Index nf = Eigen::Index(free_.size());
   Eigen::MatrixXd Rf(nf, 3), Xf(nf, 3);
   for (Eigen::Index i = 0; i < nf; ++i) {

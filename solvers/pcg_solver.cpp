@@ -1,5 +1,7 @@
 #include "solvers/pcg_solver.h"
 
+#include "solvers/symmetric_multiply.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -96,60 +98,7 @@ void PcgSolver::set_preconditioner(Preconditioner preconditioner) {
   external_ = std::move(preconditioner);
 }
 
-namespace {
-
-// Rows [b, e) of Y = A X for a compile-time number of columns K: one pass over each row's
-// entries feeds all K sums (the flows' x, y, z). The per-(row, column) summation order is the
-// entry order, whatever K and the threading.
-template <int K>
-void spmv_rows(const int* outer, const int* inner, const double* val, const MatrixXd& X,
-               MatrixXd& Y, Index b, Index e) {
-  const double* x[K];
-  double* y[K];
-  for (int c = 0; c < K; ++c) {
-    x[c] = X.col(c).data();
-    y[c] = Y.col(c).data();
-  }
-  for (Index i = b; i < e; ++i) {
-    double s[K] = {};
-    for (int p = outer[i]; p < outer[i + 1]; ++p) {
-      const double v = val[p];
-      const int j = inner[p];
-      for (int c = 0; c < K; ++c) s[c] += v * x[c][j];
-    }
-    for (int c = 0; c < K; ++c) y[c][i] = s[c];
-  }
-}
-
-}  // namespace
-
-void PcgSolver::multiply(const MatrixXd& X, MatrixXd& Y) const {
-  const Index n = A_.rows(), k = X.cols();
-  Y.resize(n, k);
-  const int* outer = A_.outerIndexPtr();
-  const int* inner = A_.innerIndexPtr();
-  const double* val = A_.valuePtr();
-  // A is symmetric, so column i of the column-major storage is row i: each output row is
-  // an independent gather with a fixed summation order (deterministic, no write conflicts).
-  for_chunks(n, [&](Index, Index b, Index e) {
-    switch (k) {
-      case 1: spmv_rows<1>(outer, inner, val, X, Y, b, e); return;
-      case 2: spmv_rows<2>(outer, inner, val, X, Y, b, e); return;
-      case 3: spmv_rows<3>(outer, inner, val, X, Y, b, e); return;
-      case 4: spmv_rows<4>(outer, inner, val, X, Y, b, e); return;
-      default: break;
-    }
-    for (Index c = 0; c < k; ++c) {
-      const double* x = X.col(c).data();
-      double* y = Y.col(c).data();
-      for (Index i = b; i < e; ++i) {
-        double s = 0.0;
-        for (int p = outer[i]; p < outer[i + 1]; ++p) s += val[p] * x[inner[p]];
-        y[i] = s;
-      }
-    }
-  });
-}
+void PcgSolver::multiply(const MatrixXd& X, MatrixXd& Y) const { symmetric_multiply(A_, X, Y); }
 
 SolveReport PcgSolver::build_preconditioner() {
   SolveReport rep;
