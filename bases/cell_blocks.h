@@ -23,20 +23,22 @@ namespace mcf {
 /// f1 = scale e1, f2 = scale e2, where e1 = (p1 - p0) / |p1 - p0| and e2 = n × e1 span the
 /// piece's plane (n its unit normal). Returns |(p1 - p0) × (p2 - p0)|, twice the area; 0 for a
 /// degenerate piece, whose frame is left unset.
+/// One division for both vectors: with u = p1 - p0 and m = u × (p2 - p0) (|m| = len),
+/// e1 = u / |u| and e2 = (m × u) / (len |u|) (this runs once per split triangle every step).
 inline double piece_frame(const double p0[3], const double p1[3], const double p2[3], double scale,
                           double f1[3], double f2[3]) {
   const double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
   const double v[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-  double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-  const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  if (!(len > 0.0)) return 0.0;
-  for (double& ni : n) ni /= len;
+  const double m[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
   const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-  const double e1[3] = {u[0] / ul, u[1] / ul, u[2] / ul};
-  const double e2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]};
+  if (!(len > 0.0) || !(ul > 0.0)) return 0.0;
+  const double r = scale / (len * ul);  // f2 = r (m × u), f1 = (r len) u
+  const double r1 = r * len;
+  const double w[3] = {m[1] * u[2] - m[2] * u[1], m[2] * u[0] - m[0] * u[2], m[0] * u[1] - m[1] * u[0]};
   for (int a = 0; a < 3; ++a) {
-    f1[a] = e1[a] * scale;
-    f2[a] = e2[a] * scale;
+    f1[a] = u[a] * r1;
+    f2[a] = w[a] * r;
   }
   return len;
 }
