@@ -19,7 +19,7 @@ bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {
 }  // namespace
 
 ReducedSystem::ReducedSystem(const Basis& basis, LinearSolver& solver)
-    : basis_(basis), solver_(solver), base_fixed_(basis.locked_functions()) {
+    : basis_(basis), solver_(solver), base_fixed_(basis.locked_functions()), full_key_(new_pattern_key()) {
   std::sort(base_fixed_.begin(), base_fixed_.end());
 }
 
@@ -65,7 +65,10 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   }
 
-  HierarchyView view{basis_.prolongations(), basis_.colours()};
+  // The basis's pattern is fixed while this object lives, so the solver may skip comparing it
+  // each step (it does not when M and K have different patterns: then sum_'s depends on b).
+  const bool fixed_pattern = shares_pattern(M, K);
+  HierarchyView view{basis_.prolongations(), basis_.colours(), fixed_pattern ? full_key_ : 0};
   if (fixed.empty()) {
     fixed_.clear();
     reduction_valid_ = false;
@@ -103,6 +106,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   }
   HierarchyView reduced_view;
   if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
+  reduced_view.pattern_key = fixed_pattern ? reduced_key_ : 0;
   report_ = solver_.set_matrix(reduced_, reduced_view);
   if (report_.ok()) report_ = solver_.solve(Rf, Xf);
   Coefficients Y = Yfixed;
@@ -159,6 +163,7 @@ void ReducedSystem::rebuild_reduction(const SparseMatrix& S) {
       colours_.back() = std::move(finest);
     }
   }
+  reduced_key_ = new_pattern_key();
   reduction_valid_ = true;
 }
 

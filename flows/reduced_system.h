@@ -10,6 +10,7 @@
 #include "bases/basis.h"
 #include "solvers/linear_solver.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace mcf {
@@ -41,6 +42,9 @@ class ReducedSystem {
   std::vector<std::vector<std::uint8_t>> colours_;
   bool reduction_valid_ = false;
   int shares_pattern_ = -1;            // M and K on one pattern? (-1: not yet checked)
+  // Pattern keys (HierarchyView::pattern_key): sum_ keeps M's pattern for every (a, b) when M
+  // and K share it, and reduced_ keeps its pattern until the fixed set changes.
+  std::uint64_t full_key_ = 0, reduced_key_ = 0;
   SolveReport report_;
 };
 

@@ -1,5 +1,7 @@
 #include "solvers/linear_solver.h"
 
+#include <atomic>
+
 namespace mcf {
 
 const char* to_string(SolveStatus s) {
@@ -11,6 +13,11 @@ const char* to_string(SolveStatus s) {
     case SolveStatus::failed: return "failed";
   }
   return "unknown";
+}
+
+std::uint64_t new_pattern_key() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
 }
 
 }  // namespace mcf

@@ -38,11 +38,21 @@ struct SolveReport {
 /// system's own). prolongations[l] maps level l to level l+1, so there are levels-1 of them.
 /// colours[l][i] in 0..7 is the Gauss-Seidel colour of function i on level l: functions of the
 /// same colour never couple (octree parity colouring, DESIGN.md "Multigrid").
+///
+/// pattern_key: 0, or a key from new_pattern_key() by which the caller vouches that A's sparsity
+/// pattern, the prolongations (pattern and values) and the colours are exactly those of the
+/// previous set_matrix call that carried the same key (PETSc's SAME_NONZERO_PATTERN). A solver
+/// may then skip comparing them; with 0 or a new key it compares. Only a caller that owns a fixed
+/// pattern (the tracked basis through ReducedSystem) should pass one.
 struct HierarchyView {
   const std::vector<SparseMatrix>* prolongations = nullptr;
   const std::vector<std::vector<std::uint8_t>>* colours = nullptr;
+  std::uint64_t pattern_key = 0;
   bool empty() const { return prolongations == nullptr || prolongations->empty(); }
 };
+
+/// A key never returned before in this process (thread-safe); never 0.
+std::uint64_t new_pattern_key();
 
 class LinearSolver {
  public:

@@ -314,7 +314,8 @@ struct MultigridSolver::Impl {
   Eigen::MatrixXd coarse_rhs, coarse_sol;
   int k = 0;                           // columns the buffers are sized for
   bool ready = false;
-  std::int64_t symbolic_builds = 0, numeric_builds = 0;
+  std::int64_t symbolic_builds = 0, numeric_builds = 0, pattern_comparisons = 0;
+  std::uint64_t pattern_key = 0;       // the key the current pattern was set with (0: none)
 
   void ensure_buffers(int cols) {
     if (cols == k) return;
@@ -643,6 +644,7 @@ SparseMatrix MultigridSolver::level_matrix(int l) const {
 bool MultigridSolver::level_is_coloured(int l) const { return impl_->levels.at(std::size_t(l)).coloured; }
 std::int64_t MultigridSolver::symbolic_builds() const { return impl_->symbolic_builds; }
 std::int64_t MultigridSolver::numeric_builds() const { return impl_->numeric_builds; }
+std::int64_t MultigridSolver::pattern_comparisons() const { return impl_->pattern_comparisons; }
 
 SolveReport MultigridSolver::set_matrix(const SparseMatrix& A_in, HierarchyView hierarchy) {
   SolveReport rep;
@@ -674,22 +676,31 @@ SolveReport MultigridSolver::set_matrix(const SparseMatrix& A_in, HierarchyView 
     fine = P[l].cols();
   }
 
-  bool need_symbolic = m.levels.size() != P.size() + 1;
-  if (!need_symbolic) {
+  const std::uint64_t key = hierarchy.pattern_key;
+  const bool vouched = key != 0 && key == m.pattern_key;
+  m.pattern_key = 0;  // until this call has set up levels for the given pattern
+  // The O(1) checks run even when vouched for: a wrong key must not make set_fine_values write
+  // past the stored pattern.
+  bool need_symbolic = m.levels.size() != P.size() + 1 || m.levels.back().n() != A.rows() ||
+                       m.levels.back().A.nonZeros() != A.nonZeros();
+  if (!need_symbolic && !vouched) {
+    ++m.pattern_comparisons;
     const std::size_t nc = colours ? colours->size() : 0;
     need_symbolic = nc != m.colours.size() || (nc > 0 && *colours != m.colours);
+    if (!need_symbolic) {
+      const auto& F = m.levels.back();
+      need_symbolic = !same_permuted(F.A, A, F.inv, F.perm, false, false);
+    }
+    for (std::size_t l = 0; !need_symbolic && l < P.size(); ++l)
+      need_symbolic =
+          !same_permuted(m.levels[l].P, P[l], m.levels[l + 1].inv, m.levels[l].perm, true, true);
   }
-  if (!need_symbolic) {
-    const auto& F = m.levels.back();
-    need_symbolic = !same_permuted(F.A, A, F.inv, F.perm, false, false);
-  }
-  for (std::size_t l = 0; !need_symbolic && l < P.size(); ++l)
-    need_symbolic = !same_permuted(m.levels[l].P, P[l], m.levels[l + 1].inv, m.levels[l].perm, true, true);
   if (need_symbolic) {
     m.symbolic(A, P, colours);
   } else {
     m.set_fine_values(A);
   }
+  m.pattern_key = key;
   const bool diag_ok = m.numeric();
 
   if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);

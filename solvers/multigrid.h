@@ -65,8 +65,9 @@ class MultigridSolver : public LinearSolver {
 
   /// A is the finest level's matrix. The hierarchy (prolongations coarsest first) is copied.
   /// When the patterns of A and of the prolongations (and the prolongation values) are those
-  /// of the previous call, only the numerical values of the coarse operators are recomputed
-  /// (in parallel over coarse columns) and the coarsest factorization is refreshed numerically.
+  /// of the previous call (compared, or vouched for by hierarchy.pattern_key), only the
+  /// numerical values of the coarse operators are recomputed (in parallel over coarse columns)
+  /// and the coarsest factorization is refreshed numerically.
   /// An empty hierarchy gives a single level: the solve is then a direct solve.
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
 
@@ -88,6 +89,9 @@ class MultigridSolver : public LinearSolver {
   bool level_is_coloured(int l) const;             ///< false: serial Gauss-Seidel fallback
   std::int64_t symbolic_builds() const;            ///< how often the Galerkin pattern was built
   std::int64_t numeric_builds() const;             ///< how often coarse values were computed
+  /// How often set_matrix compared the given pattern with the stored one (skipped when the
+  /// caller's pattern_key vouches for it).
+  std::int64_t pattern_comparisons() const;
 
   /// `sweeps` Gauss-Seidel sweeps on level l for A_l X = B (forward: colours 0..7, reverse:
   /// colours 7..0; serial fallback rows ascending / descending). X is updated in place.

@@ -227,6 +227,48 @@ TEST(Multigrid, HierarchyChangeTriggersSymbolicBuild) {
   expect_galerkin(mg, b);
 }
 
+TEST(Multigrid, PatternKeySkipsTheComparisonOnly) {
+  Problem a = make_problem(3, 1, 0.05);
+  Problem a2 = make_problem(3, 1, 0.7);  // same pattern, other values
+  ASSERT_EQ(a2.A.nonZeros(), a.A.nonZeros());
+  Problem b = make_problem(3, 1, 0.05, Drop::random);
+  ASSERT_NE(b.A.nonZeros(), a.A.nonZeros());
+  const std::uint64_t key = mcf::new_pattern_key(), other = mcf::new_pattern_key();
+  EXPECT_NE(key, 0u);
+  EXPECT_NE(key, other);
+
+  auto keyed = [](const Problem& p, std::uint64_t k) {
+    HierarchyView v = p.view();
+    v.pattern_key = k;
+    return v;
+  };
+  MultigridSolver vouched, compared;
+  ASSERT_TRUE(vouched.set_matrix(a.A, keyed(a, key)).ok());
+  ASSERT_TRUE(compared.set_matrix(a.A, a.view()).ok());
+  ASSERT_TRUE(vouched.set_matrix(a2.A, keyed(a2, key)).ok());
+  ASSERT_TRUE(compared.set_matrix(a2.A, a2.view()).ok());
+  EXPECT_EQ(vouched.pattern_comparisons(), 0);
+  EXPECT_EQ(compared.pattern_comparisons(), 1);
+  EXPECT_EQ(vouched.symbolic_builds(), 1);
+  EXPECT_EQ(vouched.numeric_builds(), 2);
+  expect_galerkin(vouched, a2);
+  // Same operators, same cycle: bitwise the same iterate.
+  const Eigen::MatrixXd B = random_matrix(a.A.rows(), 3, 5);
+  Eigen::MatrixXd X1, X2;
+  ASSERT_TRUE(vouched.solve(B, X1).ok());
+  ASSERT_TRUE(compared.solve(B, X2).ok());
+  EXPECT_EQ((X1 - X2).cwiseAbs().maxCoeff(), 0.0);
+
+  // Another key is not vouched for: compared, and still no symbolic build.
+  ASSERT_TRUE(vouched.set_matrix(a.A, keyed(a, other)).ok());
+  EXPECT_EQ(vouched.pattern_comparisons(), 1);
+  EXPECT_EQ(vouched.symbolic_builds(), 1);
+  // A key wrongly kept across a change of the number of nonzeros is caught by the O(1) checks.
+  ASSERT_TRUE(vouched.set_matrix(b.A, keyed(b, other)).ok());
+  EXPECT_EQ(vouched.symbolic_builds(), 2);
+  expect_galerkin(vouched, b);
+}
+
 void expect_converges_to_direct(MultigridCycle cycle, Drop drop) {
   // The full grid at depth 5 makes the reference factorization slow: depth 4 there.
   Problem pr = make_problem(drop == Drop::none ? 4 : 5, 1, 0.05, drop);
