@@ -65,8 +65,9 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   }
 
-  // The basis's pattern is fixed while this object lives, so the solver may skip comparing it
-  // each step (it does not when M and K have different patterns: then sum_'s depends on b).
+  // The basis's pattern is fixed while this object lives (a rebuilt basis gets a new
+  // ReducedSystem), so a pattern key lets the solver skip comparing it each step. No key when M
+  // and K have different patterns: then sum_'s pattern depends on whether b is 0.
   const bool fixed_pattern = shares_pattern(M, K);
   HierarchyView view{basis_.prolongations(), basis_.colours(), fixed_pattern ? full_key_ : 0};
   if (fixed.empty()) {
@@ -78,8 +79,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     return X;
   }
 
-  // The basis's pattern is fixed for this object's lifetime (a rebuilt basis gets a new
-  // ReducedSystem), so only a change of the fixed set needs a new reduction.
+  // Only a change of the fixed set needs a new reduction (and a new key, rebuild_reduction).
   if (!reduction_valid_ || fixed != fixed_) {
     fixed_ = std::move(fixed);
     rebuild_reduction(sum_);
