@@ -2,7 +2,7 @@
 """Turns the Google Benchmark JSON of mcfbench_micro (bench/micro_octree.cpp) into the Markdown
 tables of the README: rebuilt phases per mesh, and the per-step ratios (tracked vs rebuilt,
 tracked vs hat + CHOLMOD, 2 vs 1 threads, W-cycle / SpMV, bytes per cubature point) with their
-targets and the paper's values. Ratios only compare benchmarks of the same JSON file (same run).
+targets and the paper's values, and each multigrid level's visits and own time per V- and W-cycle. Ratios only compare benchmarks of the same JSON file (same run).
 
 Usage: bench/summarize_micro.py micro_octree.json [> table.md]
 """
@@ -95,6 +95,33 @@ def main():
             lines.append(f"Sphere at depth {int(sph['depth'])}: {int(sph['vertices'])} vertices, "
                          f"{int(sph['split_triangles'])} split triangles, dimension {int(sph['dimension'])} "
                          f"(paper, 3.7e5-vertex sphere at depth 8: 3.8e6 split triangles, dimension 5.1e5).\n")
+
+    # Where one cycle's time goes, level by level (MultigridLevelWork counters).
+    for m, n in meshes:
+        cyc = [(c, get(f"BM_Rebuilt_Cycle/mesh:{m}/W:{w}")) for c, w in (("V", 0), ("W", 1))]
+        cyc = [(c, x) for c, x in cyc if x and "level0_ms" in x]
+        if not cyc:
+            continue
+        nl = int(cyc[0][1]["mg_levels"])
+        lines.append(f"| {n}: level (0 = coarsest) | " +
+                     " | ".join(f"{c} visits | {c} ms | {c} share" for c, _ in cyc) + " |")
+        lines.append("|---|" + "---:|---:|---:|" * len(cyc))
+        for l in reversed(range(nl)):
+            row = []
+            for _, x in cyc:
+                t = x[f"level{l}_ms"]
+                row += [fmt(x[f"level{l}_visits"]), fmt(t), f"{100 * t / x['solve_ms']:.0f}%"]
+            lines.append(f"| {l} | " + " | ".join(row) + " |")
+        row = []
+        for _, x in cyc:
+            rest = x["solve_ms"] - sum(x[f"level{l}_ms"] for l in range(nl))
+            row += ["", fmt(rest), f"{100 * rest / x['solve_ms']:.0f}%"]
+        lines.append("| outside the cycle (copies, final residual) | " + " | ".join(row) + " |")
+        row = []
+        for _, x in cyc:
+            row += ["", fmt(x["solve_ms"]), "100%"]
+        lines.append("| solve | " + " | ".join(row) + " |")
+        lines.append("")
 
     # Per-step comparisons.
     t2, t1 = get("BM_Step_Tracked/threads:2"), get("BM_Step_Tracked/threads:1")

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -316,6 +317,7 @@ struct MultigridSolver::Impl {
   bool ready = false;
   std::int64_t symbolic_builds = 0, numeric_builds = 0, pattern_comparisons = 0;
   std::uint64_t pattern_key = 0;       // the key the current pattern was set with (0: none)
+  std::vector<MultigridLevelWork> work;  // per level, coarsest first (level_work())
 
   void ensure_buffers(int cols) {
     if (cols == k) return;
@@ -438,6 +440,7 @@ struct MultigridSolver::Impl {
       find_diagonal(levels[l]);
     }
     k = 0;
+    work.assign(nl, MultigridLevelWork{});
     ++symbolic_builds;
   }
 
@@ -534,9 +537,17 @@ struct MultigridSolver::Impl {
       for (int c = 0; c < k; ++c) L.x[std::size_t(i) * std::size_t(k) + std::size_t(c)] = coarse_sol(i, c);
   }
 
+  // Two clock reads per level visit (a W-cycle at depth 9 makes 384): noise next to the sweeps.
+  using Clock = std::chrono::steady_clock;
+  static double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
   void cycle(int l, const MultigridOptions& opt) {
+    const auto t0 = Clock::now();
+    MultigridLevelWork& w = work[std::size_t(l)];
+    ++w.visits;
     if (l == 0) {
       coarse_solve();
+      w.seconds += since(t0);
       return;
     }
     Level& F = levels[std::size_t(l)];
@@ -553,13 +564,19 @@ struct MultigridSolver::Impl {
     std::fill(C.x.begin(), C.x.end(), 0.0);
     // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
     const int gamma = (opt.cycle == MultigridCycle::W && l - 1 > 0) ? 2 : 1;
-    for (int g = 0; g < gamma; ++g) cycle(l - 1, opt);
+    double coarser = 0.0;  // time of the recursion, not this level's own
+    {
+      const auto tc = Clock::now();
+      for (int g = 0; g < gamma; ++g) cycle(l - 1, opt);
+      coarser = since(tc);
+    }
     // Prolongation: x_F += P x_C (gather over the columns of Pᵀ = rows of P).
     for_column_chunks(k, [&](auto KC, int o) {
       constexpr int K = decltype(KC)::value;
       for_rows(PT.cols, [&](int b, int e) { transpose_rows<K, true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
     });
     for (int i = 0; i < opt.post_smooth; ++i) sweep(l, true);
+    w.seconds += since(t0) - coarser;
   }
 
   /// max over columns of ||b - A x|| / ||b|| on the finest level (deterministic reduction).
@@ -645,6 +662,10 @@ bool MultigridSolver::level_is_coloured(int l) const { return impl_->levels.at(s
 std::int64_t MultigridSolver::symbolic_builds() const { return impl_->symbolic_builds; }
 std::int64_t MultigridSolver::numeric_builds() const { return impl_->numeric_builds; }
 std::int64_t MultigridSolver::pattern_comparisons() const { return impl_->pattern_comparisons; }
+std::vector<MultigridLevelWork> MultigridSolver::level_work() const { return impl_->work; }
+void MultigridSolver::reset_level_work() {
+  for (auto& w : impl_->work) w = MultigridLevelWork{};
+}
 
 SolveReport MultigridSolver::set_matrix(const SparseMatrix& A_in, HierarchyView hierarchy) {
   SolveReport rep;

@@ -33,10 +33,22 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 namespace mcf {
 
 enum class MultigridCycle { V, W };
+
+/// Where a solver's cycles spent their time, per level: how often the cycle visited the level
+/// and the wall time spent on the level itself (its smoothing sweeps, residual, restriction and
+/// prolongation; on the coarsest level the direct solve), not counting the coarser levels it
+/// recursed into. A W-cycle visits level l (below the finest) 2^(finest - l) times, the coarsest
+/// level as often as the next one, so the small levels' share of its time is measured, not
+/// estimated.
+struct MultigridLevelWork {
+  std::int64_t visits = 0;
+  double seconds = 0.0;
+};
 
 struct MultigridOptions {
   MultigridCycle cycle = MultigridCycle::W;
@@ -92,6 +104,10 @@ class MultigridSolver : public LinearSolver {
   /// How often set_matrix compared the given pattern with the stored one (skipped when the
   /// caller's pattern_key vouches for it).
   std::int64_t pattern_comparisons() const;
+  /// Per level (coarsest first), summed over all cycles of solve() and precondition() since the
+  /// levels were built (or since reset_level_work()); cleared when a new pattern is set up.
+  std::vector<MultigridLevelWork> level_work() const;
+  void reset_level_work();
 
   /// `sweeps` Gauss-Seidel sweeps on level l for A_l X = B (forward: colours 0..7, reverse:
   /// colours 7..0; serial fallback rows ascending / descending). X is updated in place.

@@ -5,6 +5,29 @@ set -u
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 py=/usr/bin/python3
+# bench/summarize_micro.py (no matplotlib needed) on a fabricated Google Benchmark file: the step
+# ratios, and each multigrid level's share of a W-cycle (100 of 400 ms = 25%; the 40 ms left are
+# the copies and the final residual, 10%).
+[ -x "$py" ] || py=python3
+sw=$(mktemp -d)
+cat >"$sw/micro.json" <<'JSON'
+{"context": {"host_name": "h", "num_cpus": 2, "mhz_per_cpu": 1000, "date": "d"},
+ "benchmarks": [
+  {"name": "BM_Rebuilt_Cycle/mesh:0/W:1/iterations:3/real_time", "run_type": "iteration", "time_unit": "ms",
+   "real_time": 400, "mg_levels": 3, "solve_ms": 400, "wcycle_over_spmv": 4, "depth": 9,
+   "level0_visits": 2, "level0_ms": 60, "level1_visits": 2, "level1_ms": 100,
+   "level2_visits": 1, "level2_ms": 200},
+  {"name": "BM_Step_Tracked/threads:2/iterations:5/real_time", "run_type": "iteration", "time_unit": "ms",
+   "real_time": 1000, "update_ms": 1, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
+  {"name": "BM_Step_Rebuilt/threads:2/iterations:2/real_time", "run_type": "iteration", "time_unit": "ms",
+   "real_time": 4000, "rebuild_ms": 1, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1}]}
+JSON
+"$py" "$root/bench/summarize_micro.py" "$sw/micro.json" >"$sw/out.md" 2>&1 || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py"; exit 1; }
+for want in '| 1 | 2 | 100 | 25% |' '| outside the cycle (copies, final residual) |  | 40 | 10% |' \
+            '| rebuilt / tracked per step | 4× |'; do
+  grep -qF "$want" "$sw/out.md" || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py lacks: $want"; exit 1; }
+done
+rm -rf "$sw"
 if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
   echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 0
 fi

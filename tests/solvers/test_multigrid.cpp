@@ -538,6 +538,54 @@ void expect_symmetric_preconditioner(MultigridCycle cycle) {
 TEST(Multigrid, PreconditionerIsSymmetricW) { expect_symmetric_preconditioner(MultigridCycle::W); }
 TEST(Multigrid, PreconditionerIsSymmetricV) { expect_symmetric_preconditioner(MultigridCycle::V); }
 
+// level_work(): the visits are those of the cycle's definition (V: once per level per cycle; W:
+// level l < finest 2^(finest - l) times, the coarsest as often as the next, since its exact solve
+// is not repeated), counted over solve() and precondition(), cleared by reset_level_work() and by
+// a new pattern; the seconds are each level's own and sum to at most the solves' wall time.
+TEST(Multigrid, LevelWorkCountsTheCyclesVisits) {
+  Problem pr = make_problem(5, 1, 0.05);  // 5 levels
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 11);
+  for (MultigridCycle cycle : {MultigridCycle::V, MultigridCycle::W}) {
+    MultigridOptions opt;
+    opt.cycle = cycle;
+    opt.cycles = 3;
+    MultigridSolver mg(opt);
+    ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+    const int top = mg.levels() - 1;
+    ASSERT_EQ(top, 4);
+    for (const auto& w : mg.level_work()) EXPECT_EQ(w.visits, 0);
+
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+    const auto t0 = std::chrono::steady_clock::now();
+    ASSERT_TRUE(mg.solve(B, X).ok());
+    Eigen::MatrixXd Z;
+    mg.precondition(B, Z);  // one more cycle
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    const auto work = mg.level_work();
+    ASSERT_EQ(int(work.size()), top + 1);
+    double total = 0;
+    for (int l = 0; l <= top; ++l) {
+      const std::int64_t per_cycle =
+          cycle == MultigridCycle::V ? 1 : std::int64_t(1) << (top - std::max(l, 1));
+      EXPECT_EQ(work[std::size_t(l)].visits, 4 * per_cycle) << to_string(cycle) << " level " << l;
+      EXPECT_GT(work[std::size_t(l)].seconds, 0.0) << "level " << l;
+      total += work[std::size_t(l)].seconds;
+    }
+    EXPECT_LE(total, wall);
+
+    mg.reset_level_work();
+    for (const auto& w : mg.level_work()) EXPECT_EQ(w.visits, 0);
+    mg.precondition(B, Z);
+    EXPECT_EQ(mg.level_work().back().visits, 1);
+    // A new hierarchy (one level fewer) starts its own count.
+    Problem coarser = make_problem(4, 1, 0.05);
+    ASSERT_TRUE(mg.set_matrix(coarser.A, coarser.view()).ok());
+    ASSERT_EQ(int(mg.level_work().size()), 4);
+    for (const auto& w : mg.level_work()) EXPECT_EQ(w.visits, 0);
+  }
+}
+
 TEST(Multigrid, SingleLevelIsADirectSolve) {
   Problem pr = make_problem(3, 3, 0.05);
   MultigridSolver mg;
