@@ -2,7 +2,8 @@
 """Turns the Google Benchmark JSON of mcfbench_micro (bench/micro_octree.cpp) into the Markdown
 tables of the README: rebuilt phases per mesh, and the per-step ratios (tracked vs rebuilt,
 tracked vs hat + CHOLMOD, 2 vs 1 threads, W-cycle / SpMV, bytes per cubature point) with their
-targets and the paper's values, and each multigrid level's visits and own time per V- and W-cycle. Ratios only compare benchmarks of the same JSON file (same run).
+targets and the paper's values, and each multigrid level's visits and own time per V- and
+W-cycle. Ratios only compare benchmarks of the same JSON file (same run).
 
 Usage: bench/summarize_micro.py micro_octree.json [> table.md]
 """
