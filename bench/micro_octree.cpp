@@ -118,10 +118,7 @@ void system_values(const SparseMatrix& M, const SparseMatrix& K, double dt, Spar
 
 /// The same, first giving A M's pattern unless it has it already (compared each call).
 void system_matrix(const SparseMatrix& M, const SparseMatrix& K, double dt, SparseMatrix& A) {
-  if (A.rows() != M.rows() || A.nonZeros() != M.nonZeros() || !A.isCompressed() ||
-      !std::equal(M.outerIndexPtr(), M.outerIndexPtr() + M.outerSize() + 1, A.outerIndexPtr()) ||
-      !std::equal(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros(), A.innerIndexPtr()))
-    A = M;
+  if (!same_pattern(M, A)) A = M;
   system_values(M, K, dt, A);
 }
 

@@ -8,15 +8,6 @@
 #include <stdexcept>
 
 namespace mcf {
-namespace {
-
-bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {
-  return A.rows() == B.rows() && A.nonZeros() == B.nonZeros() &&
-         std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
-         std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr());
-}
-
-}  // namespace
 
 ReducedSystem::ReducedSystem(const Basis& basis, LinearSolver& solver)
     : basis_(basis), solver_(solver), base_fixed_(basis.locked_functions()), full_key_(new_pattern_key()) {

@@ -1,5 +1,6 @@
 #include "solvers/linear_solver.h"
 
+#include <algorithm>
 #include <atomic>
 
 namespace mcf {
@@ -18,6 +19,13 @@ const char* to_string(SolveStatus s) {
 std::uint64_t new_pattern_key() {
   static std::atomic<std::uint64_t> next{1};
   return next.fetch_add(1, std::memory_order_relaxed);
+}
+
+bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {
+  return A.isCompressed() && B.isCompressed() && A.rows() == B.rows() && A.cols() == B.cols() &&
+         A.nonZeros() == B.nonZeros() &&
+         std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
+         std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr());
 }
 
 }  // namespace mcf

@@ -54,6 +54,10 @@ struct HierarchyView {
 /// A key never returned before in this process (thread-safe); never 0.
 std::uint64_t new_pattern_key();
 
+/// Whether two compressed matrices have the same sparsity pattern (size, column starts and row
+/// indices compared exactly; values ignored). False when either is not compressed.
+bool same_pattern(const SparseMatrix& A, const SparseMatrix& B);
+
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;

@@ -564,12 +564,9 @@ struct MultigridSolver::Impl {
     std::fill(C.x.begin(), C.x.end(), 0.0);
     // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
     const int gamma = (opt.cycle == MultigridCycle::W && l - 1 > 0) ? 2 : 1;
-    double coarser = 0.0;  // time of the recursion, not this level's own
-    {
-      const auto tc = Clock::now();
-      for (int g = 0; g < gamma; ++g) cycle(l - 1, opt);
-      coarser = since(tc);
-    }
+    const auto tc = Clock::now();
+    for (int g = 0; g < gamma; ++g) cycle(l - 1, opt);
+    const double coarser = since(tc);  // the recursion's time, not this level's own
     // Prolongation: x_F += P x_C (gather over the columns of Pᵀ = rows of P).
     for_column_chunks(k, [&](auto KC, int o) {
       constexpr int K = decltype(KC)::value;

@@ -173,10 +173,7 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarc
   for (Index p = 0; p < A.nonZeros(); ++p)
     if (!std::isfinite(A.valuePtr()[p])) return fail(SolveStatus::numerical_issue, "matrix has NaN/inf");
 
-  const bool same = A_.rows() == A.rows() && A_.nonZeros() == A.nonZeros() && A_.isCompressed() &&
-                    std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.rows() + 1, A_.outerIndexPtr()) &&
-                    std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), A_.innerIndexPtr());
-  if (same) {
+  if (same_pattern(A, A_)) {
     // Same pattern (every time step of a tracked flow): refresh values only.
     std::copy(A.valuePtr(), A.valuePtr() + A.nonZeros(), A_.valuePtr());
   } else {
