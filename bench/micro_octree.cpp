@@ -33,9 +33,7 @@
 #include "solvers/symmetric_multiply.h"
 
 #include <benchmark/benchmark.h>
-#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -109,11 +107,7 @@ F& acquire(const std::string& key, const std::function<std::unique_ptr<F>()>& ma
 /// A = M + δK as the flows form it (flows/reduced_system.cpp): M and K share one pattern, so the
 /// sum is value-wise into A's storage. A must already have M's pattern.
 void system_values(const SparseMatrix& M, const SparseMatrix& K, double dt, SparseMatrix& A) {
-  const double *m = M.valuePtr(), *k = K.valuePtr();
-  double* a = A.valuePtr();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, M.nonZeros(), 1 << 14), [&](const auto& r) {
-    for (Eigen::Index i = r.begin(); i != r.end(); ++i) a[i] = m[i] + dt * k[i];
-  });
+  sum_on_pattern(1.0, M, dt, K, A);
 }
 
 /// The same, first giving A M's pattern unless it has it already (compared each call).

@@ -31,12 +31,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     if (a != 1.0) sum_ *= a;
   } else if (shares_pattern(M, K)) {
     if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) sum_ = M;
-    const double *m = M.valuePtr(), *k = K.valuePtr();
-    double* s = sum_.valuePtr();
-    const Eigen::Index nnz = M.nonZeros();
-    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, nnz, 1 << 14), [&](const auto& r) {
-      for (Eigen::Index i = r.begin(); i != r.end(); ++i) s[i] = a * m[i] + b * k[i];
-    });
+    sum_on_pattern(a, M, b, K, sum_);
   } else {
     sum_ = a * M + b * K;
     sum_.makeCompressed();

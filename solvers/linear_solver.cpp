@@ -1,5 +1,8 @@
 #include "solvers/linear_solver.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <atomic>
 
@@ -26,6 +29,14 @@ bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {
          A.nonZeros() == B.nonZeros() &&
          std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
          std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr());
+}
+
+void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatrix& K, SparseMatrix& S) {
+  const double *m = M.valuePtr(), *k = K.valuePtr();
+  double* s = S.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, M.nonZeros(), 1 << 14), [&](const auto& r) {
+    for (Eigen::Index i = r.begin(); i != r.end(); ++i) s[i] = a * m[i] + b * k[i];
+  });
 }
 
 }  // namespace mcf

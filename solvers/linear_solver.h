@@ -58,6 +58,11 @@ std::uint64_t new_pattern_key();
 /// indices compared exactly; values ignored). False when either is not compressed.
 bool same_pattern(const SparseMatrix& A, const SparseMatrix& B);
 
+/// S = a M + b K entry by entry, in parallel, for M, K and S on one pattern (same_pattern: the
+/// caller checks; S keeps its pattern and only its values are written). This is how every flow
+/// forms its system matrix when the basis assembles M and K on one pattern.
+void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatrix& K, SparseMatrix& S);
+
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;

@@ -1,11 +1,13 @@
 // The pattern helpers beside the solver interface (solvers/linear_solver.h): same_pattern, which
-// decides whether a solver or ReducedSystem may refresh values only, and new_pattern_key.
+// decides whether a solver or ReducedSystem may refresh values only, sum_on_pattern, and
+// new_pattern_key.
 
 #include "solvers/linear_solver.h"
 
 #include <gtest/gtest.h>
 
 #include <set>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -36,6 +38,31 @@ TEST(SamePattern, ComparesIndicesNotValues) {
   ASSERT_FALSE(U.isCompressed());
   EXPECT_FALSE(mcf::same_pattern(A, U));
   EXPECT_FALSE(mcf::same_pattern(U, U));
+}
+
+// sum_on_pattern against Eigen's general sparse sum (which merges patterns itself), on a matrix
+// large enough to be split across threads; S's pattern is left as it was.
+TEST(SumOnPattern, EqualsEigensSum) {
+  const int n = 40000;
+  std::vector<Eigen::Triplet<double, int>> tm, tk;
+  for (int i = 0; i < n; ++i) {
+    tm.emplace_back(i, i, 1.0 + 0.25 * (i % 7));
+    tk.emplace_back(i, i, 2.0 - 0.5 * (i % 3));
+    if (i + 1 < n) {
+      for (const auto& [r, c] : {std::pair{i, i + 1}, std::pair{i + 1, i}}) {
+        tm.emplace_back(r, c, 0.1 * (i % 5));
+        tk.emplace_back(r, c, -0.3 - 0.01 * (i % 11));
+      }
+    }
+  }
+  const SparseMatrix M = from_triplets(n, tm), K = from_triplets(n, tk);
+  ASSERT_TRUE(mcf::same_pattern(M, K));
+  SparseMatrix S = M;
+  mcf::sum_on_pattern(0.5, M, 1e-3, K, S);
+  const SparseMatrix ref = 0.5 * M + 1e-3 * K;
+  EXPECT_TRUE(mcf::same_pattern(S, M));
+  EXPECT_LT((S - ref).norm(), 1e-15 * ref.norm());
+  EXPECT_GT(ref.norm(), 0.0);
 }
 
 TEST(PatternKey, NeverZeroNeverRepeated) {
