@@ -10,8 +10,11 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <cstdlib>
 #include <limits>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -26,6 +29,7 @@ namespace {
 constexpr int kGrain = 256;            // rows per TBB task
 constexpr int kSerialBelow = 2048;     // loops shorter than this run serially (same result)
 constexpr int kTile = MultigridSolver::tile_size;
+constexpr int kMinBlockTiles = 1;      // tiles per relaxation block, at least (find_blocks())
 
 /// Runs f(begin, end) over [0, n), in parallel when n is large enough. Every kernel writes
 /// disjoint outputs and reads nothing that the same loop writes, so the split is irrelevant.
@@ -39,22 +43,30 @@ void for_rows(int n, F&& f) {
                     [&](const tbb::blocked_range<int>& r) { f(r.begin(), r.end()); });
 }
 
-template <int K>
-using Cols = std::integral_constant<int, K>;
-
-/// Splits k right-hand sides into chunks of at most 4 columns (the columns are independent in
-/// every kernel, so this changes nothing but the code the compiler can unroll).
-template <class F>
-void for_column_chunks(int k, F&& f) {
-  int o = 0;
-  for (; k - o >= 4; o += 4) f(Cols<4>{}, o);
-  switch (k - o) {
-    case 1: f(Cols<1>{}, o); break;
-    case 2: f(Cols<2>{}, o); break;
-    case 3: f(Cols<3>{}, o); break;
-    default: break;
-  }
+/// Four doubles (GCC/Clang vector extensions: one AVX register when compiled for it, emulated
+/// otherwise). The kernels below hold four right-hand-side columns of one row in one vector.
+using v4 = double __attribute__((vector_size(32)));
+inline v4 splat(double a) { return v4{a, a, a, a}; }
+inline v4 load4(const double* p) {
+  v4 r;
+  std::memcpy(&r, p, sizeof(r));
+  return r;
 }
+inline void store4(double* p, v4 v) { std::memcpy(p, &v, sizeof(v)); }
+
+/// Cache-line aligned storage, so that a row's four columns (32 bytes at a multiple of 32) never
+/// straddle two cache lines.
+template <class T>
+struct CacheAligned {
+  using value_type = T;
+  CacheAligned() = default;
+  template <class U>
+  CacheAligned(const CacheAligned<U>&) {}
+  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
+  void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(64)); }
+  friend bool operator==(const CacheAligned&, const CacheAligned&) { return true; }
+};
+using Buffer = std::vector<double, CacheAligned<double>>;
 
 /// Raw view of a compressed column-major matrix.
 struct Csc {
@@ -67,63 +79,109 @@ struct Csc {
         inner(m.innerIndexPtr()), val(m.valuePtr()) {}
 };
 
-// ---- kernels on interleaved buffers: entry (i, c) of an n x k block lives at i*s + c -------
+// ---- kernels on interleaved buffers ---------------------------------------------------------
+//
+// Entry (i, c) of an n x k block lives at i*s + c, with the stride s = k rounded up to a multiple
+// of 4 (padding columns are zero and stay zero): every kernel handles four columns of a row as one
+// vector, columns o..o+3: one load of a neighbour's iterate instead of three, one vector multiply-
+// add instead of three. A row's terms are summed alternately into two vector accumulators (even
+// and odd positions of each run of entries), which halves the chain of dependent multiply-adds.
+// In a stand-alone Gauss-Seidel kernel on cached data (AMD EPYC guest) this took an entry from
+// 3.4 to 2.1 cycles; on the depth-9 levels the sweeps are bound by memory traffic instead
+// (SmootherRows, relaxation blocks).
 
-/// One Gauss-Seidel update of row i (= column i of the symmetric CSC matrix), columns o..o+K-1.
-/// diag_pos[i] is the position of the diagonal entry in column i (-1 if absent): the sum runs
-/// over the entries before and after it, in index order, without a test per entry.
-template <int K>
-inline void gs_row(const Csc& A, const int* diag_pos, const double* inv_diag, const double* b,
-                   double* x, std::size_t s, int o, int i) {
-  double acc[K];
-  const std::size_t ii = std::size_t(i) * s + o;
-  for (int c = 0; c < K; ++c) acc[c] = b[ii + c];
-  const int dp = diag_pos[i];
-  const int split = dp >= 0 ? dp : A.outer[i + 1];
-  const auto add = [&](int begin, int end) {
-    for (int p = begin; p < end; ++p) {
-      const double a = A.val[p];
-      const double* xj = x + std::size_t(A.inner[p]) * s + o;
-      for (int c = 0; c < K; ++c) acc[c] -= a * xj[c];
-    }
-  };
-  add(A.outer[i], split);
-  if (dp >= 0) add(dp + 1, A.outer[i + 1]);
-  const double d = inv_diag[i];
-  for (int c = 0; c < K; ++c) x[ii + c] = acc[c] * d;
+/// Σ_p val[p] x[inner[p]] over p in [begin, end), into acc0 (even p - begin) and acc1 (odd).
+inline void gather_sub(const Csc& A, const double* x, std::size_t s, int o, int begin, int end, v4& acc0,
+                       v4& acc1) {
+  int p = begin;
+  for (; p + 1 < end; p += 2) {
+    acc0 -= splat(A.val[p]) * load4(x + std::size_t(A.inner[p]) * s + o);
+    acc1 -= splat(A.val[p + 1]) * load4(x + std::size_t(A.inner[p + 1]) * s + o);
+  }
+  if (p < end) acc0 -= splat(A.val[p]) * load4(x + std::size_t(A.inner[p]) * s + o);
 }
 
-/// r = b - A x (rows [begin, end)).
-template <int K>
-inline void residual_rows(const Csc& A, const double* b, const double* x, double* r, std::size_t s,
-                          int o, int begin, int end) {
+/// One Gauss-Seidel update of row i (= column i of the symmetric CSC matrix), columns o..o+3.
+/// diag_pos[i] is the position of the diagonal entry in column i (-1 if absent): the sum runs
+/// over the entries before and after it, in index order, without a test per entry.
+inline void gs_row(const Csc& A, const int* diag_pos, const double* inv_diag, const double* b, double* x,
+                   std::size_t s, int o, int i) {
+  const std::size_t ii = std::size_t(i) * s + o;
+  v4 acc0 = load4(b + ii), acc1 = splat(0.0);
+  const int dp = diag_pos[i];
+  if (dp >= 0) {
+    gather_sub(A, x, s, o, A.outer[i], dp, acc0, acc1);
+    gather_sub(A, x, s, o, dp + 1, A.outer[i + 1], acc0, acc1);
+  } else {
+    gather_sub(A, x, s, o, A.outer[i], A.outer[i + 1], acc0, acc1);
+  }
+  store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
+}
+
+/// r = b - A x (rows [begin, end)), columns o..o+3.
+inline void residual_rows(const Csc& A, const double* b, const double* x, double* r, std::size_t s, int o,
+                          int begin, int end) {
   for (int i = begin; i < end; ++i) {
-    double acc[K];
     const std::size_t ii = std::size_t(i) * s + o;
-    for (int c = 0; c < K; ++c) acc[c] = b[ii + c];
-    for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
-      const double a = A.val[p];
-      const double* xj = x + std::size_t(A.inner[p]) * s + o;
-      for (int c = 0; c < K; ++c) acc[c] -= a * xj[c];
-    }
-    for (int c = 0; c < K; ++c) r[ii + c] = acc[c];
+    v4 acc0 = load4(b + ii), acc1 = splat(0.0);
+    gather_sub(A, x, s, o, A.outer[i], A.outer[i + 1], acc0, acc1);
+    store4(r + ii, acc0 + acc1);
   }
 }
 
 /// y = Mᵀ v (or y += Mᵀ v when Add) on output rows [begin, end) = columns of M (gather along
-/// columns, so parallel output ranges never write the same entry).
-template <int K, bool Add>
+/// columns, so parallel output ranges never write the same entry), columns o..o+3.
+template <bool Add>
 inline void transpose_rows(const Csc& M, const double* v, double* y, std::size_t s, int o, int begin, int end) {
   for (int J = begin; J < end; ++J) {
-    double acc[K] = {};
-    for (int p = M.outer[J]; p < M.outer[J + 1]; ++p) {
-      const double w = M.val[p];
-      const double* vi = v + std::size_t(M.inner[p]) * s + o;
-      for (int c = 0; c < K; ++c) acc[c] += w * vi[c];
-    }
+    v4 acc0 = splat(0.0), acc1 = splat(0.0);
+    gather_sub(M, v, s, o, M.outer[J], M.outer[J + 1], acc0, acc1);
     double* yJ = y + std::size_t(J) * s + o;
-    for (int c = 0; c < K; ++c) yJ[c] = Add ? yJ[c] + acc[c] : acc[c];
+    const v4 sum = -(acc0 + acc1);
+    store4(yJ, Add ? load4(yJ) + sum : sum);
   }
+}
+
+/// A level's off-diagonal entries as the smoother reads them: row by row in the internal
+/// numbering, each entry as (column - row) in 16 bits and its value, in single precision on coarse
+/// levels (6 bytes an entry instead of CSC's 12) and in double precision on the finest level (10
+/// bytes). The sweeps stream the matrix ten times per level visit and are bound by its bytes once
+/// the iterate stays in cache. Why not single precision on the finest level: a Gauss-Seidel update
+/// x_i = (b_i - Σ a_ij x_j) / a_ii with rounded a_ij has the rounded system's solution as its fixed
+/// point, so the finest level's sweeps would pull the iterate off A x = b (a test that cycles to
+/// 1e-10 stalled at 2e-8); on a coarse level the sweeps only shape a correction of the finest
+/// residual, which is exact, so the cycle still converges to the solution of A x = b. Empty
+/// (unused) when some column lies farther than 16 bits from its row.
+struct SmootherRows {
+  std::vector<int> start;               // row i: entries [start[i], start[i+1])
+  std::vector<std::int16_t> offset;     // column - row
+  std::vector<float> single;            // values (coarse levels), or
+  std::vector<double> full;             // values (finest level)
+  bool empty() const { return start.empty(); }
+};
+
+/// acc0/acc1 -= Σ_p val[p] x[i + offset[p]] over the compact entries [begin, end).
+template <class V>
+inline void gather_sub_compact(const std::int16_t* off, const V* val, const double* xi, std::size_t s, int begin,
+                               int end, v4& acc0, v4& acc1) {
+  const std::ptrdiff_t st = std::ptrdiff_t(s);
+  int p = begin;
+  for (; p + 1 < end; p += 2) {
+    acc0 -= splat(double(val[p])) * load4(xi + std::ptrdiff_t(off[p]) * st);
+    acc1 -= splat(double(val[p + 1])) * load4(xi + std::ptrdiff_t(off[p + 1]) * st);
+  }
+  if (p < end) acc0 -= splat(double(val[p])) * load4(xi + std::ptrdiff_t(off[p]) * st);
+}
+
+/// gs_row on the smoother's compact rows (values val: S.single or S.full).
+template <class V>
+inline void gs_row_compact(const SmootherRows& S, const V* val, const double* inv_diag, const double* b, double* x,
+                           std::size_t s, int o, int i) {
+  const std::size_t ii = std::size_t(i) * s + o;
+  v4 acc0 = load4(b + ii), acc1 = splat(0.0);
+  gather_sub_compact(S.offset.data(), val, x + ii, s, S.start[std::size_t(i)], S.start[std::size_t(i) + 1], acc0,
+                     acc1);
+  store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
 }
 
 // ---- sparse products with a precomputed pattern ------------------------------------------
@@ -300,12 +358,16 @@ struct MultigridSolver::Impl {
     std::vector<int> diag_pos;         // position of the diagonal entry of each column, -1 if none
     bool coloured = false;
     std::vector<int> segment_start;    // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
+    int block_tiles = 1;               // tiles per relaxation block (find_blocks())
+    SmootherRows smoother;             // compact off-diagonal rows for the sweeps (may be empty)
+    int tiles() const { return int(segment_start.size() / 8); }
+    int blocks() const { return (tiles() + block_tiles - 1) / block_tiles; }
     // Transfer to the next finer level (absent on the finest level).
     SparseMatrix P;                    // n_{l+1} x n_l
     SparseMatrix PT;                   // n_l x n_{l+1}
     Spa spa;                           // dense accumulators of the Galerkin product
-    // Work buffers (interleaved n x k).
-    std::vector<double> x, b, r;
+    // Work buffers (interleaved n x k, row stride padded to a multiple of 4).
+    Buffer x, b, r;
     int n() const { return int(A.rows()); }
   };
 
@@ -314,6 +376,7 @@ struct MultigridSolver::Impl {
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
   Eigen::MatrixXd coarse_rhs, coarse_sol;
   int k = 0;                           // columns the buffers are sized for
+  std::size_t s = 0;                   // their row stride: k rounded up to a multiple of 4
   bool ready = false;
   std::int64_t symbolic_builds = 0, numeric_builds = 0, pattern_comparisons = 0;
   std::uint64_t pattern_key = 0;       // the key the current pattern was set with (0: none)
@@ -322,8 +385,9 @@ struct MultigridSolver::Impl {
   void ensure_buffers(int cols) {
     if (cols == k) return;
     k = cols;
+    s = (std::size_t(k) + 3) / 4 * 4;
     for (auto& L : levels) {
-      const std::size_t sz = std::size_t(L.n()) * std::size_t(k);
+      const std::size_t sz = std::size_t(L.n()) * s;
       L.x.assign(sz, 0.0);
       L.b.assign(sz, 0.0);
       L.r.assign(sz, 0.0);
@@ -395,6 +459,79 @@ struct MultigridSolver::Impl {
     });
   }
 
+  /// Relaxation blocks of a coloured level (header, "Smoother ordering"): runs of `block_tiles`
+  /// consecutive tiles, at least as many as the farthest coupling reaches (in tiles), so rows of
+  /// block q couple only with blocks q-1, q, q+1 and blocks of one parity never couple.
+  /// Measured on the armadillo at depth 9 (reach 9 tiles): five fine sweeps 176 -> 115 ms with
+  /// the compact smoother rows, the W-cycle 646 -> 514 ms.
+  static void find_blocks(Level& L) {
+    L.block_tiles = 1;
+    if (!L.coloured) return;
+    const Csc A(L.A);
+    const int reach = tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, L.n(), 4096), 0,
+        [&](const tbb::blocked_range<int>& rows, int far) {
+          for (int r = rows.begin(); r < rows.end(); ++r)
+            for (int p = A.outer[r]; p < A.outer[r + 1]; ++p) far = std::max(far, std::abs(A.inner[p] / kTile - r / kTile));
+          return far;
+        },
+        [](int a, int b) { return std::max(a, b); });
+    L.block_tiles = std::max(reach, kMinBlockTiles);
+  }
+
+  /// The compact rows' pattern (SmootherRows), or none when an offset does not fit 16 bits.
+  static void smoother_pattern(Level& L, bool finest) {
+    SmootherRows& S = L.smoother;
+    S = SmootherRows{};
+    if (!L.coloured) return;  // the serial fallback reads the double-precision matrix
+    const Csc A(L.A);
+    std::vector<int> start(std::size_t(L.n()) + 1, 0);
+    for (int i = 0; i < L.n(); ++i) {
+      const int dp = L.diag_pos[std::size_t(i)];
+      start[std::size_t(i) + 1] = start[std::size_t(i)] + (A.outer[i + 1] - A.outer[i]) - (dp >= 0 ? 1 : 0);
+    }
+    std::vector<std::int16_t> offset(std::size_t(start.back()));
+    bool fits = true;
+    for (int i = 0; i < L.n() && fits; ++i) {
+      int e = start[std::size_t(i)];
+      for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
+        const int d = A.inner[p] - i;
+        if (d == 0) continue;
+        if (d < INT16_MIN || d > INT16_MAX) {
+          fits = false;
+          break;
+        }
+        offset[std::size_t(e++)] = std::int16_t(d);
+      }
+    }
+    if (!fits) return;
+    S.start = std::move(start);
+    S.offset = std::move(offset);
+    if (finest)
+      S.full.assign(S.offset.size(), 0.0);
+    else
+      S.single.assign(S.offset.size(), 0.0f);
+  }
+
+  /// The compact rows' values from the level's matrix (same order, diagonal skipped).
+  static void smoother_values(Level& L) {
+    SmootherRows& S = L.smoother;
+    if (S.empty()) return;
+    const Csc A(L.A);
+    for_rows(L.n(), [&](int b, int e) {
+      for (int i = b; i < e; ++i) {
+        int q = S.start[std::size_t(i)];
+        for (int p = A.outer[i]; p < A.outer[i + 1]; ++p)
+          if (A.inner[p] != i) {
+            if (S.full.empty())
+              S.single[std::size_t(q++)] = float(A.val[p]);
+            else
+              S.full[std::size_t(q++)] = A.val[p];
+          }
+      }
+    });
+  }
+
   void symbolic(const SparseMatrix& A, const std::vector<SparseMatrix>& P,
                 const std::vector<std::vector<std::uint8_t>>* given_colours) {
     const std::size_t nl = P.size() + 1;
@@ -438,6 +575,8 @@ struct MultigridSolver::Impl {
     for (std::size_t l = 0; l < nl; ++l) {
       check_colouring(levels[l], l < colours.size() ? &colours[l] : nullptr);
       find_diagonal(levels[l]);
+      find_blocks(levels[l]);
+      smoother_pattern(levels[l], l + 1 == nl);
     }
     k = 0;
     work.assign(nl, MultigridLevelWork{});
@@ -475,6 +614,7 @@ struct MultigridSolver::Impl {
         if (!(d >= 0.0) || !std::isfinite(d)) ok = false;
         L.inv_diag[std::size_t(i)] = d > 0.0 ? 1.0 / d : 0.0;
       }
+      smoother_values(L);
     }
     ++numeric_builds;
     return ok;
@@ -485,56 +625,90 @@ struct MultigridSolver::Impl {
   void sweep(int l, bool reverse) {
     Level& L = levels[std::size_t(l)];
     const Csc A(L.A);
-    const std::size_t s = std::size_t(k);
     const double* id = L.inv_diag.data();
     const int* dp = L.diag_pos.data();
     const double* b = L.b.data();
     double* x = L.x.data();
-    for_column_chunks(k, [&](auto KC, int o) {
-      constexpr int K = decltype(KC)::value;
+    for (int o = 0; o < int(s); o += 4) {
       if (L.coloured) {
-        for (int ci = 0; ci < 8; ++ci) {
-          const int c = reverse ? 7 - ci : ci;
-          const int tiles = int(L.segment_start.size() / 8);
-          const auto relax_tiles = [&](int t0, int t1) {
+        const bool compact = !L.smoother.empty();
+        const auto relax_block = [&](int q) {
+          const int t0 = q * L.block_tiles, t1 = std::min(L.tiles(), t0 + L.block_tiles);
+          for (int ci = 0; ci < 8; ++ci) {
+            const std::size_t c = std::size_t(reverse ? 7 - ci : ci);
             for (int t = t0; t < t1; ++t) {
-              const std::size_t q = std::size_t(t) * 8 + std::size_t(c);
-              for (int r = L.segment_start[q]; r < L.segment_start[q + 1]; ++r) gs_row<K>(A, dp, id, b, x, s, o, r);
+              const std::size_t q8 = std::size_t(t) * 8 + c;
+              const int r0 = L.segment_start[q8], r1 = L.segment_start[q8 + 1];
+              if (compact && !L.smoother.full.empty()) {
+                for (int r = r0; r < r1; ++r) gs_row_compact(L.smoother, L.smoother.full.data(), id, b, x, s, o, r);
+              } else if (compact) {
+                for (int r = r0; r < r1; ++r) gs_row_compact(L.smoother, L.smoother.single.data(), id, b, x, s, o, r);
+              } else {
+                for (int r = r0; r < r1; ++r) gs_row(A, dp, id, b, x, s, o, r);
+              }
             }
-          };
-          if (tiles == 1) {
-            relax_tiles(0, 1);
-          } else {
-            tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1),
-                              [&](const tbb::blocked_range<int>& r) { relax_tiles(r.begin(), r.end()); });
           }
+        };
+        const int blocks = L.blocks();
+        for (int pi = 0; pi < 2; ++pi) {
+          const int parity = reverse ? 1 - pi : pi;
+          const int count = (blocks - parity + 1) / 2;  // blocks parity, parity + 2, ...
+          if (count <= 1) {
+            for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
+            continue;
+          }
+          tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& r) {
+            for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
+          });
         }
       } else if (!reverse) {
-        for (int i = 0; i < A.cols; ++i) gs_row<K>(A, dp, id, b, x, s, o, i);
+        for (int i = 0; i < A.cols; ++i) gs_row(A, dp, id, b, x, s, o, i);
       } else {
-        for (int i = A.cols - 1; i >= 0; --i) gs_row<K>(A, dp, id, b, x, s, o, i);
+        for (int i = A.cols - 1; i >= 0; --i) gs_row(A, dp, id, b, x, s, o, i);
       }
-    });
+    }
+  }
+
+  /// The caller's indices of level l in the order sweep(l, reverse) relaxes them (serially).
+  std::vector<int> relaxation_order(int l, bool reverse) const {
+    const Level& L = levels[std::size_t(l)];
+    std::vector<int> order;
+    order.reserve(std::size_t(L.n()));
+    if (L.coloured) {
+      const int blocks = L.blocks();
+      for (int pi = 0; pi < 2; ++pi) {
+        const int parity = reverse ? 1 - pi : pi;
+        for (int q = parity; q < blocks; q += 2) {
+          const int t0 = q * L.block_tiles, t1 = std::min(L.tiles(), t0 + L.block_tiles);
+          for (int ci = 0; ci < 8; ++ci) {
+            const std::size_t c = std::size_t(reverse ? 7 - ci : ci);
+            for (int t = t0; t < t1; ++t)
+              for (int r = L.segment_start[std::size_t(t) * 8 + c]; r < L.segment_start[std::size_t(t) * 8 + c + 1]; ++r)
+                order.push_back(old_index(L.perm, r));
+          }
+        }
+      }
+    } else {
+      for (int i = 0; i < L.n(); ++i) order.push_back(old_index(L.perm, reverse ? L.n() - 1 - i : i));
+    }
+    return order;
   }
 
   void residual(int l) {
     Level& L = levels[std::size_t(l)];
     const Csc A(L.A);
-    const std::size_t s = std::size_t(k);
-    for_column_chunks(k, [&](auto KC, int o) {
-      constexpr int K = decltype(KC)::value;
-      for_rows(A.cols, [&](int b, int e) { residual_rows<K>(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e); });
-    });
+    for (int o = 0; o < int(s); o += 4)
+      for_rows(A.cols, [&](int b, int e) { residual_rows(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e); });
   }
 
   void coarse_solve() {
     Level& L = levels.front();
     const int n = L.n();
     for (int i = 0; i < n; ++i)
-      for (int c = 0; c < k; ++c) coarse_rhs(i, c) = L.b[std::size_t(i) * std::size_t(k) + std::size_t(c)];
+      for (int c = 0; c < k; ++c) coarse_rhs(i, c) = L.b[std::size_t(i) * s + std::size_t(c)];
     coarse_sol = ldlt.solve(coarse_rhs);
     for (int i = 0; i < n; ++i)
-      for (int c = 0; c < k; ++c) L.x[std::size_t(i) * std::size_t(k) + std::size_t(c)] = coarse_sol(i, c);
+      for (int c = 0; c < k; ++c) L.x[std::size_t(i) * s + std::size_t(c)] = coarse_sol(i, c);
   }
 
   // Two clock reads per level visit (a W-cycle at depth 9 makes 384): noise next to the sweeps.
@@ -552,15 +726,12 @@ struct MultigridSolver::Impl {
     }
     Level& F = levels[std::size_t(l)];
     Level& C = levels[std::size_t(l) - 1];
-    const std::size_t s = std::size_t(k);
     for (int i = 0; i < opt.pre_smooth; ++i) sweep(l, false);
     residual(l);
     // Restriction: b_C = Pᵀ r_F (gather over the columns of P).
     const Csc P(C.P), PT(C.PT);
-    for_column_chunks(k, [&](auto KC, int o) {
-      constexpr int K = decltype(KC)::value;
-      for_rows(P.cols, [&](int b, int e) { transpose_rows<K, false>(P, F.r.data(), C.b.data(), s, o, b, e); });
-    });
+    for (int o = 0; o < int(s); o += 4)
+      for_rows(P.cols, [&](int b, int e) { transpose_rows<false>(P, F.r.data(), C.b.data(), s, o, b, e); });
     std::fill(C.x.begin(), C.x.end(), 0.0);
     // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
     const int gamma = (opt.cycle == MultigridCycle::W && l - 1 > 0) ? 2 : 1;
@@ -568,10 +739,8 @@ struct MultigridSolver::Impl {
     for (int g = 0; g < gamma; ++g) cycle(l - 1, opt);
     const double coarser = since(tc);  // the recursion's time, not this level's own
     // Prolongation: x_F += P x_C (gather over the columns of Pᵀ = rows of P).
-    for_column_chunks(k, [&](auto KC, int o) {
-      constexpr int K = decltype(KC)::value;
-      for_rows(PT.cols, [&](int b, int e) { transpose_rows<K, true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
-    });
+    for (int o = 0; o < int(s); o += 4)
+      for_rows(PT.cols, [&](int b, int e) { transpose_rows<true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
     for (int i = 0; i < opt.post_smooth; ++i) sweep(l, true);
     w.seconds += since(t0) - coarser;
   }
@@ -580,33 +749,28 @@ struct MultigridSolver::Impl {
   double relative_residual(const Eigen::VectorXd& bnorm) {
     Level& L = levels.back();
     const Csc A(L.A);
-    const std::size_t s = std::size_t(k);
-    std::vector<double> rn(std::size_t(k), 0.0);
-    for_column_chunks(k, [&](auto KC, int o) {
-      constexpr int K = decltype(KC)::value;
-      using Acc = std::array<double, K>;
+    std::vector<double> rn(s, 0.0);
+    for (int o = 0; o < int(s); o += 4) {
+      struct Acc {
+        v4 v = {0.0, 0.0, 0.0, 0.0};
+      };
       const Acc sum = tbb::parallel_deterministic_reduce(
           tbb::blocked_range<int>(0, A.cols, 4096), Acc{},
           [&](const tbb::blocked_range<int>& r, Acc acc) {
             for (int i = r.begin(); i < r.end(); ++i) {
-              double res[K];
-              const std::size_t ii = std::size_t(i) * s + o;
-              for (int c = 0; c < K; ++c) res[c] = L.b[ii + c];
-              for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
-                const double a = A.val[p];
-                const double* xj = L.x.data() + std::size_t(A.inner[p]) * s + o;
-                for (int c = 0; c < K; ++c) res[c] -= a * xj[c];
-              }
-              for (int c = 0; c < K; ++c) acc[std::size_t(c)] += res[c] * res[c];
+              v4 res0 = load4(L.b.data() + std::size_t(i) * s + o), res1 = splat(0.0);
+              gather_sub(A, L.x.data(), s, o, A.outer[i], A.outer[i + 1], res0, res1);
+              const v4 res = res0 + res1;
+              acc.v += res * res;
             }
             return acc;
           },
           [](Acc a, const Acc& b) {
-            for (int c = 0; c < K; ++c) a[std::size_t(c)] += b[std::size_t(c)];
+            a.v += b.v;
             return a;
           });
-      for (int c = 0; c < K; ++c) rn[std::size_t(o + c)] = sum[std::size_t(c)];
-    });
+      for (int c = 0; c < 4; ++c) rn[std::size_t(o + c)] = sum.v[c];
+    }
     double worst = 0.0;
     for (int c = 0; c < k; ++c) {
       const double r = std::sqrt(rn[std::size_t(c)]);
@@ -618,8 +782,7 @@ struct MultigridSolver::Impl {
   }
 
   /// Caller's n x k matrix -> a level's interleaved buffer in its internal numbering, and back.
-  void load(const Level& L, std::vector<double>& dst, const Eigen::MatrixXd& src) {
-    const std::size_t s = std::size_t(k);
+  void load(const Level& L, Buffer& dst, const Eigen::MatrixXd& src) {
     for_rows(int(src.rows()), [&](int b, int e) {
       for (int r = b; r < e; ++r) {
         const int i = old_index(L.perm, r);
@@ -627,8 +790,7 @@ struct MultigridSolver::Impl {
       }
     });
   }
-  void store(const Level& L, const std::vector<double>& src, Eigen::MatrixXd& dst) {
-    const std::size_t s = std::size_t(k);
+  void store(const Level& L, const Buffer& src, Eigen::MatrixXd& dst) {
     for_rows(int(dst.rows()), [&](int b, int e) {
       for (int r = b; r < e; ++r) {
         const int i = old_index(L.perm, r);
@@ -656,6 +818,14 @@ SparseMatrix MultigridSolver::level_matrix(int l) const {
   return permuted(L.A, L.perm, L.inv, true);  // back to the caller's numbering
 }
 bool MultigridSolver::level_is_coloured(int l) const { return impl_->levels.at(std::size_t(l)).coloured; }
+bool MultigridSolver::level_has_compact_smoother(int l) const {
+  const auto& L = impl_->levels.at(std::size_t(l));
+  return L.coloured && !L.smoother.empty();
+}
+std::vector<int> MultigridSolver::relaxation_order(int l, bool reverse) const {
+  (void)impl_->levels.at(std::size_t(l));
+  return impl_->relaxation_order(l, reverse);
+}
 std::int64_t MultigridSolver::symbolic_builds() const { return impl_->symbolic_builds; }
 std::int64_t MultigridSolver::numeric_builds() const { return impl_->numeric_builds; }
 std::int64_t MultigridSolver::pattern_comparisons() const { return impl_->pattern_comparisons; }

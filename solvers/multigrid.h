@@ -7,10 +7,26 @@
 // task, in a fixed order), and norms use a deterministic reduction, so results are bitwise
 // identical for any number of TBB threads.
 //
-// Smoother ordering: pre-smoothing sweeps colours 0..7 (serial fallback: rows 0..n-1),
-// post-smoothing sweeps colours 7..0 (serial fallback: rows n-1..0). Within one colour the
-// functions are independent, so their order does not change the result. With pre_smooth ==
-// post_smooth the cycle, started from zero, is a symmetric operator (precondition()).
+// Smoother ordering: a coloured level is cut into relaxation blocks of consecutive tiles (below),
+// each at least as wide as the level's farthest coupling, so only neighbouring blocks couple. A
+// forward sweep (pre-smoothing) relaxes the even blocks, in parallel, then the odd blocks; inside a
+// block colours 0..7 one after the other (functions of one colour never couple, so their order
+// does not matter). A reverse sweep (post-smoothing) is the exact reverse: odd blocks, then even
+// blocks, colours 7..0. Serial fallback (no valid colouring): rows 0..n-1, reverse n-1..0. Every
+// sweep is thus one fixed serial Gauss-Seidel ordering whatever the thread count, and with
+// pre_smooth == post_smooth the cycle, started from zero, is a symmetric operator (precondition()).
+// Why blocks and not one pass per colour over the whole level: a colour pass reads the iterates of
+// all its rows' neighbours, i.e. nearly the whole iterate, eight times per sweep, and at depth 9
+// that is more than the last-level cache holds; a block's rows and iterates stay in cache through
+// its eight colours.
+//
+// Smoother matrix: the sweeps read each level's off-diagonal entries with 16-bit column offsets,
+// in single precision on coarse levels (6 bytes an entry instead of 12) and in double precision on
+// the finest (10 bytes): the sweeps stream the matrix ten times per level visit and are bound by
+// its bytes. Coarse-level sweeps only shape a correction of the finest level's residual, which
+// the residual, the transfers and the coarse operators keep exact, so the cycle converges to the
+// solution of A x = b; a rounded finest-level matrix would not (multigrid.cpp, SmootherRows).
+// A level whose couplings lie farther apart than 16 bits reach keeps CSC sweeps.
 //
 // Internal numbering: every coloured level is stored in tiles of `tile_size` consecutive indices,
 // colour-major inside each tile, so a colour pass streams contiguous segments of rows; the
@@ -20,8 +36,9 @@
 // entry order, coarse levels add in internal order); level_matrix() converts back. A level whose
 // given colouring is invalid keeps the internal order and is relaxed serially in it.
 //
-// Layout and cost: right-hand sides are interleaved (row-major n x k) in preallocated per-level
-// buffers, all columns are relaxed in the same sweep (chunks of up to 4 columns). Per cycle on
+// Layout and cost: right-hand sides are interleaved (row-major n x k, the row padded to a multiple
+// of 4 columns) in preallocated per-level buffers; every kernel relaxes four columns of a row as one
+// vector (the flows' x, y, z and a zero column). Per cycle on
 // level l: pre + post sweeps, one residual, restriction b_c = Pᵀ r (gather over P's columns),
 // prolongation x += P x_c (gather over the columns of the stored Pᵀ). The Galerkin pattern of
 // Pᵀ (A_{l+1} P) is built once (symbolic_builds()); later set_matrix calls only recompute values:
@@ -99,6 +116,11 @@ class MultigridSolver : public LinearSolver {
   /// Level l's operator (l = 0 coarsest, levels()-1 finest) in the caller's numbering (a copy).
   SparseMatrix level_matrix(int l) const;
   bool level_is_coloured(int l) const;             ///< false: serial Gauss-Seidel fallback
+  /// Whether level l's sweeps read the single-precision compact rows (header, "Smoother matrix").
+  bool level_has_compact_smoother(int l) const;
+  /// Level l's functions (caller's numbering) in the order one sweep relaxes them: the serial
+  /// Gauss-Seidel ordering the parallel sweep equals (header, "Smoother ordering").
+  std::vector<int> relaxation_order(int l, bool reverse = false) const;
   std::int64_t symbolic_builds() const;            ///< how often the Galerkin pattern was built
   std::int64_t numeric_builds() const;             ///< how often coarse values were computed
   /// How often set_matrix compared the given pattern with the stored one (skipped when the
