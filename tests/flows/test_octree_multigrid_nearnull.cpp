@@ -51,7 +51,7 @@ TEST(OctreeMultigridNearNull, PlainCyclesStagnateButNotBecauseOfNegligibleFuncti
   EXPECT_GT(res[11] / res[10], 0.5);
   EXPECT_GT(res[11], 1e-6);
 
-  // Fixing every function with M_ii < 1e-8 max M_ii at the exact solution changes nothing.
+  // Fixing every function with M_ii < 1e-8 max M_ii at the exact solution does not cure it.
   const Eigen::VectorXd md = s.basis.mass().diagonal();
   const Eigen::Index n = s.A.rows();
   std::vector<int> free;
@@ -77,7 +77,13 @@ TEST(OctreeMultigridNearNull, PlainCyclesStagnateButNotBecauseOfNegligibleFuncti
   C.back() = cf;
   const auto res_f = w_cycles(Af, Bf, HierarchyView{&P, &C}, 12);
   ASSERT_EQ(res_f.size(), 12u);
-  EXPECT_NEAR(res_f[11] / res[11], 1.0, 0.1);
+  // The filtered system stagnates the same way and ends at a comparable residual. Removing rows
+  // shifts the smoother's relaxation blocks (solvers/multigrid.h), so the two runs relax in
+  // different orders and only agree to within a small factor; were the negligible functions the
+  // cause, the filtered residual would instead fall by orders of magnitude.
+  EXPECT_GT(res_f[11] / res_f[10], 0.5);
+  EXPECT_GT(res_f[11] / res[11], 0.5);
+  EXPECT_LT(res_f[11] / res[11], 2.0);
 }
 
 TEST(OctreeMultigridNearNull, SmallestModeIsASmoothFunctionVanishingOnTheSurface) {
