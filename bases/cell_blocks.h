@@ -52,9 +52,8 @@ class CellBlocks {
 
   /// Zeroes the blocks (start of a cell).
   void clear() {
-    std::memset(m_, 0, sizeof(m_));
-    std::memset(k_, 0, sizeof(k_));
     count_ = 0;
+    fresh_ = true;  // the first batch starts its sums from zero instead of loading the blocks
   }
 
   /// One cubature point at local cell coordinates t ∈ [0,1]^3. f1, f2 = e1/h, e2/h: the frame
@@ -96,7 +95,14 @@ class CellBlocks {
   }
 
   /// Sums the buffered points; then mass(a,b) / stiffness(a,b) for a ≤ b are the cell's blocks.
-  void finish() { accumulate(); }
+  void finish() {
+    if (fresh_ && count_ == 0) {  // no point: zero blocks
+      std::memset(m_, 0, sizeof(m_));
+      std::memset(k_, 0, sizeof(k_));
+      fresh_ = false;
+    }
+    accumulate();
+  }
   double mass(int a, int b) const { return m_[a][b]; }
   double stiffness(int a, int b) const { return k_[a][b]; }
 
@@ -118,8 +124,13 @@ class CellBlocks {
   struct Upper {
     v4 lo[4], hi[8];
   };
-  static Upper load_upper(const double (&block)[8][8]) {
+  Upper load_upper(const double (&block)[8][8]) const {
     Upper u;
+    if (fresh_) {
+      for (auto& v : u.lo) v = splat(0.0);
+      for (auto& v : u.hi) v = splat(0.0);
+      return u;
+    }
     for (int a = 0; a < 4; ++a) u.lo[a] = load(&block[a][0]);
     for (int a = 0; a < 8; ++a) u.hi[a] = load(&block[a][4]);
     return u;
@@ -149,6 +160,9 @@ class CellBlocks {
       store_upper(m_, m);
     }
     if constexpr (Stiffness) {
+      // Two passes over the points, rows 0..3 (8 accumulators) then rows 4..7 (4), so that the
+      // accumulators, four lane vectors and two broadcasts fit 16 AVX registers (all twelve at
+      // once spilled on AVX2); each term is two multiply-adds into the accumulator.
       Upper k = load_upper(k_);
       v4(&lo)[4] = k.lo;
       v4(&hi)[8] = k.hi;
@@ -156,22 +170,35 @@ class CellBlocks {
         const double* s = lanes_[p];
         const v4 elo = load(s + kEta), ehi = load(s + kEta + 4);
         const v4 mlo = load(s + kMu), mhi = load(s + kMu + 4);
-#pragma GCC unroll 8
-        for (int a = 0; a < 8; ++a) {
+#pragma GCC unroll 4
+        for (int a = 0; a < 4; ++a) {
           const v4 pa = splat(s[kP + a]), qa = splat(s[kQ + a]);
-          if (a < 4) lo[a] += pa * elo + qa * mlo;
-          hi[a] += pa * ehi + qa * mhi;
+          lo[a] += pa * elo;
+          lo[a] += qa * mlo;
+          hi[a] += pa * ehi;
+          hi[a] += qa * mhi;
+        }
+      }
+      for (int p = 0; p < count_; ++p) {
+        const double* s = lanes_[p];
+        const v4 ehi = load(s + kEta + 4), mhi = load(s + kMu + 4);
+#pragma GCC unroll 4
+        for (int a = 4; a < 8; ++a) {
+          hi[a] += splat(s[kP + a]) * ehi;
+          hi[a] += splat(s[kQ + a]) * mhi;
         }
       }
       store_upper(k_, k);
     }
     count_ = 0;
+    fresh_ = false;
   }
 
   alignas(32) double m_[8][8];
   alignas(32) double k_[8][8];
   alignas(32) double lanes_[kBatch][kLanes];
   int count_ = 0;
+  bool fresh_ = true;
 };
 
 }  // namespace mcf

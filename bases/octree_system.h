@@ -38,10 +38,26 @@ inline void trilinear_values(const double t[3], double inv_h, double value[8], d
 
 /// Offset bit (0..26) of row function I relative to column function J, both corners of one cell:
 /// o = (dz+1)*9 + (dy+1)*3 + (dx+1) with d = corner(a) - corner(b).
-inline int neighbour_bit(int corner_row, int corner_col) {
-  const auto a = corner_offset(corner_row), b = corner_offset(corner_col);
-  return (a[2] - b[2] + 1) * 9 + (a[1] - b[1] + 1) * 3 + (a[0] - b[0] + 1);
+constexpr int neighbour_bit(int corner_row, int corner_col) {
+  const int dx = (corner_row & 1) - (corner_col & 1), dy = ((corner_row >> 1) & 1) - ((corner_col >> 1) & 1),
+            dz = ((corner_row >> 2) & 1) - ((corner_col >> 2) & 1);
+  return (dz + 1) * 9 + (dy + 1) * 3 + (dx + 1);
 }
+
+/// Per (a, b) of a cell's 8x8 block, entry 8a+b: the mask of the neighbour bits below
+/// neighbour_bit(a, b) (its rank in column b's neighbour mask). A constant table, so that the
+/// unrolled scatter of a cell's blocks is a popcount and an add per entry (computed per entry, the
+/// bit arithmetic was a third of the scatter's instructions).
+struct CellBlockTables {
+  std::uint32_t below[64];
+};
+constexpr CellBlockTables make_cell_block_tables() {
+  CellBlockTables t{};
+  for (int a = 0; a < 8; ++a)
+    for (int b = 0; b < 8; ++b) t.below[8 * a + b] = (1u << neighbour_bit(a, b)) - 1u;
+  return t;
+}
+inline constexpr CellBlockTables kCellBlockTables = make_cell_block_tables();
 
 /// Integration data of one octree level over fixed pieces: pieces grouped by cell, cells grouped
 /// by parity colour, and the CSC pattern of the level's matrices (full symmetric storage).
@@ -73,14 +89,20 @@ class OctreeSystem {
   /// (SetSystemMatrices). A null array is skipped.
   template <class Blocks>
   void add_cell_blocks(int cell, const Blocks& blocks, double* mass, double* stiffness) const {
-    int slots[64];
-    cell_slots(cell, slots);
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b) {
+    const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];
+#pragma GCC unroll 8
+    for (int b = 0; b < 8; ++b) {
+      const auto J = static_cast<std::size_t>(f[static_cast<std::size_t>(b)]);
+      const int base = outer_[J];
+      const std::uint32_t m = mask_[J];
+#pragma GCC unroll 8
+      for (int a = 0; a < 8; ++a) {
+        const int slot = base + std::popcount(m & kCellBlockTables.below[8 * a + b]);
         const int lo = a < b ? a : b, hi = a < b ? b : a;
-        if (mass) mass[slots[8 * a + b]] += blocks.mass(lo, hi);
-        if (stiffness) stiffness[slots[8 * a + b]] += blocks.stiffness(lo, hi);
+        if (mass) mass[slot] += blocks.mass(lo, hi);
+        if (stiffness) stiffness[slot] += blocks.stiffness(lo, hi);
       }
+    }
   }
   /// Pieces of cell c: piece_order()[cell_start()[c] .. cell_start()[c+1]).
   const std::vector<int>& cell_start() const { return cell_start_; }
@@ -125,7 +147,7 @@ class OctreeSystem {
       const auto J = static_cast<std::size_t>(f[static_cast<std::size_t>(b)]);
       const int base = outer_[J];
       const std::uint32_t m = mask_[J];
-      for (int a = 0; a < 8; ++a) slots[8 * a + b] = base + std::popcount(m & ((1u << neighbour_bit(a, b)) - 1u));
+      for (int a = 0; a < 8; ++a) slots[8 * a + b] = base + std::popcount(m & kCellBlockTables.below[8 * a + b]);
     }
   }
   const std::vector<int>& piece_cell() const { return piece_cell_; }

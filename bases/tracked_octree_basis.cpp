@@ -44,7 +44,8 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   identity_ = initial_->initial_coefficients();
 
   // Pieces in cell order, corners in their cell's local coordinates (p - cell origin) / h.
-  local_corners_.resize(9 * order.size());
+  // One double of padding: the last piece's third corner is read as four doubles.
+  local_corners_.assign(9 * order.size() + 1, 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, L.cells.size(), 256), [&](const auto& r) {
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       const auto ijk = grid_index(L.cells[c]);
@@ -88,6 +89,15 @@ inline v4 load4(const double* p) {
   return r;
 }
 inline void store4(double* p, v4 x) { std::memcpy(p, &x, sizeof(x)); }
+/// x clamped to [0, 1] lane by lane as std::clamp does it (max, then min).
+inline v4 clamp01(v4 x) {
+#if defined(__AVX__)
+  return _mm256_min_pd(_mm256_max_pd(x, splat(0.0)), splat(1.0));
+#else
+  for (int a = 0; a < 4; ++a) x[a] = std::clamp(x[a], 0.0, 1.0);
+  return x;
+#endif
+}
 inline v4 sqrt4(v4 x) {
 #if defined(__AVX__)
   return _mm256_sqrt_pd(x);
@@ -196,12 +206,16 @@ int integrate_cell(const double xc[8][3], const double* corners, int pieces, con
     const double len = piece_frame(p, p + 3, p + 6, inv_h, f1, f2);
     if (!(len > 0.0)) continue;
     const double area = 0.5 * len * h * h;
+    // The corners as vectors (x, y, z, next value), so a point is three vector multiply-adds
+    // and a clamp (scalar, the coordinates' arithmetic was ~10% of the update's instructions).
+    const v4 c0 = load4(p), c1 = load4(p + 3), c2 = load4(p + 6);
     for (int q = 0; q < nq; ++q) {
       if (P.n == StagedPoints::kCapacity) flush();
       const auto& bc = rule.points[std::size_t(q)];
       const int i = P.n++;
+      const v4 t = clamp01(splat(bc[0]) * c0 + splat(bc[1]) * c1 + splat(bc[2]) * c2);
       for (int a = 0; a < 3; ++a) {
-        P.t[a][i] = std::clamp(bc[0] * p[a] + bc[1] * p[3 + a] + bc[2] * p[6 + a], 0.0, 1.0);
+        P.t[a][i] = t[a];
         P.f1[a][i] = f1[a];
         P.f2[a][i] = f2[a];
       }
