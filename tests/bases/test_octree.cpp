@@ -167,7 +167,9 @@ TEST(Octree, PatternIsSymmetricAndColoursSeparateNeighbours) {
   for (int J = 0; J < A.outerSize(); ++J) {
     EXPECT_TRUE(std::is_sorted(A.innerIndexPtr() + A.outerIndexPtr()[J], A.innerIndexPtr() + A.outerIndexPtr()[J + 1]));
     for (mcf::SparseMatrix::InnerIterator it(A, J); it; ++it) {
-      if (it.row() != J) EXPECT_NE(col[it.row()], col[J]);
+      if (it.row() != J) {
+        EXPECT_NE(col[it.row()], col[J]);
+      }
     }
   }
   const mcf::SparseMatrix At = A.transpose();
