@@ -131,8 +131,8 @@ class MultigridSolver : public LinearSolver {
   std::vector<MultigridLevelWork> level_work() const;
   void reset_level_work();
 
-  /// `sweeps` Gauss-Seidel sweeps on level l for A_l X = B (forward: colours 0..7, reverse:
-  /// colours 7..0; serial fallback rows ascending / descending). X is updated in place.
+  /// `sweeps` Gauss-Seidel sweeps on level l for A_l X = B, forward or reverse in the order
+  /// relaxation_order(l, reverse) lists (header, "Smoother ordering"). X is updated in place.
   void gauss_seidel(int l, const Eigen::MatrixXd& B, Eigen::MatrixXd& X, int sweeps,
                     bool reverse = false);
 
