@@ -14,6 +14,8 @@
 // upper triangles are summed (b ≥ a) and read. The order of the sums depends only on the order
 // of the points, so results do not depend on threads.
 
+#include "bases/vec4.h"
+
 #include <cmath>
 #include <cstring>
 
@@ -107,14 +109,10 @@ class CellBlocks {
   double stiffness(int a, int b) const { return k_[a][b]; }
 
  private:
-  using v4 = double __attribute__((vector_size(32)));
-  static v4 splat(double x) { return v4{x, x, x, x}; }
-  static v4 load(const double* p) {
-    v4 r;
-    std::memcpy(&r, p, sizeof(r));
-    return r;
-  }
-  static void store(double* p, v4 x) { std::memcpy(p, &x, sizeof(x)); }
+  using v4 = vec4::v4;
+  static v4 splat(double x) { return vec4::splat(x); }
+  static v4 load(const double* p) { return vec4::load4(p); }
+  static void store(double* p, v4 x) { vec4::store4(p, x); }
 
   // Per buffered point: 8 lanes each of β, w_m β, η, μ, P = S₁₁η + S₁₂μ, Q = S₁₂η + S₂₂μ.
   enum { kVal = 0, kWVal = 8, kEta = 16, kMu = 24, kP = 32, kQ = 40, kLanes = 48 };

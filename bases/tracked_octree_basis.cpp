@@ -1,6 +1,7 @@
 #include "bases/tracked_octree_basis.h"
 
 #include "bases/cell_blocks.h"
+#include "bases/vec4.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,9 +10,6 @@
 #include <chrono>
 #include <cstring>
 #include <limits>
-#if defined(__AVX__)
-#include <immintrin.h>
-#endif
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -78,33 +76,7 @@ std::size_t TrackedOctreeBasis::preprocessed_bytes() const {
 
 namespace {
 
-/// Four doubles, one cubature point per lane (GCC/Clang vector extensions: AVX2 when compiled
-/// for it, emulated otherwise).
-using v4 = double __attribute__((vector_size(32)));
-using m4 = long long __attribute__((vector_size(32)));  // lane masks of v4 comparisons
-inline v4 splat(double x) { return v4{x, x, x, x}; }
-inline v4 load4(const double* p) {
-  v4 r;
-  std::memcpy(&r, p, sizeof(r));
-  return r;
-}
-inline void store4(double* p, v4 x) { std::memcpy(p, &x, sizeof(x)); }
-/// x clamped to [0, 1] lane by lane as std::clamp does it (max, then min).
-inline v4 clamp01(v4 x) {
-#if defined(__AVX__)
-  return _mm256_min_pd(_mm256_max_pd(x, splat(0.0)), splat(1.0));
-#else
-  for (int a = 0; a < 4; ++a) x[a] = std::clamp(x[a], 0.0, 1.0);
-  return x;
-#endif
-}
-inline v4 sqrt4(v4 x) {
-#if defined(__AVX__)
-  return _mm256_sqrt_pd(x);
-#else
-  return v4{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])};
-#endif
-}
+using namespace vec4;  // one cubature point per lane
 
 /// Cubature points of one cell staged one array per quantity, so that ComputeDifferential (the
 /// metric, √|g| and g⁻¹ at every point) runs four points per instruction: scalar, this was ~60%
