@@ -520,18 +520,26 @@ struct MultigridSolver::Impl {
     SmootherRows& S = L.smoother;
     if (S.empty()) return;
     const Csc A(L.A);
-    for_rows(L.n(), [&](int b, int e) {
-      for (int i = b; i < e; ++i) {
-        int q = S.start[std::size_t(i)];
-        for (int p = A.outer[i]; p < A.outer[i + 1]; ++p)
-          if (A.inner[p] != i) {
-            if (S.full.empty())
-              S.single[std::size_t(q++)] = float(A.val[p]);
-            else
-              S.full[std::size_t(q++)] = A.val[p];
+    // A row's off-diagonal entries are the runs before and after its diagonal (diag_pos), so they
+    // are copied as two runs without reading the row indices.
+    const auto fill = [&](auto* out) {
+      for_rows(L.n(), [&](int b, int e) {
+        for (int i = b; i < e; ++i) {
+          const int p0 = A.outer[i], p1 = A.outer[i + 1], dp = L.diag_pos[std::size_t(i)];
+          auto* q = out + S.start[std::size_t(i)];
+          if (dp < 0) {
+            std::copy(A.val + p0, A.val + p1, q);
+          } else {
+            q = std::copy(A.val + p0, A.val + dp, q);
+            std::copy(A.val + dp + 1, A.val + p1, q);
           }
-      }
-    });
+        }
+      });
+    };
+    if (S.full.empty())
+      fill(S.single.data());
+    else
+      fill(S.full.data());
   }
 
   void symbolic(const SparseMatrix& A, const std::vector<SparseMatrix>& P,
