@@ -17,7 +17,6 @@
 #include "bases/vec4.h"
 
 #include <cmath>
-#include <cstring>
 
 namespace mcf {
 
@@ -52,7 +51,7 @@ class CellBlocks {
 
   CellBlocks() { clear(); }
 
-  /// Zeroes the blocks (start of a cell).
+  /// Starts a new cell: its blocks count from zero (the first batch does not load them).
   void clear() {
     count_ = 0;
     fresh_ = true;  // the first batch starts its sums from zero instead of loading the blocks
@@ -97,14 +96,7 @@ class CellBlocks {
   }
 
   /// Sums the buffered points; then mass(a,b) / stiffness(a,b) for a ≤ b are the cell's blocks.
-  void finish() {
-    if (fresh_ && count_ == 0) {  // no point: zero blocks
-      std::memset(m_, 0, sizeof(m_));
-      std::memset(k_, 0, sizeof(k_));
-      fresh_ = false;
-    }
-    accumulate();
-  }
+  void finish() { accumulate(); }
   double mass(int a, int b) const { return m_[a][b]; }
   double stiffness(int a, int b) const { return k_[a][b]; }
 
@@ -140,7 +132,7 @@ class CellBlocks {
 
   /// Sums the buffered points into the blocks' upper triangles, held in registers meanwhile.
   void accumulate() {
-    if (count_ == 0) return;
+    if (count_ == 0 && !fresh_) return;  // a cell without points still stores its zero blocks
     if constexpr (Mass) {
       Upper m = load_upper(m_);
       v4(&lo)[4] = m.lo;

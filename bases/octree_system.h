@@ -140,16 +140,6 @@ class OctreeSystem {
           [](long long a, long long b) { return a + b; });
     return total;
   }
-  /// The 64 value slots of cell c's 8x8 block: slots[8a+b] = slot(c, a, b).
-  void cell_slots(int cell, int slots[64]) const {
-    const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];
-    for (int b = 0; b < 8; ++b) {
-      const auto J = static_cast<std::size_t>(f[static_cast<std::size_t>(b)]);
-      const int base = outer_[J];
-      const std::uint32_t m = mask_[J];
-      for (int a = 0; a < 8; ++a) slots[8 * a + b] = base + std::popcount(m & kCellBlockTables.below[8 * a + b]);
-    }
-  }
   const std::vector<int>& piece_cell() const { return piece_cell_; }
 
   /// Mass and stiffness with the identity metric (the pieces' own geometry), any cubature rule.

@@ -632,6 +632,23 @@ struct MultigridSolver::Impl {
 
   // ---- cycle ----
 
+  // The relaxation order (header, "Smoother ordering") in one place, for sweep() and
+  // relaxation_order(): a sweep is two passes, pass pi relaxing the blocks of parity
+  // block_parity(pi, reverse); block q is relaxed colour by colour, tiles ascending, and
+  // for_block_segments calls f(r0, r1) for each run of internal rows in that order.
+  static int block_parity(int pi, bool reverse) { return reverse ? 1 - pi : pi; }
+  template <class F>
+  static void for_block_segments(const Level& L, int q, bool reverse, F&& f) {
+    const int t0 = q * L.block_tiles, t1 = std::min(L.tiles(), t0 + L.block_tiles);
+    for (int ci = 0; ci < 8; ++ci) {
+      const std::size_t c = std::size_t(reverse ? 7 - ci : ci);
+      for (int t = t0; t < t1; ++t) {
+        const std::size_t q8 = std::size_t(t) * 8 + c;
+        f(L.segment_start[q8], L.segment_start[q8 + 1]);
+      }
+    }
+  }
+
   void sweep(int l, bool reverse) {
     Level& L = levels[std::size_t(l)];
     const Csc A(L.A);
@@ -641,27 +658,21 @@ struct MultigridSolver::Impl {
     double* x = L.x.data();
     for (int o = 0; o < int(s); o += 4) {
       if (L.coloured) {
-        const bool compact = !L.smoother.empty();
+        const SmootherRows& S = L.smoother;
         const auto relax_block = [&](int q) {
-          const int t0 = q * L.block_tiles, t1 = std::min(L.tiles(), t0 + L.block_tiles);
-          for (int ci = 0; ci < 8; ++ci) {
-            const std::size_t c = std::size_t(reverse ? 7 - ci : ci);
-            for (int t = t0; t < t1; ++t) {
-              const std::size_t q8 = std::size_t(t) * 8 + c;
-              const int r0 = L.segment_start[q8], r1 = L.segment_start[q8 + 1];
-              if (compact && !L.smoother.full.empty()) {
-                for (int r = r0; r < r1; ++r) gs_row_compact(L.smoother, L.smoother.full.data(), id, b, x, s, o, r);
-              } else if (compact) {
-                for (int r = r0; r < r1; ++r) gs_row_compact(L.smoother, L.smoother.single.data(), id, b, x, s, o, r);
-              } else {
-                for (int r = r0; r < r1; ++r) gs_row(A, dp, id, b, x, s, o, r);
-              }
+          for_block_segments(L, q, reverse, [&](int r0, int r1) {
+            if (!S.full.empty()) {
+              for (int r = r0; r < r1; ++r) gs_row_compact(S, S.full.data(), id, b, x, s, o, r);
+            } else if (!S.empty()) {
+              for (int r = r0; r < r1; ++r) gs_row_compact(S, S.single.data(), id, b, x, s, o, r);
+            } else {
+              for (int r = r0; r < r1; ++r) gs_row(A, dp, id, b, x, s, o, r);
             }
-          }
+          });
         };
         const int blocks = L.blocks();
         for (int pi = 0; pi < 2; ++pi) {
-          const int parity = reverse ? 1 - pi : pi;
+          const int parity = block_parity(pi, reverse);
           const int count = (blocks - parity + 1) / 2;  // blocks parity, parity + 2, ...
           if (count <= 1) {
             for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
@@ -685,19 +696,11 @@ struct MultigridSolver::Impl {
     std::vector<int> order;
     order.reserve(std::size_t(L.n()));
     if (L.coloured) {
-      const int blocks = L.blocks();
-      for (int pi = 0; pi < 2; ++pi) {
-        const int parity = reverse ? 1 - pi : pi;
-        for (int q = parity; q < blocks; q += 2) {
-          const int t0 = q * L.block_tiles, t1 = std::min(L.tiles(), t0 + L.block_tiles);
-          for (int ci = 0; ci < 8; ++ci) {
-            const std::size_t c = std::size_t(reverse ? 7 - ci : ci);
-            for (int t = t0; t < t1; ++t)
-              for (int r = L.segment_start[std::size_t(t) * 8 + c]; r < L.segment_start[std::size_t(t) * 8 + c + 1]; ++r)
-                order.push_back(old_index(L.perm, r));
-          }
-        }
-      }
+      for (int pi = 0; pi < 2; ++pi)
+        for (int q = block_parity(pi, reverse); q < L.blocks(); q += 2)
+          for_block_segments(L, q, reverse, [&](int r0, int r1) {
+            for (int r = r0; r < r1; ++r) order.push_back(old_index(L.perm, r));
+          });
     } else {
       for (int i = 0; i < L.n(); ++i) order.push_back(old_index(L.perm, reverse ? L.n() - 1 - i : i));
     }

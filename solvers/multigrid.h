@@ -116,7 +116,8 @@ class MultigridSolver : public LinearSolver {
   /// Level l's operator (l = 0 coarsest, levels()-1 finest) in the caller's numbering (a copy).
   SparseMatrix level_matrix(int l) const;
   bool level_is_coloured(int l) const;             ///< false: serial Gauss-Seidel fallback
-  /// Whether level l's sweeps read the single-precision compact rows (header, "Smoother matrix").
+  /// Whether level l's sweeps read the compact rows: 16-bit offsets, single-precision values on
+  /// coarse levels, double on the finest (header, "Smoother matrix").
   bool level_has_compact_smoother(int l) const;
   /// Level l's functions (caller's numbering) in the order one sweep relaxes them: the serial
   /// Gauss-Seidel ordering the parallel sweep equals (header, "Smoother ordering").
