@@ -835,6 +835,15 @@ bool MultigridSolver::level_has_compact_smoother(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
   return L.coloured && !L.smoother.empty();
 }
+std::vector<int> MultigridSolver::relaxation_blocks(int l) const {
+  const auto& L = impl_->levels.at(std::size_t(l));
+  std::vector<int> block(std::size_t(L.n()), 0);
+  if (!L.coloured) return block;
+  for (int t = 0; t < L.tiles(); ++t)
+    for (int r = L.segment_start[std::size_t(t) * 8]; r < L.segment_start[std::size_t(t) * 8 + 8]; ++r)
+      block[std::size_t(old_index(L.perm, r))] = t / L.block_tiles;
+  return block;
+}
 std::vector<int> MultigridSolver::relaxation_order(int l, bool reverse) const {
   (void)impl_->levels.at(std::size_t(l));
   return impl_->relaxation_order(l, reverse);

@@ -122,6 +122,10 @@ class MultigridSolver : public LinearSolver {
   /// Level l's functions (caller's numbering) in the order one sweep relaxes them: the serial
   /// Gauss-Seidel ordering the parallel sweep equals (header, "Smoother ordering").
   std::vector<int> relaxation_order(int l, bool reverse = false) const;
+  /// Level l's relaxation block of each function (caller's numbering; all 0 on a serial level).
+  /// Blocks of one parity are relaxed in parallel, which is exact only because functions of
+  /// blocks q and q' with |q - q'| >= 2 never couple.
+  std::vector<int> relaxation_blocks(int l) const;
   std::int64_t symbolic_builds() const;            ///< how often the Galerkin pattern was built
   std::int64_t numeric_builds() const;             ///< how often coarse values were computed
   /// How often set_matrix compared the given pattern with the stored one (skipped when the

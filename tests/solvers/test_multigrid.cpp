@@ -466,6 +466,30 @@ TEST(Multigrid, SweepEqualsSerialGaussSeidelInItsRelaxationOrder) {
   EXPECT_GT((X - Xglobal).cwiseAbs().maxCoeff(), 1e-6 * scale);
 }
 
+/// The parallel sweep relaxes blocks of one parity at the same time, so it is a serial
+/// Gauss-Seidel sweep only if no function couples with one two or more blocks away. Checked on
+/// every level's matrix, with levels of several blocks (a depth-7 shell, whose finest level couples
+/// functions more than a tile apart) so that the check is not vacuous: with one-tile blocks it fails.
+TEST(Multigrid, RelaxationBlocksOfOneParityNeverCouple) {
+  Problem pr = make_problem(7, 4, 0.05, Drop::shell);
+  MultigridSolver mg;
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  int most_blocks = 0;
+  for (int l = 0; l < mg.levels(); ++l) {
+    ASSERT_TRUE(mg.level_is_coloured(l));
+    const SparseMatrix A = mg.level_matrix(l);
+    const std::vector<int> block = mg.relaxation_blocks(l);
+    ASSERT_EQ(block.size(), std::size_t(A.rows()));
+    most_blocks = std::max(most_blocks, *std::max_element(block.begin(), block.end()) + 1);
+    int far = 0;
+    for (int j = 0; j < A.outerSize(); ++j)
+      for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+        far = std::max(far, std::abs(block[std::size_t(it.row())] - block[std::size_t(j)]));
+    EXPECT_LE(far, 1) << "level " << l;
+  }
+  EXPECT_GE(most_blocks, 3);  // even blocks 0 and 2 relax in parallel somewhere
+}
+
 TEST(Multigrid, SerialFallbackWithoutColours) {
   Problem pr = make_problem(4, 1, 0.05, Drop::shell);
   std::vector<std::vector<std::uint8_t>> none;
