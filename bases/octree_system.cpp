@@ -170,6 +170,8 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
   double* Kv = stiffness.valuePtr();
   const int nq = rule.size();
   const auto& pieces = *pieces_;
+  if (pieces.size() != piece_cell_.size())
+    throw std::logic_error("OctreeSystem::assemble: the pieces were released (RebuiltOctreeBasis::release_assembly)");
 
   for_each_tile([&](const int* cells, int n) {
     CellBlocks<true, true> blocks;

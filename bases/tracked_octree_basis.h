@@ -49,6 +49,9 @@ class TrackedOctreeBasis final : public Basis {
   long long degenerate_points() const { return degenerate_points_; }
   /// Bytes of per-step pre-processed data (split-triangle corners + vertex stencils).
   std::size_t preprocessed_bytes() const;
+  /// The octree, system pattern and hierarchy on X_0. Its pieces and assembled matrices were
+  /// released at construction (RebuiltOctreeBasis::release_assembly): compare against a freshly
+  /// built RebuiltOctreeBasis with the same options instead.
   const RebuiltOctreeBasis& initial() const { return *initial_; }
 
  private:
