@@ -69,10 +69,10 @@ class RebuiltOctreeBasis : public Basis {
   const OctreeSystem& system() const { return *system_; }
 
   /// For the tracked basis, which from now on re-integrates on this basis's fixed pattern: swaps
-  /// the assembled mass and stiffness into `mass` and `stiffness` (Eigen 3.4's SparseMatrix has no
-  /// move constructor, so a swap is the only way not to copy them) (their memory, already allocated and touched, is reused
-  /// instead of a fresh copy of the pattern) and frees the pieces and their cells (the tracked
-  /// basis keeps its own compact copy). Afterwards mass(), stiffness() and pieces() are empty and
+  /// the assembled mass and stiffness into `mass` and `stiffness`, so their memory (allocated and
+  /// touched already) is reused instead of a fresh copy of the pattern — a swap, because Eigen
+  /// 3.4's SparseMatrix has no move constructor — and frees the pieces and their cells (the
+  /// tracked basis keeps its own compact copy). Afterwards mass(), stiffness() and pieces() are empty and
   /// system() can no longer assemble; octree, hierarchy, stencils and stats stay. rebuild() starts
   /// over from scratch as usual.
   void release_assembly(SparseMatrix& mass, SparseMatrix& stiffness);

@@ -164,14 +164,15 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
   const OctreeLevel& L = octree_->levels[static_cast<std::size_t>(level_)];
   const GridCube& cube = octree_->cube;
   const double h = cube.cell_size(L.depth), inv_h = 1.0 / h;
+  // The pieces are held by reference; the tracked basis frees them once it has its own copy.
+  if (pieces_->size() != piece_cell_.size())
+    throw std::logic_error("OctreeSystem::assemble: the pieces were released (RebuiltOctreeBasis::release_assembly)");
   set_pattern(mass, outer_, inner_);
   set_pattern(stiffness, outer_, inner_);
   double* Mv = mass.valuePtr();
   double* Kv = stiffness.valuePtr();
   const int nq = rule.size();
   const auto& pieces = *pieces_;
-  if (pieces.size() != piece_cell_.size())
-    throw std::logic_error("OctreeSystem::assemble: the pieces were released (RebuiltOctreeBasis::release_assembly)");
 
   for_each_tile([&](const int* cells, int n) {
     CellBlocks<true, true> blocks;
