@@ -839,9 +839,11 @@ std::vector<int> MultigridSolver::relaxation_blocks(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
   std::vector<int> block(std::size_t(L.n()), 0);
   if (!L.coloured) return block;
-  for (int t = 0; t < L.tiles(); ++t)
-    for (int r = L.segment_start[std::size_t(t) * 8]; r < L.segment_start[std::size_t(t) * 8 + 8]; ++r)
-      block[std::size_t(old_index(L.perm, r))] = t / L.block_tiles;
+  // Block membership as the sweep itself walks it (for_block_segments), not re-derived here.
+  for (int q = 0; q < L.blocks(); ++q)
+    Impl::for_block_segments(L, q, false, [&](int r0, int r1) {
+      for (int r = r0; r < r1; ++r) block[std::size_t(old_index(L.perm, r))] = q;
+    });
   return block;
 }
 std::vector<int> MultigridSolver::relaxation_order(int l, bool reverse) const {
