@@ -8,10 +8,10 @@
 // with 3 columns, and the counter wcycle_over_spmv = (one W-cycle) / (one fine SpMV).
 //
 // Per-step comparisons (issue 4) on the armadillo at depth 9, one W-cycle, 5 GS sweeps:
-//   BM_Step_Tracked/threads:T  update(x,true,true) + M+δK + set_matrix (pattern key: values
-//                              only) + W-cycle + evaluate
-//   BM_Step_Rebuilt/threads:2  rebuild(vertices) + M+δK + set_matrix (fresh solver: new pattern)
-//                              + W-cycle + evaluate
+//   BM_Step_Tracked/threads:T  update(x,true,true) + set_matrix_sum(M, δ, K) (pattern key:
+//                              values only) + W-cycle + evaluate
+//   BM_Step_Rebuilt/threads:2  rebuild(vertices) + set_matrix_sum(M, δ, K) (fresh solver: new
+//                              pattern) + W-cycle + evaluate
 //   BM_Step_HatCholmod/threads:2  hat update + M+δK + CHOLMOD refactorize + solve
 //                              (symbolic analysis outside the loop)
 // Ratios: bench/summarize_micro.py turns the JSON into the README table.
@@ -111,16 +111,11 @@ F& acquire(const std::string& key, const std::function<std::unique_ptr<F>()>& ma
   return *static_cast<F*>(s.object.get());
 }
 
-/// A = M + δK as the flows form it (flows/reduced_system.cpp): M and K share one pattern, so the
-/// sum is value-wise into A's storage. A must already have M's pattern.
-void system_values(const SparseMatrix& M, const SparseMatrix& K, double dt, SparseMatrix& A) {
-  sum_on_pattern(1.0, M, dt, K, A);
-}
-
-/// The same, first giving A M's pattern unless it has it already (compared each call).
+/// A = M + δK as the default LinearSolver::set_matrix_sum forms it (M and K share one pattern, so
+/// the sum is value-wise), first giving A M's pattern unless it has it already (compared each call).
 void system_matrix(const SparseMatrix& M, const SparseMatrix& K, double dt, SparseMatrix& A) {
   if (!same_pattern(M, A)) A = M;
-  system_values(M, K, dt, A);
+  sum_on_pattern(1.0, M, dt, K, A);
 }
 
 MultigridOptions mg_options(MultigridCycle cycle) {
@@ -364,18 +359,17 @@ void BM_Step_Tracked(benchmark::State& state) {
   // As in a flow (ReducedSystem): the tracked pattern is fixed, so it is checked once and the
   // solver is told so through a pattern key instead of comparing it every step.
   const HierarchyView h{basis.prolongations(), basis.colours(), new_pattern_key()};
+  // M + δK goes to the solver as set_matrix_sum, as ReducedSystem hands it over: the multigrid
+  // writes the sum straight into its finest matrix.
   basis.update(f.x, true, true);
-  SparseMatrix A;
-  system_matrix(basis.mass(), basis.stiffness(), f.c.dt, A);
-  solver.set_matrix(A, h);  // Galerkin pattern once
+  solver.set_matrix_sum(1.0, basis.mass(), f.c.dt, basis.stiffness(), h);  // Galerkin pattern once
   Eigen::MatrixXd X, B;
   double t_update = 0, t_set = 0, t_solve = 0, t_eval = 0, residual = 0;
   const auto step = [&](bool timed) {
     auto t0 = Clock::now();
     basis.update(f.x, true, true);
     auto t1 = Clock::now();
-    system_values(basis.mass(), basis.stiffness(), f.c.dt, A);
-    solver.set_matrix(A, h);
+    solver.set_matrix_sum(1.0, basis.mass(), f.c.dt, basis.stiffness(), h);
     auto t2 = Clock::now();
     symmetric_multiply(basis.mass(), f.x, B);
     X = f.x;  // warm start from the previous step's coefficients
@@ -446,17 +440,15 @@ void BM_Step_Rebuilt(benchmark::State& state) {
   RebuiltOctreeBasis& basis = *f.basis;
   const Positions& vertices = f.source->mesh.vertices;
   Eigen::MatrixXd X, B;
-  SparseMatrix A;
   double t_rebuild = 0, t_set = 0, t_solve = 0, t_eval = 0, residual = 0;
   const auto step = [&](bool timed) {
     auto t0 = Clock::now();
     basis.rebuild(vertices);
     auto t1 = Clock::now();
-    system_matrix(basis.mass(), basis.stiffness(), c.dt, A);  // new pattern after a rebuild: copies M
     // A fresh solver: after a rebuild on a moved mesh the pattern is new, so the Galerkin pattern
     // must be rebuilt (reusing the solver on identical vertices would skip that).
     MultigridSolver solver(mg_options(MultigridCycle::W));
-    solver.set_matrix(A, {basis.prolongations(), basis.colours()});
+    solver.set_matrix_sum(1.0, basis.mass(), c.dt, basis.stiffness(), {basis.prolongations(), basis.colours()});
     auto t2 = Clock::now();
     X = basis.initial_coefficients();
     symmetric_multiply(basis.mass(), X, B);

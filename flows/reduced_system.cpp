@@ -25,26 +25,27 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   const SparseMatrix& M = basis_.mass();
   const SparseMatrix& K = basis_.stiffness();
   const Eigen::Index n = M.rows();
-  // S = a M + b K. Bases assemble M and K on one pattern, so this is a value-wise sum.
-  if (b == 0.0) {
-    sum_ = M;
-    if (a != 1.0) sum_ *= a;
-  } else if (shares_pattern(M, K)) {
-    if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) sum_ = M;
-    sum_on_pattern(a, M, b, K, sum_);
-  } else {
-    sum_ = a * M + b * K;
+  // S = a M + b K. Bases assemble M and K on one pattern: then S is a value-wise sum, and it is
+  // formed here only when functions are held (below); otherwise the solver forms it itself
+  // (set_matrix_sum), so no copy of it is kept here (0.4 GB at depth 9).
+  const bool shared = shares_pattern(M, K);
+  if (!shared) {
+    sum_ = b == 0.0 ? SparseMatrix(a * M) : SparseMatrix(a * M + b * K);
     sum_.makeCompressed();
   }
 
-  // Fixed set: the basis's locked functions plus rows that received no contribution.
+  // Fixed set: the basis's locked functions plus rows that received no contribution (every
+  // entry of a M + b K zero).
   std::vector<int> fixed = base_fixed_;
   {
-    const auto* outer = sum_.outerIndexPtr();
-    const double* v = sum_.valuePtr();
+    const auto* outer = (shared ? M : sum_).outerIndexPtr();
+    const double* m = shared ? M.valuePtr() : nullptr;
+    const double* k = shared ? K.valuePtr() : nullptr;
+    const double* v = shared ? nullptr : sum_.valuePtr();
     for (Eigen::Index c = 0; c < n; ++c) {
       bool empty = true;
-      for (int p = outer[c]; p < outer[c + 1] && empty; ++p) empty = v[p] == 0.0;
+      for (int p = outer[c]; p < outer[c + 1] && empty; ++p)
+        empty = (shared ? sum_entry(a, m[p], b, k[p]) : v[p]) == 0.0;
       if (empty) fixed.push_back(int(c));
     }
     std::sort(fixed.begin(), fixed.end());
@@ -54,15 +55,23 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   // The basis's pattern is fixed while this object lives (a rebuilt basis gets a new
   // ReducedSystem), so a pattern key lets the solver skip comparing it each step. No key when M
   // and K have different patterns: then sum_'s pattern depends on whether b is 0.
-  const bool fixed_pattern = shares_pattern(M, K);
-  HierarchyView view{basis_.prolongations(), basis_.colours(), fixed_pattern ? full_key_ : 0};
+  HierarchyView view{basis_.prolongations(), basis_.colours(), shared ? full_key_ : 0};
   if (fixed.empty()) {
     fixed_.clear();
     reduction_valid_ = false;
-    report_ = solver_.set_matrix(sum_, view);
+    if (shared) {
+      sum_ = SparseMatrix();  // held functions may have needed it; now it is the solver's
+      report_ = solver_.set_matrix_sum(a, M, b, K, view);
+    } else {
+      report_ = solver_.set_matrix(sum_, view);
+    }
     Eigen::MatrixXd X = warm;
     if (report_.ok()) report_ = solver_.solve(R, X);
     return X;
+  }
+  if (shared) {
+    if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) sum_ = M;  // M's pattern is fixed
+    sum_on_pattern(a, M, b, K, sum_);
   }
 
   // Only a change of the fixed set needs a new reduction (and a new key, rebuild_reduction).
@@ -92,7 +101,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   }
   HierarchyView reduced_view;
   if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
-  reduced_view.pattern_key = fixed_pattern ? reduced_key_ : 0;
+  reduced_view.pattern_key = shared ? reduced_key_ : 0;
   report_ = solver_.set_matrix(reduced_, reduced_view);
   if (report_.ok()) report_ = solver_.solve(Rf, Xf);
   Coefficients Y = Yfixed;

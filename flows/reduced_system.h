@@ -3,6 +3,8 @@
 // system the solver sees stays symmetric positive definite (open boundaries, DESIGN.md), and
 // functions whose row is empty this step (no cubature point contributes: the paper's
 // "anchoring" through a pinch) are held too instead of making the matrix singular.
+// With no function held (a closed surface) M and K go to the solver as they are
+// (LinearSolver::set_matrix_sum), so the sum is not stored here as well.
 // The reduced pattern and the restricted hierarchy are rebuilt only when the fixed set changes;
 // the basis's own pattern must stay fixed while a ReducedSystem lives (make a new one after a
 // rebuild).
@@ -37,7 +39,8 @@ class ReducedSystem {
   std::vector<int> free_;              // reduced index -> full index
   std::vector<int> reduced_of_;        // full index -> reduced index or -1
   std::vector<int> source_nz_;         // reduced nonzero -> nonzero of the full matrix
-  SparseMatrix sum_, reduced_;
+  SparseMatrix sum_;                   // a M + b K: only while functions are held (else the solver's)
+  SparseMatrix reduced_;
   std::vector<SparseMatrix> prolongations_;            // finest one row-restricted
   std::vector<std::vector<std::uint8_t>> colours_;
   bool reduction_valid_ = false;

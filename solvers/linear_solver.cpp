@@ -35,8 +35,34 @@ void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatri
   const double *m = M.valuePtr(), *k = K.valuePtr();
   double* s = S.valuePtr();
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, M.nonZeros(), 1 << 14), [&](const auto& r) {
-    for (Eigen::Index i = r.begin(); i != r.end(); ++i) s[i] = a * m[i] + b * k[i];
+    for (Eigen::Index i = r.begin(); i != r.end(); ++i) s[i] = sum_entry(a, m[i], b, k[i]);
   });
+}
+
+bool summable(const SparseMatrix& M, const SparseMatrix& K) {
+  return M.isCompressed() && K.isCompressed() && M.rows() == K.rows() && M.cols() == K.cols() &&
+         M.nonZeros() == K.nonZeros();
+}
+
+std::optional<SolveReport> LinearSolver::refuse_sum(const SparseMatrix& M, const SparseMatrix& K) {
+  if (summable(M, K)) return std::nullopt;
+  SolveReport rep;
+  rep.status = SolveStatus::failed;
+  rep.message = "set_matrix_sum: M and K are not on one compressed pattern";
+  return rep;
+}
+
+SolveReport LinearSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                                         HierarchyView hierarchy) {
+  if (auto refused = refuse_sum(M, K)) return *refused;
+  // The key vouches for M's pattern as it does for A's (HierarchyView); without one, compare.
+  const std::uint64_t key = hierarchy.pattern_key;
+  if (key == 0 || key != sum_key_ || sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) {
+    if (!same_pattern(sum_, M)) sum_ = M;
+  }
+  sum_key_ = key;
+  sum_on_pattern(a, M, b, K, sum_);
+  return set_matrix(sum_, hierarchy);
 }
 
 }  // namespace mcf

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,10 +59,19 @@ std::uint64_t new_pattern_key();
 /// indices compared exactly; values ignored). False when either is not compressed.
 bool same_pattern(const SparseMatrix& A, const SparseMatrix& B);
 
+/// One entry of a M + b K. Every kernel that forms the system from M and K on one pattern calls
+/// this, so they agree bitwise (the multigrid's fused refill and sum_on_pattern below).
+inline double sum_entry(double a, double m, double b, double k) { return a * m + b * k; }
+
 /// S = a M + b K entry by entry, in parallel, for M, K and S on one pattern (same_pattern: the
 /// caller checks; S keeps its pattern and only its values are written). This is how every flow
 /// forms its system matrix when the basis assembles M and K on one pattern.
 void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatrix& K, SparseMatrix& S);
+
+/// Whether M and K may be summed on one pattern as far as O(1) checks tell (compressed, same
+/// size and number of nonzeros); same_pattern() is the full comparison, which a caller that owns
+/// a fixed pattern makes once.
+bool summable(const SparseMatrix& M, const SparseMatrix& K);
 
 class LinearSolver {
  public:
@@ -73,9 +83,25 @@ class LinearSolver {
   /// Returns a report whose status is not_positive_definite when a factorization fails.
   virtual SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) = 0;
 
+  /// set_matrix(a M + b K) for M and K on one pattern (same_pattern: the caller checks; a failed
+  /// report when summable() does not hold), bitwise the same, without the caller storing the sum:
+  /// at depth 9 that matrix is 0.4 GB. The default forms the sum in a matrix this object keeps
+  /// (PCG copies it and CHOLMOD factors it anyway); the multigrid solver overrides it and writes
+  /// a M + b K straight into its own (permuted) finest matrix, one pass instead of two.
+  virtual SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                                     HierarchyView hierarchy = {});
+
   /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers
   /// use it; direct solvers ignore it) and the solution on exit.
   virtual SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
+
+ protected:
+  /// The default set_matrix_sum's check of its operands (nullopt: go on).
+  static std::optional<SolveReport> refuse_sum(const SparseMatrix& M, const SparseMatrix& K);
+
+ private:
+  SparseMatrix sum_;              // the default set_matrix_sum's a M + b K
+  std::uint64_t sum_key_ = 0;     // pattern key of the last call
 };
 
 }  // namespace mcf

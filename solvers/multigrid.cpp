@@ -593,16 +593,24 @@ struct MultigridSolver::Impl {
     ++symbolic_builds;
   }
 
-  /// New values of the finest matrix (same pattern as the stored one, in the caller's numbering).
-  void set_fine_values(const SparseMatrix& A) {
+  /// New values of the finest matrix (same pattern as the stored one, in the caller's numbering):
+  /// A's, or a A + b K entry by entry when K is given (K on A's pattern; sum_entry, so bitwise
+  /// what sum_on_pattern would have handed to set_matrix).
+  void set_fine_values(const SparseMatrix& A, double a, double b, const SparseMatrix* K) {
     Level& F = levels.back();
     const Csc G(A);
     const int* outer = F.A.outerIndexPtr();
     double* val = F.A.valuePtr();
-    for_rows(F.n(), [&](int b, int e) {
-      for (int r = b; r < e; ++r) {
+    const double* kv = K ? K->valuePtr() : nullptr;
+    for_rows(F.n(), [&](int rb, int re) {
+      for (int r = rb; r < re; ++r) {
         const int j = old_index(F.perm, r);
-        std::copy(G.val + G.outer[j], G.val + G.outer[j + 1], val + outer[r]);
+        double* out = val + outer[r];
+        if (!kv) {
+          std::copy(G.val + G.outer[j], G.val + G.outer[j + 1], out);
+          continue;
+        }
+        for (int p = G.outer[j]; p < G.outer[j + 1]; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p]);
       }
     });
   }
@@ -858,7 +866,21 @@ void MultigridSolver::reset_level_work() {
   for (auto& w : impl_->work) w = MultigridLevelWork{};
 }
 
-SolveReport MultigridSolver::set_matrix(const SparseMatrix& A_in, HierarchyView hierarchy) {
+SolveReport MultigridSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
+  return set_levels(A, 1.0, 0.0, nullptr, hierarchy);
+}
+
+SolveReport MultigridSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                                            HierarchyView hierarchy) {
+  if (auto refused = refuse_sum(M, K)) {
+    impl_->ready = false;
+    return *refused;
+  }
+  return set_levels(M, a, b, &K, hierarchy);
+}
+
+SolveReport MultigridSolver::set_levels(const SparseMatrix& A_in, double a, double b, const SparseMatrix* K,
+                                        HierarchyView hierarchy) {
   SolveReport rep;
   Impl& m = *impl_;
   m.ready = false;
@@ -907,11 +929,9 @@ SolveReport MultigridSolver::set_matrix(const SparseMatrix& A_in, HierarchyView 
       need_symbolic =
           !same_permuted(m.levels[l].P, P[l], m.levels[l + 1].inv, m.levels[l].perm, true, true);
   }
-  if (need_symbolic) {
-    m.symbolic(A, P, colours);
-  } else {
-    m.set_fine_values(A);
-  }
+  // symbolic() copies A's values along with its pattern; a sum (K given) overwrites them.
+  if (need_symbolic) m.symbolic(A, P, colours);
+  if (!need_symbolic || K) m.set_fine_values(A, a, b, K);
   m.pattern_key = key;
   const bool diag_ok = m.numeric();
 

@@ -31,7 +31,8 @@
 // Internal numbering: every coloured level is stored in tiles of `tile_size` consecutive indices,
 // colour-major inside each tile, so a colour pass streams contiguous segments of rows; the
 // permutation is applied when right-hand sides and solutions are copied in and out, and to the
-// finest matrix's values in set_matrix (one block copy per column). Only the order in which a
+// finest matrix's values in set_matrix (one block copy per column; set_matrix_sum writes a M + b K
+// entry by entry in the same walk). Only the order in which a
 // row's terms are added differs from the caller's numbering (the finest level keeps the caller's
 // entry order, coarse levels add in internal order); level_matrix() converts back. A level whose
 // given colouring is invalid keeps the internal order and is relaxed serially in it.
@@ -100,6 +101,13 @@ class MultigridSolver : public LinearSolver {
   /// An empty hierarchy gives a single level: the solve is then a direct solve.
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
 
+  /// set_matrix(a M + b K), bitwise, without the sum being stored anywhere but in this solver's
+  /// finest level: when the pattern is unchanged, a M + b K is written straight into the permuted
+  /// finest matrix (one pass over M and K instead of forming the sum and copying it); a new
+  /// pattern is set up from M's, and the sum then written the same way.
+  SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                             HierarchyView hierarchy = {}) override;
+
   /// Runs cycles from the warm start X (resized to zero if its shape does not match B).
   /// residuals[c] = max over columns of ||B - A X|| / ||B|| after cycle c.
   SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
@@ -143,6 +151,8 @@ class MultigridSolver : public LinearSolver {
 
  private:
   struct Impl;
+  /// Both set_matrix entries: the finest values are A's, or a A + b K when K is given (A = M).
+  SolveReport set_levels(const SparseMatrix& A, double a, double b, const SparseMatrix* K, HierarchyView hierarchy);
   MultigridOptions options_;
   std::unique_ptr<Impl> impl_;
 };

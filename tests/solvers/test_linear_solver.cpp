@@ -1,12 +1,14 @@
 // The pattern helpers beside the solver interface (solvers/linear_solver.h): same_pattern, which
-// decides whether a solver or ReducedSystem may refresh values only, sum_on_pattern, and
-// new_pattern_key.
+// decides whether a solver or ReducedSystem may refresh values only, sum_on_pattern,
+// new_pattern_key, and the default LinearSolver::set_matrix_sum.
 
 #include "solvers/linear_solver.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -72,6 +74,62 @@ TEST(PatternKey, NeverZeroNeverRepeated) {
     EXPECT_NE(k, 0u);
     EXPECT_TRUE(seen.insert(k).second) << "key " << k << " repeated";
   }
+}
+
+/// Keeps a copy of what set_matrix was given, so the default set_matrix_sum can be checked
+/// against sum_on_pattern without any solver's own arithmetic in between.
+class RecordingSolver : public mcf::LinearSolver {
+ public:
+  std::string name() const override { return "recording"; }
+  mcf::SolveReport set_matrix(const SparseMatrix& A, mcf::HierarchyView h = {}) override {
+    given = A;
+    key = h.pattern_key;
+    ++calls;
+    return {};
+  }
+  mcf::SolveReport solve(const Eigen::MatrixXd&, Eigen::MatrixXd&) override { return {}; }
+  SparseMatrix given;
+  std::uint64_t key = 0;
+  int calls = 0;
+};
+
+bool bitwise_equal(const SparseMatrix& A, const SparseMatrix& B) {
+  return mcf::same_pattern(A, B) && std::equal(A.valuePtr(), A.valuePtr() + A.nonZeros(), B.valuePtr());
+}
+
+// The default hands set_matrix exactly sum_on_pattern's matrix; it follows a change of pattern
+// (same count of entries, so only the comparison can see it) when no key vouches for it, and
+// refuses operands that cannot share a pattern without calling set_matrix.
+TEST(SetMatrixSum, DefaultHandsOverSumOnPattern) {
+  using T = Eigen::Triplet<double, int>;
+  const SparseMatrix M1 = from_triplets(3, {T{0, 0, 2.0}, T{1, 0, 0.5}, T{0, 1, 0.5}, T{1, 1, 3.0}, T{2, 2, 4.0}});
+  const SparseMatrix K1 = from_triplets(3, {T{0, 0, 1.0}, T{1, 0, -1.0}, T{0, 1, -1.0}, T{1, 1, 1.0}, T{2, 2, 0.0}});
+  const SparseMatrix M2 = from_triplets(3, {T{0, 0, 2.0}, T{2, 0, 0.25}, T{0, 2, 0.25}, T{1, 1, 3.0}, T{2, 2, 4.0}});
+  const SparseMatrix K2 = from_triplets(3, {T{0, 0, 1.0}, T{2, 0, -1.0}, T{0, 2, -1.0}, T{1, 1, 7.0}, T{2, 2, 1.0}});
+  ASSERT_FALSE(mcf::same_pattern(M1, M2));
+  auto sum = [](double a, const SparseMatrix& M, double b, const SparseMatrix& K) {
+    SparseMatrix S = M;
+    mcf::sum_on_pattern(a, M, b, K, S);
+    return S;
+  };
+  RecordingSolver s;
+  const std::uint64_t key = mcf::new_pattern_key();
+  ASSERT_TRUE(s.set_matrix_sum(1.0, M1, 0.1, K1, {nullptr, nullptr, key}).ok());
+  EXPECT_TRUE(bitwise_equal(s.given, sum(1.0, M1, 0.1, K1)));
+  EXPECT_EQ(s.key, key);
+  ASSERT_TRUE(s.set_matrix_sum(2.0, M1, 0.3, K1, {nullptr, nullptr, key}).ok());  // vouched: values only
+  EXPECT_TRUE(bitwise_equal(s.given, sum(2.0, M1, 0.3, K1)));
+  ASSERT_TRUE(s.set_matrix_sum(1.0, M2, 0.1, K2).ok());  // no key: compared, new pattern taken
+  EXPECT_TRUE(bitwise_equal(s.given, sum(1.0, M2, 0.1, K2)));
+  const double expected = 1.0 * 0.25 + 0.1 * -1.0;
+  EXPECT_EQ(s.given.coeff(2, 0), expected);
+  EXPECT_EQ(s.calls, 3);
+
+  const SparseMatrix K3 = from_triplets(3, {T{0, 0, 1.0}, T{1, 1, 1.0}, T{2, 2, 1.0}});
+  const mcf::SolveReport refused = s.set_matrix_sum(1.0, M1, 0.1, K3);
+  EXPECT_EQ(refused.status, mcf::SolveStatus::failed);
+  EXPECT_NE(refused.message.find("one compressed pattern"), std::string::npos) << refused.message;
+  EXPECT_EQ(s.calls, 3);
 }
 
 }  // namespace

@@ -269,6 +269,58 @@ TEST(Multigrid, PatternKeySkipsTheComparisonOnly) {
   expect_galerkin(vouched, b);
 }
 
+// set_matrix_sum writes a M + b K straight into the finest level; it must give bitwise the levels
+// and the iterate that set_matrix gives for the sum formed by sum_on_pattern: on a new pattern
+// (symbolic set-up), on a refresh compared or vouched for by a key, and with b = 0.
+TEST(Multigrid, SetMatrixSumEqualsSetMatrixOfTheSum) {
+  for (Drop drop : {Drop::none, Drop::shell}) {
+    SCOPED_TRACE(int(drop));
+    const Problem pm = make_problem(4, 1, 0.0, drop);  // the trilinear mass
+    const Problem pk = make_problem(4, 1, 1.0, drop);  // mass + stiffness: another SPD matrix
+    ASSERT_TRUE(mcf::same_pattern(pm.A, pk.A));
+    const SparseMatrix &M = pm.A, &K = pk.A;
+    const Eigen::MatrixXd B = random_matrix(M.rows(), 3, 7);
+    const std::uint64_t key = mcf::new_pattern_key();
+    MultigridSolver fused, reference;
+    struct Call { double a, b; std::uint64_t key; };
+    for (const Call c : {Call{1.0, 0.05, key}, Call{0.5, 0.2, key}, Call{2.0, 0.0, 0}, Call{1.0, 1e-3, 0}}) {
+      SCOPED_TRACE(c.a);
+      HierarchyView v = pm.view();
+      v.pattern_key = c.key;
+      SparseMatrix S = M;
+      mcf::sum_on_pattern(c.a, M, c.b, K, S);
+      ASSERT_TRUE(fused.set_matrix_sum(c.a, M, c.b, K, v).ok());
+      ASSERT_TRUE(reference.set_matrix(S, pm.view()).ok());
+      ASSERT_EQ(fused.levels(), reference.levels());
+      for (int l = 0; l < fused.levels(); ++l) {
+        const SparseMatrix Lf = fused.level_matrix(l), Lr = reference.level_matrix(l);
+        ASSERT_TRUE(mcf::same_pattern(Lf, Lr)) << "level " << l;
+        EXPECT_TRUE(std::equal(Lf.valuePtr(), Lf.valuePtr() + Lf.nonZeros(), Lr.valuePtr())) << "level " << l;
+      }
+      Eigen::MatrixXd X1, X2;
+      ASSERT_TRUE(fused.solve(B, X1).ok());
+      ASSERT_TRUE(reference.solve(B, X2).ok());
+      EXPECT_EQ((X1 - X2).cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_GT(X1.norm(), 0.0);
+    }
+    EXPECT_EQ(fused.symbolic_builds(), 1);
+    EXPECT_EQ(fused.numeric_builds(), 4);
+    EXPECT_EQ(fused.pattern_comparisons(), 2);  // the two calls without a key
+  }
+}
+
+TEST(Multigrid, SetMatrixSumRefusesOperandsOffOnePattern) {
+  const Problem a = make_problem(3, 1, 0.05);
+  const Problem b = make_problem(3, 1, 0.05, Drop::random);
+  ASSERT_NE(a.A.nonZeros(), b.A.nonZeros());
+  MultigridSolver mg;
+  ASSERT_TRUE(mg.set_matrix(a.A, a.view()).ok());
+  const auto rep = mg.set_matrix_sum(1.0, a.A, 0.1, b.A, a.view());
+  EXPECT_EQ(rep.status, SolveStatus::failed);
+  Eigen::MatrixXd X;
+  EXPECT_FALSE(mg.solve(random_matrix(a.A.rows(), 3, 1), X).ok()) << "a refused matrix leaves no usable solver";
+}
+
 void expect_converges_to_direct(MultigridCycle cycle, Drop drop) {
   // The full grid at depth 5 makes the reference factorization slow: depth 4 there.
   Problem pr = make_problem(drop == Drop::none ? 4 : 5, 1, 0.05, drop);
