@@ -18,4 +18,11 @@ SolveReport MultigridPcgSolver::set_matrix(const SparseMatrix& A, HierarchyView 
   return pcg_.set_matrix(A, hierarchy);
 }
 
+SolveReport MultigridPcgSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                                               HierarchyView hierarchy) {
+  SolveReport r = multigrid_.set_matrix_sum(a, M, b, K, hierarchy);
+  if (!r.ok()) return r;
+  return pcg_.set_matrix_sum(a, M, b, K, hierarchy);
+}
+
 }  // namespace mcf

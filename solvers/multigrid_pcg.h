@@ -12,6 +12,9 @@ class MultigridPcgSolver final : public LinearSolver {
   MultigridPcgSolver(MultigridOptions cycle, PcgOptions pcg);
   std::string name() const override { return "pcg-" + multigrid_.name(); }
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
+  /// Both halves take M and K (each keeps its one copy of the sum).
+  SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                             HierarchyView hierarchy = {}) override;
   SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override { return pcg_.solve(B, X); }
 
  private:

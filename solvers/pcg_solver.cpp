@@ -181,6 +181,36 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarc
     A_.makeCompressed();
     ic_.reset();
   }
+  return matrix_in_place();
+}
+
+SolveReport PcgSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                                      HierarchyView /*hierarchy*/) {
+  have_matrix_ = false;
+  if (auto refused = refuse_sum(M, K)) {
+    matrix_status_ = refused->status;
+    matrix_message_ = refused->message;
+    return *refused;
+  }
+  // The sum straight into A_ (the copy set_matrix would make), compared as set_matrix compares.
+  if (!same_pattern(M, A_)) {
+    A_ = M;
+    ic_.reset();
+  }
+  sum_on_pattern(a, M, b, K, A_);
+  for (Index p = 0; p < A_.nonZeros(); ++p)
+    if (!std::isfinite(A_.valuePtr()[p])) {
+      matrix_status_ = SolveStatus::numerical_issue;
+      matrix_message_ = "matrix has NaN/inf";
+      SolveReport rep;
+      rep.status = matrix_status_;
+      rep.message = matrix_message_;
+      return rep;
+    }
+  return matrix_in_place();
+}
+
+SolveReport PcgSolver::matrix_in_place() {
   have_matrix_ = true;
   const SolveReport pre = build_preconditioner();
   matrix_status_ = pre.status;

@@ -52,6 +52,9 @@ class PcgSolver final : public LinearSolver {
   /// Copies A (values only when the pattern is unchanged) and builds the preconditioner.
   /// not_positive_definite for a non-positive diagonal with Jacobi or an IC breakdown.
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
+  /// The same for a M + b K, written straight into the copy set_matrix keeps (no other copy).
+  SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+                             HierarchyView hierarchy = {}) override;
 
   /// Block PCG from the warm start X (resized to zero if its shape does not match B).
   /// residuals[i] = max relative residual over columns after iteration i+1; the last entry
@@ -63,6 +66,7 @@ class PcgSolver final : public LinearSolver {
 
  private:
   SolveReport build_preconditioner();
+  SolveReport matrix_in_place();  ///< A_ holds the new matrix: the preconditioner, the status
   void apply_preconditioner(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) const;
 
   PcgOptions options_;

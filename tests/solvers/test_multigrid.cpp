@@ -4,6 +4,7 @@
 // (a spherical shell, as an octree around a surface would; or random), so P loses rows/columns.
 
 #include "solvers/multigrid.h"
+#include "solvers/multigrid_pcg.h"
 
 #include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
@@ -306,6 +307,29 @@ TEST(Multigrid, SetMatrixSumEqualsSetMatrixOfTheSum) {
     EXPECT_EQ(fused.symbolic_builds(), 1);
     EXPECT_EQ(fused.numeric_builds(), 4);
     EXPECT_EQ(fused.pattern_comparisons(), 2);  // the two calls without a key
+  }
+}
+
+// PCG preconditioned by the cycle hands M and K to both halves: bitwise as set_matrix on the sum.
+TEST(Multigrid, PcgSetMatrixSumEqualsSetMatrixOfTheSum) {
+  const Problem pm = make_problem(4, 1, 0.0, Drop::shell), pk = make_problem(4, 1, 1.0, Drop::shell);
+  ASSERT_TRUE(mcf::same_pattern(pm.A, pk.A));
+  mcf::PcgOptions pcg;
+  pcg.max_iterations = 3;
+  pcg.relative_tolerance = 1e-14;
+  MultigridOptions cycle;
+  mcf::MultigridPcgSolver fused(cycle, pcg), reference(cycle, pcg);
+  for (const double b : {0.05, 0.2}) {
+    SparseMatrix S = pm.A;
+    mcf::sum_on_pattern(1.0, pm.A, b, pk.A, S);
+    ASSERT_TRUE(fused.set_matrix_sum(1.0, pm.A, b, pk.A, pm.view()).ok());
+    ASSERT_TRUE(reference.set_matrix(S, pm.view()).ok());
+    const Eigen::MatrixXd B = random_matrix(S.rows(), 3, 9);
+    Eigen::MatrixXd X1, X2;
+    ASSERT_TRUE(fused.solve(B, X1).ok());
+    ASSERT_TRUE(reference.solve(B, X2).ok());
+    EXPECT_EQ((X1 - X2).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_GT(X1.norm(), 0.0);
   }
 }
 

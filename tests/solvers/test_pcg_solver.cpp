@@ -238,6 +238,37 @@ TEST(PcgSolver, SameAnswerAfterValueUpdateAndOptionChange) {
   EXPECT_EQ(pcg.name(), "pcg-jacobi");
 }
 
+// set_matrix_sum writes a M + b K straight into the solver's copy: bitwise the iterate of
+// set_matrix on sum_on_pattern's matrix, through a value refresh and a change of pattern (which
+// must rebuild the incomplete Cholesky's ordering), and it refuses operands off one pattern.
+TEST(PcgSolver, SetMatrixSumEqualsSetMatrixOfTheSum) {
+  const SparseMatrix M1 = laplacian3d(7, 7, 7, 0.1, 1), K1 = laplacian3d(7, 7, 7, 0.5, 2, 3.0);
+  const SparseMatrix M2 = graph_laplacian(700, 4, 0.05), K2 = graph_laplacian(700, 4, 0.3);
+  ASSERT_TRUE(same_pattern(M1, K1));
+  ASSERT_TRUE(same_pattern(M2, K2));
+  struct Call { const SparseMatrix *M, *K; double a, b; };
+  PcgOptions o = tight(PcgPreconditioner::incomplete_cholesky);
+  o.max_iterations = 7;  // stop early: an iterate depends on every rounding of A and of the factor
+  PcgSolver fused(o), reference(o);
+  for (const Call c : {Call{&M1, &K1, 1.0, 0.01}, Call{&M1, &K1, 0.5, 0.2}, Call{&M2, &K2, 1.0, 1e-3}}) {
+    SparseMatrix S = *c.M;
+    sum_on_pattern(c.a, *c.M, c.b, *c.K, S);
+    ASSERT_TRUE(fused.set_matrix_sum(c.a, *c.M, c.b, *c.K).ok());
+    ASSERT_TRUE(reference.set_matrix(S).ok());
+    const Eigen::MatrixXd B = random_rhs(S.rows());
+    Eigen::MatrixXd X1, X2;
+    const SolveReport r1 = fused.solve(B, X1), r2 = reference.solve(B, X2);
+    ASSERT_TRUE(r1.ok() && r2.ok());
+    EXPECT_EQ(r1.iterations, r2.iterations);
+    EXPECT_EQ((X1 - X2).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_GT(X1.norm(), 0.0);
+  }
+  const SolveReport refused = fused.set_matrix_sum(1.0, M1, 0.1, M2);
+  EXPECT_EQ(refused.status, SolveStatus::failed);
+  Eigen::MatrixXd X;
+  EXPECT_FALSE(fused.solve(random_rhs(M1.rows()), X).ok()) << "a refused matrix leaves no usable solver";
+}
+
 TEST(PcgSolver, MultiplyMatchesEigen) {
   const SparseMatrix A = graph_laplacian(9000, 4, 0.05, 4);  // > 2 chunks of 4096 rows
   const Eigen::MatrixXd X = random_rhs(A.rows());
