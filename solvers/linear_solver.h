@@ -85,9 +85,9 @@ class LinearSolver {
 
   /// set_matrix(a M + b K) for M and K on one pattern (same_pattern: the caller checks; a failed
   /// report when summable() does not hold), bitwise the same, without the caller storing the sum:
-  /// at depth 9 that matrix is 0.4 GB. The default forms the sum in a matrix this object keeps
-  /// (PCG copies it and CHOLMOD factors it anyway); the multigrid solver overrides it and writes
-  /// a M + b K straight into its own (permuted) finest matrix, one pass instead of two.
+  /// at depth 9 that matrix is 0.28 GB. The default forms the sum in a matrix this object keeps
+  /// (CHOLMOD uses it); the multigrid and PCG solvers override it and write a M + b K straight
+  /// into the copy they keep anyway (the multigrid's permuted finest level, PCG's matrix).
   virtual SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
                                      HierarchyView hierarchy = {});
 
