@@ -44,17 +44,15 @@ bool summable(const SparseMatrix& M, const SparseMatrix& K) {
          M.nonZeros() == K.nonZeros();
 }
 
-std::optional<SolveReport> LinearSolver::refuse_sum(const SparseMatrix& M, const SparseMatrix& K) {
-  if (summable(M, K)) return std::nullopt;
-  SolveReport rep;
-  rep.status = SolveStatus::failed;
-  rep.message = "set_matrix_sum: M and K are not on one compressed pattern";
-  return rep;
-}
-
 SolveReport LinearSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
                                          HierarchyView hierarchy) {
-  if (auto refused = refuse_sum(M, K)) return *refused;
+  if (!summable(M, K)) {
+    // Off one pattern: Eigen merges the patterns; no key, as the union is not what it vouched for.
+    sum_ = b == 0.0 ? SparseMatrix(a * M) : SparseMatrix(a * M + b * K);
+    sum_.makeCompressed();
+    sum_key_ = 0;
+    return set_matrix(sum_, HierarchyView{hierarchy.prolongations, hierarchy.colours, 0});
+  }
   // The key vouches for M's pattern as it does for A's (HierarchyView); without one, compare.
   const std::uint64_t key = hierarchy.pattern_key;
   if (key == 0 || key != sum_key_ || sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) {

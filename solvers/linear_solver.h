@@ -8,7 +8,6 @@
 
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -83,8 +82,9 @@ class LinearSolver {
   /// Returns a report whose status is not_positive_definite when a factorization fails.
   virtual SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) = 0;
 
-  /// set_matrix(a M + b K) for M and K on one pattern (same_pattern: the caller checks; a failed
-  /// report when summable() does not hold), bitwise the same, without the caller storing the sum:
+  /// set_matrix(a M + b K) for M and K on one pattern (same_pattern: the caller checks; when
+  /// summable() does not hold, the default below forms Eigen's general sum, whose pattern is the
+  /// union), bitwise the same, without the caller storing the sum:
   /// at depth 9 that matrix is 0.28 GB. The default forms the sum in a matrix this object keeps
   /// (CHOLMOD uses it); the multigrid and PCG solvers override it and write a M + b K straight
   /// into the copy they keep anyway (the multigrid's permuted finest level, PCG's matrix).
@@ -94,10 +94,6 @@ class LinearSolver {
   /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers
   /// use it; direct solvers ignore it) and the solution on exit.
   virtual SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
-
- protected:
-  /// The default set_matrix_sum's check of its operands (nullopt: go on).
-  static std::optional<SolveReport> refuse_sum(const SparseMatrix& M, const SparseMatrix& K);
 
  private:
   SparseMatrix sum_;              // the default set_matrix_sum's a M + b K

@@ -872,10 +872,7 @@ SolveReport MultigridSolver::set_matrix(const SparseMatrix& A, HierarchyView hie
 
 SolveReport MultigridSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
                                             HierarchyView hierarchy) {
-  if (auto refused = refuse_sum(M, K)) {
-    impl_->ready = false;
-    return *refused;
-  }
+  if (!summable(M, K)) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);  // the general sum
   return set_levels(M, a, b, &K, hierarchy);
 }
 

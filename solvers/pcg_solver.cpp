@@ -170,9 +170,6 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarc
     C.makeCompressed();
     return set_matrix(C);
   }
-  for (Index p = 0; p < A.nonZeros(); ++p)
-    if (!std::isfinite(A.valuePtr()[p])) return fail(SolveStatus::numerical_issue, "matrix has NaN/inf");
-
   if (same_pattern(A, A_)) {
     // Same pattern (every time step of a tracked flow): refresh values only.
     std::copy(A.valuePtr(), A.valuePtr() + A.nonZeros(), A_.valuePtr());
@@ -185,19 +182,21 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarc
 }
 
 SolveReport PcgSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
-                                      HierarchyView /*hierarchy*/) {
+                                      HierarchyView hierarchy) {
+  // Off one pattern (the general sum) or not square (set_matrix says so): the default.
+  if (!summable(M, K) || M.rows() != M.cols()) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
   have_matrix_ = false;
-  if (auto refused = refuse_sum(M, K)) {
-    matrix_status_ = refused->status;
-    matrix_message_ = refused->message;
-    return *refused;
-  }
   // The sum straight into A_ (the copy set_matrix would make), compared as set_matrix compares.
   if (!same_pattern(M, A_)) {
     A_ = M;
     ic_.reset();
   }
   sum_on_pattern(a, M, b, K, A_);
+  return matrix_in_place();
+}
+
+SolveReport PcgSolver::matrix_in_place() {
+  // Checked in the copy, so both entries share it. NaN/inf would make the iteration meaningless.
   for (Index p = 0; p < A_.nonZeros(); ++p)
     if (!std::isfinite(A_.valuePtr()[p])) {
       matrix_status_ = SolveStatus::numerical_issue;
@@ -207,10 +206,6 @@ SolveReport PcgSolver::set_matrix_sum(double a, const SparseMatrix& M, double b,
       rep.message = matrix_message_;
       return rep;
     }
-  return matrix_in_place();
-}
-
-SolveReport PcgSolver::matrix_in_place() {
   have_matrix_ = true;
   const SolveReport pre = build_preconditioner();
   matrix_status_ = pre.status;

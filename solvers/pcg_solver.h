@@ -66,7 +66,7 @@ class PcgSolver final : public LinearSolver {
 
  private:
   SolveReport build_preconditioner();
-  SolveReport matrix_in_place();  ///< A_ holds the new matrix: the preconditioner, the status
+  SolveReport matrix_in_place();  ///< A_ holds the new matrix: finite check, preconditioner, status
   void apply_preconditioner(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) const;
 
   PcgOptions options_;

@@ -99,7 +99,7 @@ bool bitwise_equal(const SparseMatrix& A, const SparseMatrix& B) {
 
 // The default hands set_matrix exactly sum_on_pattern's matrix; it follows a change of pattern
 // (same count of entries, so only the comparison can see it) when no key vouches for it, and
-// refuses operands that cannot share a pattern without calling set_matrix.
+// operands off one pattern get Eigen's general sum (the union of the patterns), without a key.
 TEST(SetMatrixSum, DefaultHandsOverSumOnPattern) {
   using T = Eigen::Triplet<double, int>;
   const SparseMatrix M1 = from_triplets(3, {T{0, 0, 2.0}, T{1, 0, 0.5}, T{0, 1, 0.5}, T{1, 1, 3.0}, T{2, 2, 4.0}});
@@ -125,11 +125,16 @@ TEST(SetMatrixSum, DefaultHandsOverSumOnPattern) {
   EXPECT_EQ(s.given.coeff(2, 0), expected);
   EXPECT_EQ(s.calls, 3);
 
-  const SparseMatrix K3 = from_triplets(3, {T{0, 0, 1.0}, T{1, 1, 1.0}, T{2, 2, 1.0}});
-  const mcf::SolveReport refused = s.set_matrix_sum(1.0, M1, 0.1, K3);
-  EXPECT_EQ(refused.status, mcf::SolveStatus::failed);
-  EXPECT_NE(refused.message.find("one compressed pattern"), std::string::npos) << refused.message;
-  EXPECT_EQ(s.calls, 3);
+  const SparseMatrix K3 = from_triplets(3, {T{2, 2, 1.0}, T{2, 1, 5.0}, T{1, 2, 5.0}});
+  ASSERT_FALSE(mcf::summable(M1, K3));
+  ASSERT_TRUE(s.set_matrix_sum(1.0, M1, 0.1, K3, {nullptr, nullptr, key}).ok());
+  EXPECT_EQ(s.calls, 4);
+  EXPECT_EQ(s.key, 0u) << "the union pattern is not what the key vouched for";
+  const SparseMatrix general = 1.0 * M1 + 0.1 * K3;
+  EXPECT_EQ(s.given.nonZeros(), 7);
+  EXPECT_LT((s.given - general).norm(), 1e-15 * general.norm());
+  EXPECT_EQ(s.given.coeff(2, 1), 0.5);
+  EXPECT_EQ(s.given.coeff(1, 0), 0.5);
 }
 
 }  // namespace

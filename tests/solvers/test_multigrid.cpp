@@ -333,16 +333,30 @@ TEST(Multigrid, PcgSetMatrixSumEqualsSetMatrixOfTheSum) {
   }
 }
 
-TEST(Multigrid, SetMatrixSumRefusesOperandsOffOnePattern) {
+// Operands off one pattern (here K has fewer entries: a diagonal) are not refused: the solver gets
+// Eigen's general sum, exactly as set_matrix on that sum.
+TEST(Multigrid, SetMatrixSumOffOnePatternSetsTheGeneralSum) {
   const Problem a = make_problem(3, 1, 0.05);
-  const Problem b = make_problem(3, 1, 0.05, Drop::random);
-  ASSERT_NE(a.A.nonZeros(), b.A.nonZeros());
-  MultigridSolver mg;
-  ASSERT_TRUE(mg.set_matrix(a.A, a.view()).ok());
-  const auto rep = mg.set_matrix_sum(1.0, a.A, 0.1, b.A, a.view());
-  EXPECT_EQ(rep.status, SolveStatus::failed);
-  Eigen::MatrixXd X;
-  EXPECT_FALSE(mg.solve(random_matrix(a.A.rows(), 3, 1), X).ok()) << "a refused matrix leaves no usable solver";
+  const SparseMatrix D = SparseMatrix(a.A.diagonal().asDiagonal());
+  ASSERT_FALSE(mcf::summable(a.A, D));
+  MultigridSolver fused, reference;
+  ASSERT_TRUE(fused.set_matrix(a.A, a.view()).ok());  // then the other matrix, on the same solver
+  ASSERT_TRUE(fused.set_matrix_sum(1.0, a.A, 0.3, D, a.view()).ok());
+  SparseMatrix S = a.A + 0.3 * D;
+  S.makeCompressed();
+  ASSERT_TRUE(reference.set_matrix(S, a.view()).ok());
+  const Eigen::MatrixXd B = random_matrix(a.A.rows(), 3, 1);
+  Eigen::MatrixXd X1, X2;
+  ASSERT_TRUE(fused.solve(B, X1).ok());
+  ASSERT_TRUE(reference.solve(B, X2).ok());
+  EXPECT_LT(rel_diff(X1, X2), 1e-14);
+  EXPECT_GT(X1.norm(), 0.0);
+  // Not the old matrix's iterate.
+  MultigridSolver old;
+  ASSERT_TRUE(old.set_matrix(a.A, a.view()).ok());
+  Eigen::MatrixXd X0;
+  ASSERT_TRUE(old.solve(B, X0).ok());
+  EXPECT_GT(rel_diff(X1, X0), 1e-3);
 }
 
 void expect_converges_to_direct(MultigridCycle cycle, Drop drop) {
