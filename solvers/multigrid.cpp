@@ -43,6 +43,12 @@ void for_rows(int n, F&& f) {
                     [&](const tbb::blocked_range<int>& r) { f(r.begin(), r.end()); });
 }
 
+// The kernels below cost a few instructions per matrix entry and run at full speed only when
+// inlined into their loops: out of line, the two accumulators passed by reference go through
+// memory on every entry. GCC stopped inlining gather_sub and gather_sub_compact once they had a
+// few more call sites (a fine sweep at depth 9 went from 116 to 140-180 ms), so they are forced.
+#define MCF_KERNEL_INLINE inline __attribute__((always_inline))
+
 /// Four doubles (GCC/Clang vector extensions: one AVX register when compiled for it, emulated
 /// otherwise). The kernels below hold four right-hand-side columns of one row in one vector.
 using v4 = double __attribute__((vector_size(32)));
@@ -91,8 +97,8 @@ struct Csc {
 // (SmootherRows, relaxation blocks).
 
 /// Σ_p val[p] x[inner[p]] over p in [begin, end), into acc0 (even p - begin) and acc1 (odd).
-inline void gather_sub(const Csc& A, const double* x, std::size_t s, int o, int begin, int end, v4& acc0,
-                       v4& acc1) {
+MCF_KERNEL_INLINE void gather_sub(const Csc& A, const double* x, std::size_t s, int o, int begin, int end, v4& acc0,
+                                  v4& acc1) {
   int p = begin;
   for (; p + 1 < end; p += 2) {
     acc0 -= splat(A.val[p]) * load4(x + std::size_t(A.inner[p]) * s + o);
@@ -104,8 +110,8 @@ inline void gather_sub(const Csc& A, const double* x, std::size_t s, int o, int 
 /// One Gauss-Seidel update of row i (= column i of the symmetric CSC matrix), columns o..o+3.
 /// diag_pos[i] is the position of the diagonal entry in column i (-1 if absent): the sum runs
 /// over the entries before and after it, in index order, without a test per entry.
-inline void gs_row(const Csc& A, const int* diag_pos, const double* inv_diag, const double* b, double* x,
-                   std::size_t s, int o, int i) {
+MCF_KERNEL_INLINE void gs_row(const Csc& A, const int* diag_pos, const double* inv_diag, const double* b, double* x,
+                              std::size_t s, int o, int i) {
   const std::size_t ii = std::size_t(i) * s + o;
   v4 acc0 = load4(b + ii), acc1 = splat(0.0);
   const int dp = diag_pos[i];
@@ -118,21 +124,11 @@ inline void gs_row(const Csc& A, const int* diag_pos, const double* inv_diag, co
   store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
 }
 
-/// r = b - A x (rows [begin, end)), columns o..o+3.
-inline void residual_rows(const Csc& A, const double* b, const double* x, double* r, std::size_t s, int o,
-                          int begin, int end) {
-  for (int i = begin; i < end; ++i) {
-    const std::size_t ii = std::size_t(i) * s + o;
-    v4 acc0 = load4(b + ii), acc1 = splat(0.0);
-    gather_sub(A, x, s, o, A.outer[i], A.outer[i + 1], acc0, acc1);
-    store4(r + ii, acc0 + acc1);
-  }
-}
-
 /// y = Mᵀ v (or y += Mᵀ v when Add) on output rows [begin, end) = columns of M (gather along
 /// columns, so parallel output ranges never write the same entry), columns o..o+3.
 template <bool Add>
-inline void transpose_rows(const Csc& M, const double* v, double* y, std::size_t s, int o, int begin, int end) {
+MCF_KERNEL_INLINE void transpose_rows(const Csc& M, const double* v, double* y, std::size_t s, int o, int begin,
+                                      int end) {
   for (int J = begin; J < end; ++J) {
     v4 acc0 = splat(0.0), acc1 = splat(0.0);
     gather_sub(M, v, s, o, M.outer[J], M.outer[J + 1], acc0, acc1);
@@ -142,28 +138,33 @@ inline void transpose_rows(const Csc& M, const double* v, double* y, std::size_t
   }
 }
 
-/// A level's off-diagonal entries as the smoother reads them: row by row in the internal
-/// numbering, each entry as (column - row) in 16 bits and its value, in single precision on coarse
-/// levels (6 bytes an entry instead of CSC's 12) and in double precision on the finest level (10
-/// bytes). The sweeps stream the matrix ten times per level visit and are bound by its bytes once
-/// the iterate stays in cache. Why not single precision on the finest level: a Gauss-Seidel update
-/// x_i = (b_i - Σ a_ij x_j) / a_ii with rounded a_ij has the rounded system's solution as its fixed
-/// point, so the finest level's sweeps would pull the iterate off A x = b (a test that cycles to
-/// 1e-10 stalled at 2e-8); on a coarse level the sweeps only shape a correction of the finest
-/// residual, which is exact, so the cycle still converges to the solution of A x = b. Empty
-/// (unused) when some column lies farther than 16 bits from its row.
+/// A level's off-diagonal entries as the smoother reads them, each entry's column as (column -
+/// row) in 16 bits. The sweeps stream the matrix ten times per level visit and are bound by its
+/// bytes once the iterate stays in cache.
+/// - Coarse levels: row by row in the internal numbering, the diagonal left out, the values in
+///   single precision (6 bytes an entry instead of CSC's 12).
+/// - Finest level (`aligned`): one offset per entry of the level's CSC matrix, whose columns store
+///   their diagonal last (Impl::symbolic), so a row's off-diagonal entries are one run of the
+///   matrix's own values: 10 bytes an entry, and the largest matrix is stored once (a copy of its
+///   values was 0.18 GB at depth 9). Why not single precision here: a Gauss-Seidel update
+///   x_i = (b_i - Σ a_ij x_j) / a_ii with rounded a_ij has the rounded system's solution as its
+///   fixed point, so the finest level's sweeps would pull the iterate off A x = b (a test that
+///   cycles to 1e-10 stalled at 2e-8); on a coarse level the sweeps only shape a correction of
+///   the finest residual, which is exact, so the cycle still converges to the solution of A x = b.
+/// Unused when some column lies farther than 16 bits from its row (the sweeps then read the CSC).
 struct SmootherRows {
-  std::vector<int> start;               // row i: entries [start[i], start[i+1])
+  bool in_use = false;
+  bool aligned = false;                 // finest level: offset[p] belongs to CSC entry p
+  std::vector<int> start;               // coarse levels: row i's entries [start[i], start[i+1])
   std::vector<std::int16_t> offset;     // column - row
-  std::vector<float> single;            // values (coarse levels), or
-  std::vector<double> full;             // values (finest level)
-  bool empty() const { return start.empty(); }
+  std::vector<float> single;            // coarse levels' values
+  bool empty() const { return !in_use; }
 };
 
 /// acc0/acc1 -= Σ_p val[p] x[i + offset[p]] over the compact entries [begin, end).
 template <class V>
-inline void gather_sub_compact(const std::int16_t* off, const V* val, const double* xi, std::size_t s, int begin,
-                               int end, v4& acc0, v4& acc1) {
+MCF_KERNEL_INLINE void gather_sub_compact(const std::int16_t* off, const V* val, const double* xi, std::size_t s,
+                                          int begin, int end, v4& acc0, v4& acc1) {
   const std::ptrdiff_t st = std::ptrdiff_t(s);
   int p = begin;
   for (; p + 1 < end; p += 2) {
@@ -173,15 +174,56 @@ inline void gather_sub_compact(const std::int16_t* off, const V* val, const doub
   if (p < end) acc0 -= splat(double(val[p])) * load4(xi + std::ptrdiff_t(off[p]) * st);
 }
 
-/// gs_row on the smoother's compact rows (values val: S.single or S.full).
+/// gs_row on a coarse level's compact rows (values val: S.single).
 template <class V>
-inline void gs_row_compact(const SmootherRows& S, const V* val, const double* inv_diag, const double* b, double* x,
-                           std::size_t s, int o, int i) {
+MCF_KERNEL_INLINE void gs_row_compact(const SmootherRows& S, const V* val, const double* inv_diag, const double* b,
+                                      double* x, std::size_t s, int o, int i) {
   const std::size_t ii = std::size_t(i) * s + o;
   v4 acc0 = load4(b + ii), acc1 = splat(0.0);
   gather_sub_compact(S.offset.data(), val, x + ii, s, S.start[std::size_t(i)], S.start[std::size_t(i) + 1], acc0,
                      acc1);
   store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
+}
+
+/// gs_row on the finest level's aligned offsets: the row's off-diagonal entries are the run
+/// before its diagonal (stored last), read from the matrix itself; bitwise what gs_row_compact
+/// computes on a copy of them.
+MCF_KERNEL_INLINE void gs_row_aligned(const Csc& A, const std::int16_t* off, const int* diag_pos,
+                                      const double* inv_diag, const double* b, double* x, std::size_t s, int o,
+                                      int i) {
+  const std::size_t ii = std::size_t(i) * s + o;
+  v4 acc0 = load4(b + ii), acc1 = splat(0.0);
+  const int dp = diag_pos[i];
+  gather_sub_compact(off, A.val, x + ii, s, A.outer[i], dp >= 0 ? dp : A.outer[i + 1], acc0, acc1);
+  store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
+}
+
+/// b - A x on row i (= column i), columns o..o+3, the row's terms in the caller's order: on the
+/// finest level, whose columns store their diagonal last, the diagonal term is added where the
+/// caller's column had it (diag_rank[i]-th; -1: none or not moved): the same terms in the same
+/// order into the same accumulators as gather_sub over the caller's column (acc0 the even terms,
+/// acc1 the odd). Bitwise the same with -ffp-contract=off; with the default contraction GCC may
+/// fuse the diagonal's multiply-add differently, a last-bit difference (checked 2026-11-24).
+MCF_KERNEL_INLINE v4 row_residual(const Csc& A, const int* diag_rank, const double* b, const double* x,
+                                  std::size_t s, int o, int i) {
+  const std::size_t ii = std::size_t(i) * s + o;
+  v4 acc0 = load4(b + ii), acc1 = splat(0.0);
+  const int p0 = A.outer[i], p1 = A.outer[i + 1];
+  const int k = diag_rank ? diag_rank[i] : -1;
+  if (k < 0) {
+    gather_sub(A, x, s, o, p0, p1, acc0, acc1);
+    return acc0 + acc1;
+  }
+  // Terms 0..k-1 at p0.., term k (the diagonal) at p1 - 1, terms k+1.. at p0 + k..: the
+  // diagonal's accumulator follows its parity, and the run after it continues the parity.
+  gather_sub(A, x, s, o, p0, p0 + k, acc0, acc1);
+  v4& diag_acc = (k % 2 == 0) ? acc0 : acc1;
+  diag_acc -= splat(A.val[p1 - 1]) * load4(x + ii);
+  if (k % 2 == 0)
+    gather_sub(A, x, s, o, p0 + k, p1 - 1, acc1, acc0);
+  else
+    gather_sub(A, x, s, o, p0 + k, p1 - 1, acc0, acc1);
+  return acc0 + acc1;
 }
 
 // ---- sparse products with a precomputed pattern ------------------------------------------
@@ -313,9 +355,11 @@ SparseMatrix permuted(const SparseMatrix& Mm, const std::vector<int>& row_inv, c
 }
 
 /// Whether `stored` == permuted(given, row_inv, col_perm, sort) (pattern, and values when asked)
-/// without building the permuted copy.
+/// without building the permuted copy. Unsorted, with diag_rank (the finest level): column r
+/// stores the caller's diag_rank[r]-th entry last (Impl::diagonal_last).
 bool same_permuted(const SparseMatrix& stored, const SparseMatrix& given, const std::vector<int>& row_inv,
-                   const std::vector<int>& col_perm, bool sort, bool values) {
+                   const std::vector<int>& col_perm, bool sort, bool values,
+                   const std::vector<int>& diag_rank = {}) {
   if (stored.rows() != given.rows() || stored.cols() != given.cols() ||
       stored.nonZeros() != given.nonZeros() || !given.isCompressed())
     return false;
@@ -334,7 +378,9 @@ bool same_permuted(const SparseMatrix& stored, const SparseMatrix& given, const 
             const int i = new_index(row_inv, G.inner[p]);
             // Unsorted: entry t in place. Sorted: somewhere in the column (rows are distinct and
             // the counts equal, so finding every given entry proves equality).
-            const int* it = sort ? std::lower_bound(sb, se, i) : sb + t;
+            const int k = diag_rank.empty() ? -1 : diag_rank[std::size_t(r)];
+            const int slot = k < 0 || t < k ? t : (t == k ? n - 1 : t - 1);
+            const int* it = sort ? std::lower_bound(sb, se, i) : sb + slot;
             if (it == se || *it != i || (values && S.val[it - S.inner] != G.val[p])) return false;
           }
         }
@@ -356,6 +402,10 @@ struct MultigridSolver::Impl {
     std::vector<int> transpose_pos;    // entry e=(i,J) -> position of (J,i) (coarse levels)
     std::vector<double> inv_diag;
     std::vector<int> diag_pos;         // position of the diagonal entry of each column, -1 if none
+    // Finest level of a hierarchy: each column stores its diagonal last (the smoother reads the
+    // off-diagonal run in place); diag_rank[r] = the diagonal's place in the caller's column
+    // (-1: none). Empty on coarse levels and a single level.
+    std::vector<int> diag_rank;
     bool coloured = false;
     std::vector<int> segment_start;    // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
     int block_tiles = 1;               // tiles per relaxation block (find_blocks())
@@ -481,65 +531,89 @@ struct MultigridSolver::Impl {
     L.block_tiles = std::max(reach, kMinBlockTiles);
   }
 
-  /// The compact rows' pattern (SmootherRows), or none when an offset does not fit 16 bits.
+  /// The compact rows' pattern (SmootherRows), or none when an offset does not fit 16 bits: on
+  /// the finest level one offset per CSC entry (aligned; its values are the matrix's own), on
+  /// coarse levels the off-diagonal entries only, with room for their single-precision values.
   static void smoother_pattern(Level& L, bool finest) {
     SmootherRows& S = L.smoother;
     S = SmootherRows{};
     if (!L.coloured) return;  // the serial fallback reads the double-precision matrix
     const Csc A(L.A);
+    const auto fits16 = [](int d) { return d >= INT16_MIN && d <= INT16_MAX; };
+    if (finest) {
+      std::vector<std::int16_t> offset(std::size_t(A.outer[A.cols]));
+      for (int i = 0; i < L.n(); ++i)
+        for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
+          const int d = A.inner[p] - i;
+          if (!fits16(d)) return;
+          offset[std::size_t(p)] = std::int16_t(d);
+        }
+      S.offset = std::move(offset);
+      S.aligned = S.in_use = true;
+      return;
+    }
     std::vector<int> start(std::size_t(L.n()) + 1, 0);
     for (int i = 0; i < L.n(); ++i) {
       const int dp = L.diag_pos[std::size_t(i)];
       start[std::size_t(i) + 1] = start[std::size_t(i)] + (A.outer[i + 1] - A.outer[i]) - (dp >= 0 ? 1 : 0);
     }
     std::vector<std::int16_t> offset(std::size_t(start.back()));
-    bool fits = true;
-    for (int i = 0; i < L.n() && fits; ++i) {
+    for (int i = 0; i < L.n(); ++i) {
       int e = start[std::size_t(i)];
       for (int p = A.outer[i]; p < A.outer[i + 1]; ++p) {
         const int d = A.inner[p] - i;
         if (d == 0) continue;
-        if (d < INT16_MIN || d > INT16_MAX) {
-          fits = false;
-          break;
-        }
+        if (!fits16(d)) return;
         offset[std::size_t(e++)] = std::int16_t(d);
       }
     }
-    if (!fits) return;
     S.start = std::move(start);
     S.offset = std::move(offset);
-    if (finest)
-      S.full.assign(S.offset.size(), 0.0);
-    else
-      S.single.assign(S.offset.size(), 0.0f);
+    S.single.assign(S.offset.size(), 0.0f);
+    S.in_use = true;
   }
 
-  /// The compact rows' values from the level's matrix (same order, diagonal skipped).
+  /// A coarse level's compact values from its matrix (same order, diagonal skipped, rounded to
+  /// single precision). The finest level's sweeps read the matrix's own values.
   static void smoother_values(Level& L) {
     SmootherRows& S = L.smoother;
-    if (S.empty()) return;
+    if (S.empty() || S.aligned) return;
     const Csc A(L.A);
     // A row's off-diagonal entries are the runs before and after its diagonal (diag_pos), so they
     // are copied as two runs without reading the row indices.
-    const auto fill = [&](auto* out) {
-      for_rows(L.n(), [&](int b, int e) {
-        for (int i = b; i < e; ++i) {
-          const int p0 = A.outer[i], p1 = A.outer[i + 1], dp = L.diag_pos[std::size_t(i)];
-          auto* q = out + S.start[std::size_t(i)];
-          if (dp < 0) {
-            std::copy(A.val + p0, A.val + p1, q);
-          } else {
-            q = std::copy(A.val + p0, A.val + dp, q);
-            std::copy(A.val + dp + 1, A.val + p1, q);
-          }
+    float* out = S.single.data();
+    for_rows(L.n(), [&](int b, int e) {
+      for (int i = b; i < e; ++i) {
+        const int p0 = A.outer[i], p1 = A.outer[i + 1], dp = L.diag_pos[std::size_t(i)];
+        float* q = out + S.start[std::size_t(i)];
+        if (dp < 0) {
+          std::copy(A.val + p0, A.val + p1, q);
+        } else {
+          q = std::copy(A.val + p0, A.val + dp, q);
+          std::copy(A.val + dp + 1, A.val + p1, q);
         }
-      });
-    };
-    if (S.full.empty())
-      fill(S.single.data());
-    else
-      fill(S.full.data());
+      }
+    });
+  }
+
+  /// Moves each column's diagonal entry of the finest matrix to the column's end (the other
+  /// entries keep their order) and records where it was (diag_rank).
+  static void diagonal_last(Level& F) {
+    int* outer = F.A.outerIndexPtr();
+    int* inner = F.A.innerIndexPtr();
+    double* val = F.A.valuePtr();
+    F.diag_rank.assign(std::size_t(F.n()), -1);
+    for_rows(F.n(), [&](int b, int e) {
+      for (int r = b; r < e; ++r) {
+        const int p0 = outer[r], p1 = outer[r + 1];
+        const int* d = std::find(inner + p0, inner + p1, r);
+        if (d == inner + p1) continue;
+        const int k = int(d - (inner + p0));
+        F.diag_rank[std::size_t(r)] = k;
+        std::rotate(inner + p0 + k, inner + p0 + k + 1, inner + p1);
+        std::rotate(val + p0 + k, val + p0 + k + 1, val + p1);
+      }
+    });
   }
 
   void symbolic(const SparseMatrix& A, const std::vector<SparseMatrix>& P,
@@ -554,11 +628,14 @@ struct MultigridSolver::Impl {
       const int n = l + 1 < nl ? int(P[l].cols()) : int(A.rows());
       number_by_colour(levels[l], n, l < colours.size() ? &colours[l] : nullptr);
     }
-    // The finest matrix keeps each column's entries in the caller's order, so later value
-    // updates are one block copy per column (set_fine_values) and row sums add their terms in
-    // the caller's order.
+    // The finest matrix keeps each column's entries in the caller's order, except its diagonal,
+    // which it stores last (diagonal_last: the smoother then reads a row's off-diagonal entries
+    // as one run of the matrix itself). Later value updates are three block copies per column
+    // (set_fine_values), and the residual adds the terms in the caller's order (row_residual).
     Level& F = levels.back();
     F.A = permuted(A, F.inv, F.perm, false);
+    F.diag_rank.clear();
+    if (nl > 1) diagonal_last(F);
     for (std::size_t l = 0; l + 1 < nl; ++l) {
       SparseMatrix given = P[l];
       given.makeCompressed();
@@ -602,15 +679,26 @@ struct MultigridSolver::Impl {
     const int* outer = F.A.outerIndexPtr();
     double* val = F.A.valuePtr();
     const double* kv = K ? K->valuePtr() : nullptr;
+    // Caller's entries [p, q) of column j to out: copied, or summed with K's.
+    const auto put = [&](int p, int q, double* out) {
+      if (!kv) return std::copy(G.val + p, G.val + q, out);
+      for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p]);
+      return out;
+    };
     for_rows(F.n(), [&](int rb, int re) {
       for (int r = rb; r < re; ++r) {
         const int j = old_index(F.perm, r);
+        const int g0 = G.outer[j], g1 = G.outer[j + 1];
+        const int k = F.diag_rank.empty() ? -1 : F.diag_rank[std::size_t(r)];
         double* out = val + outer[r];
-        if (!kv) {
-          std::copy(G.val + G.outer[j], G.val + G.outer[j + 1], out);
+        if (k < 0 || k >= g1 - g0) {
+          put(g0, g1, out);
           continue;
         }
-        for (int p = G.outer[j]; p < G.outer[j + 1]; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p]);
+        // The diagonal last (diagonal_last): the entries before it, after it, then it.
+        out = put(g0, g0 + k, out);
+        out = put(g0 + k + 1, g1, out);
+        put(g0 + k, g0 + k + 1, out);
       }
     });
   }
@@ -669,8 +757,8 @@ struct MultigridSolver::Impl {
         const SmootherRows& S = L.smoother;
         const auto relax_block = [&](int q) {
           for_block_segments(L, q, reverse, [&](int r0, int r1) {
-            if (!S.full.empty()) {
-              for (int r = r0; r < r1; ++r) gs_row_compact(S, S.full.data(), id, b, x, s, o, r);
+            if (S.aligned) {
+              for (int r = r0; r < r1; ++r) gs_row_aligned(A, S.offset.data(), dp, id, b, x, s, o, r);
             } else if (!S.empty()) {
               for (int r = r0; r < r1; ++r) gs_row_compact(S, S.single.data(), id, b, x, s, o, r);
             } else {
@@ -718,8 +806,12 @@ struct MultigridSolver::Impl {
   void residual(int l) {
     Level& L = levels[std::size_t(l)];
     const Csc A(L.A);
+    const int* rank = L.diag_rank.empty() ? nullptr : L.diag_rank.data();
     for (int o = 0; o < int(s); o += 4)
-      for_rows(A.cols, [&](int b, int e) { residual_rows(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e); });
+      for_rows(A.cols, [&](int b, int e) {
+        for (int i = b; i < e; ++i)
+          store4(L.r.data() + std::size_t(i) * s + o, row_residual(A, rank, L.b.data(), L.x.data(), s, o, i));
+      });
   }
 
   void coarse_solve() {
@@ -770,6 +862,7 @@ struct MultigridSolver::Impl {
   double relative_residual(const Eigen::VectorXd& bnorm) {
     Level& L = levels.back();
     const Csc A(L.A);
+    const int* rank = L.diag_rank.empty() ? nullptr : L.diag_rank.data();
     std::vector<double> rn(s, 0.0);
     for (int o = 0; o < int(s); o += 4) {
       struct Acc {
@@ -779,9 +872,7 @@ struct MultigridSolver::Impl {
           tbb::blocked_range<int>(0, A.cols, 4096), Acc{},
           [&](const tbb::blocked_range<int>& r, Acc acc) {
             for (int i = r.begin(); i < r.end(); ++i) {
-              v4 res0 = load4(L.b.data() + std::size_t(i) * s + o), res1 = splat(0.0);
-              gather_sub(A, L.x.data(), s, o, A.outer[i], A.outer[i + 1], res0, res1);
-              const v4 res = res0 + res1;
+              const v4 res = row_residual(A, rank, L.b.data(), L.x.data(), s, o, i);
               acc.v += res * res;
             }
             return acc;
@@ -920,7 +1011,7 @@ SolveReport MultigridSolver::set_levels(const SparseMatrix& A_in, double a, doub
     need_symbolic = nc != m.colours.size() || (nc > 0 && *colours != m.colours);
     if (!need_symbolic) {
       const auto& F = m.levels.back();
-      need_symbolic = !same_permuted(F.A, A, F.inv, F.perm, false, false);
+      need_symbolic = !same_permuted(F.A, A, F.inv, F.perm, false, false, F.diag_rank);
     }
     for (std::size_t l = 0; !need_symbolic && l < P.size(); ++l)
       need_symbolic =

@@ -310,6 +310,73 @@ TEST(Multigrid, SetMatrixSumEqualsSetMatrixOfTheSum) {
   }
 }
 
+/// A's entries with each column rotated by (j mod its length) places: the same matrix, stored
+/// with the diagonal first, last or in between.
+SparseMatrix rotate_columns(const SparseMatrix& A) {
+  SparseMatrix R = A;
+  for (int j = 0; j < R.cols(); ++j) {
+    const int p0 = R.outerIndexPtr()[j], n = R.outerIndexPtr()[j + 1] - p0;
+    if (n == 0) continue;
+    std::rotate(R.innerIndexPtr() + p0, R.innerIndexPtr() + p0 + j % n, R.innerIndexPtr() + p0 + n);
+    std::rotate(R.valuePtr() + p0, R.valuePtr() + p0 + j % n, R.valuePtr() + p0 + n);
+  }
+  return R;
+}
+
+bool same_values(const SparseMatrix& X, const SparseMatrix& Y) {
+  return mcf::same_pattern(X, Y) && std::equal(X.valuePtr(), X.valuePtr() + X.nonZeros(), Y.valuePtr());
+}
+
+/// The finest level stores each column's diagonal last and remembers where the caller had it
+/// (multigrid.cpp, diagonal_last): a value refresh and set_matrix_sum must put every entry back
+/// in its place, and the pattern comparison must recognise the caller's order. Checked with the
+/// caller's diagonal at every rank (columns rotated), against the same matrix stored sorted.
+TEST(Multigrid, FinestDiagonalStoredLastWhereverTheCallerHasIt) {
+  const Problem pm = make_problem(5, 2, 0.0, Drop::shell);
+  const Problem pk = make_problem(5, 2, 1.0, Drop::shell);
+  const SparseMatrix M = rotate_columns(pm.A), K = rotate_columns(pk.A);
+  int ranks_seen = 0;  // teeth: the rotation really moves the diagonal around
+  for (int j = 0; j < M.cols(); ++j) {
+    const int p0 = M.outerIndexPtr()[j];
+    if (M.innerIndexPtr()[p0] != j && M.innerIndexPtr()[M.outerIndexPtr()[j + 1] - 1] != j) ++ranks_seen;
+  }
+  ASSERT_GT(ranks_seen, M.cols() / 2);
+  const Eigen::MatrixXd B = random_matrix(M.rows(), 3, 31);
+  MultigridSolver rotated, sorted;
+  ASSERT_TRUE(rotated.set_matrix(M, pm.view()).ok());
+  ASSERT_TRUE(sorted.set_matrix(pm.A, pm.view()).ok());
+  ASSERT_TRUE(rotated.level_has_compact_smoother(rotated.levels() - 1));
+  for (int l = 0; l < rotated.levels(); ++l)
+    EXPECT_TRUE(same_values(rotated.level_matrix(l), sorted.level_matrix(l))) << "level " << l;
+  Eigen::MatrixXd X1, X2;
+  ASSERT_TRUE(rotated.solve(B, X1).ok());
+  ASSERT_TRUE(sorted.solve(B, X2).ok());
+  EXPECT_LE((X1 - X2).cwiseAbs().maxCoeff(), 1e-12 * X2.cwiseAbs().maxCoeff());  // term order only
+  EXPECT_GT(X2.norm(), 0.0);
+
+  // New values, compared pattern: no new symbolic build, every value in its place.
+  const SparseMatrix M2 = M * 2.0;
+  ASSERT_TRUE(rotated.set_matrix(M2, pm.view()).ok());
+  EXPECT_EQ(rotated.symbolic_builds(), 1);
+  EXPECT_EQ(rotated.pattern_comparisons(), 1);
+  SparseMatrix twice = pm.A * 2.0;
+  EXPECT_TRUE(same_values(rotated.level_matrix(rotated.levels() - 1), twice));
+
+  // The sum written entry by entry: the level equals the sorted sum.
+  SparseMatrix S = pm.A;
+  mcf::sum_on_pattern(1.0, pm.A, 0.05, pk.A, S);
+  ASSERT_TRUE(rotated.set_matrix_sum(1.0, M, 0.05, K, pm.view()).ok());
+  EXPECT_EQ(rotated.symbolic_builds(), 1);
+  ASSERT_TRUE(sorted.set_matrix(S, pm.view()).ok());
+  for (int l = 0; l < rotated.levels(); ++l)
+    EXPECT_TRUE(same_values(rotated.level_matrix(l), sorted.level_matrix(l))) << "sum, level " << l;
+
+  // The same matrix in the sorted order is another stored pattern: a new symbolic build.
+  ASSERT_TRUE(rotated.set_matrix(pm.A, pm.view()).ok());
+  EXPECT_EQ(rotated.symbolic_builds(), 2);
+  EXPECT_TRUE(same_values(rotated.level_matrix(rotated.levels() - 1), pm.A));
+}
+
 // PCG preconditioned by the cycle hands M and K to both halves: bitwise as set_matrix on the sum.
 TEST(Multigrid, PcgSetMatrixSumEqualsSetMatrixOfTheSum) {
   const Problem pm = make_problem(4, 1, 0.0, Drop::shell), pk = make_problem(4, 1, 1.0, Drop::shell);
