@@ -29,10 +29,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   // formed here only when functions are held (below); otherwise the solver forms it itself
   // (set_matrix_sum), so no copy of it is kept here (0.28 GB at depth 9).
   const bool shared = shares_pattern(M, K);
-  if (!shared) {
-    sum_ = b == 0.0 ? SparseMatrix(a * M) : SparseMatrix(a * M + b * K);
-    sum_.makeCompressed();
-  }
+  if (!shared) sum_ = general_sum(a, M, b, K);
 
   // Fixed set: the basis's locked functions plus rows that received no contribution (every
   // entry of a M + b K zero).

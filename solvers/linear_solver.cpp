@@ -39,6 +39,12 @@ void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatri
   });
 }
 
+SparseMatrix general_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K) {
+  SparseMatrix S = b == 0.0 ? SparseMatrix(a * M) : SparseMatrix(a * M + b * K);
+  S.makeCompressed();
+  return S;
+}
+
 bool summable(const SparseMatrix& M, const SparseMatrix& K) {
   return M.isCompressed() && K.isCompressed() && M.rows() == K.rows() && M.cols() == K.cols() &&
          M.nonZeros() == K.nonZeros();
@@ -48,8 +54,7 @@ SolveReport LinearSolver::set_matrix_sum(double a, const SparseMatrix& M, double
                                          HierarchyView hierarchy) {
   if (!summable(M, K)) {
     // Off one pattern: Eigen merges the patterns; no key, as the union is not what it vouched for.
-    sum_ = b == 0.0 ? SparseMatrix(a * M) : SparseMatrix(a * M + b * K);
-    sum_.makeCompressed();
+    sum_ = general_sum(a, M, b, K);
     sum_key_ = 0;
     return set_matrix(sum_, HierarchyView{hierarchy.prolongations, hierarchy.colours, 0});
   }

@@ -67,6 +67,10 @@ inline double sum_entry(double a, double m, double b, double k) { return a * m +
 /// forms its system matrix when the basis assembles M and K on one pattern.
 void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatrix& K, SparseMatrix& S);
 
+/// a M + b K for any two patterns (Eigen's sum: the union of the patterns; a M alone when b is 0),
+/// compressed.
+SparseMatrix general_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K);
+
 /// Whether M and K may be summed on one pattern as far as O(1) checks tell (compressed, same
 /// size and number of nonzeros); same_pattern() is the full comparison, which a caller that owns
 /// a fixed pattern makes once.

@@ -124,6 +124,17 @@ MCF_KERNEL_INLINE void gs_row(const Csc& A, const int* diag_pos, const double* i
   store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
 }
 
+/// r = b - A x (rows [begin, end)), columns o..o+3.
+MCF_KERNEL_INLINE void residual_rows(const Csc& A, const double* b, const double* x, double* r, std::size_t s,
+                                     int o, int begin, int end) {
+  for (int i = begin; i < end; ++i) {
+    const std::size_t ii = std::size_t(i) * s + o;
+    v4 acc0 = load4(b + ii), acc1 = splat(0.0);
+    gather_sub(A, x, s, o, A.outer[i], A.outer[i + 1], acc0, acc1);
+    store4(r + ii, acc0 + acc1);
+  }
+}
+
 /// y = Mᵀ v (or y += Mᵀ v when Add) on output rows [begin, end) = columns of M (gather along
 /// columns, so parallel output ranges never write the same entry), columns o..o+3.
 template <bool Add>
@@ -196,34 +207,6 @@ MCF_KERNEL_INLINE void gs_row_aligned(const Csc& A, const std::int16_t* off, con
   const int dp = diag_pos[i];
   gather_sub_compact(off, A.val, x + ii, s, A.outer[i], dp >= 0 ? dp : A.outer[i + 1], acc0, acc1);
   store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
-}
-
-/// b - A x on row i (= column i), columns o..o+3, the row's terms in the caller's order: on the
-/// finest level, whose columns store their diagonal last, the diagonal term is added where the
-/// caller's column had it (diag_rank[i]-th; -1: none or not moved): the same terms in the same
-/// order into the same accumulators as gather_sub over the caller's column (acc0 the even terms,
-/// acc1 the odd). Bitwise the same with -ffp-contract=off; with the default contraction GCC may
-/// fuse the diagonal's multiply-add differently, a last-bit difference (checked 2026-11-24).
-MCF_KERNEL_INLINE v4 row_residual(const Csc& A, const int* diag_rank, const double* b, const double* x,
-                                  std::size_t s, int o, int i) {
-  const std::size_t ii = std::size_t(i) * s + o;
-  v4 acc0 = load4(b + ii), acc1 = splat(0.0);
-  const int p0 = A.outer[i], p1 = A.outer[i + 1];
-  const int k = diag_rank ? diag_rank[i] : -1;
-  if (k < 0) {
-    gather_sub(A, x, s, o, p0, p1, acc0, acc1);
-    return acc0 + acc1;
-  }
-  // Terms 0..k-1 at p0.., term k (the diagonal) at p1 - 1, terms k+1.. at p0 + k..: the
-  // diagonal's accumulator follows its parity, and the run after it continues the parity.
-  gather_sub(A, x, s, o, p0, p0 + k, acc0, acc1);
-  v4& diag_acc = (k % 2 == 0) ? acc0 : acc1;
-  diag_acc -= splat(A.val[p1 - 1]) * load4(x + ii);
-  if (k % 2 == 0)
-    gather_sub(A, x, s, o, p0 + k, p1 - 1, acc1, acc0);
-  else
-    gather_sub(A, x, s, o, p0 + k, p1 - 1, acc0, acc1);
-  return acc0 + acc1;
 }
 
 // ---- sparse products with a precomputed pattern ------------------------------------------
@@ -370,6 +353,7 @@ bool same_permuted(const SparseMatrix& stored, const SparseMatrix& given, const 
         for (int r = range.begin(); ok && r < range.end(); ++r) {
           const int j = old_index(col_perm, r);
           const int n = G.outer[j + 1] - G.outer[j];
+          const int k = diag_rank.empty() ? -1 : diag_rank[std::size_t(r)];
           if (n != S.outer[r + 1] - S.outer[r]) return false;
           const int* sb = S.inner + S.outer[r];
           const int* se = sb + n;
@@ -378,7 +362,6 @@ bool same_permuted(const SparseMatrix& stored, const SparseMatrix& given, const 
             const int i = new_index(row_inv, G.inner[p]);
             // Unsorted: entry t in place. Sorted: somewhere in the column (rows are distinct and
             // the counts equal, so finding every given entry proves equality).
-            const int k = diag_rank.empty() ? -1 : diag_rank[std::size_t(r)];
             const int slot = k < 0 || t < k ? t : (t == k ? n - 1 : t - 1);
             const int* it = sort ? std::lower_bound(sb, se, i) : sb + slot;
             if (it == se || *it != i || (values && S.val[it - S.inner] != G.val[p])) return false;
@@ -631,7 +614,8 @@ struct MultigridSolver::Impl {
     // The finest matrix keeps each column's entries in the caller's order, except its diagonal,
     // which it stores last (diagonal_last: the smoother then reads a row's off-diagonal entries
     // as one run of the matrix itself). Later value updates are three block copies per column
-    // (set_fine_values), and the residual adds the terms in the caller's order (row_residual).
+    // (set_fine_values); the sweeps add a row's terms in the caller's order, the residual adds
+    // the diagonal's term last.
     Level& F = levels.back();
     F.A = permuted(A, F.inv, F.perm, false);
     F.diag_rank.clear();
@@ -806,12 +790,8 @@ struct MultigridSolver::Impl {
   void residual(int l) {
     Level& L = levels[std::size_t(l)];
     const Csc A(L.A);
-    const int* rank = L.diag_rank.empty() ? nullptr : L.diag_rank.data();
     for (int o = 0; o < int(s); o += 4)
-      for_rows(A.cols, [&](int b, int e) {
-        for (int i = b; i < e; ++i)
-          store4(L.r.data() + std::size_t(i) * s + o, row_residual(A, rank, L.b.data(), L.x.data(), s, o, i));
-      });
+      for_rows(A.cols, [&](int b, int e) { residual_rows(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e); });
   }
 
   void coarse_solve() {
@@ -862,7 +842,6 @@ struct MultigridSolver::Impl {
   double relative_residual(const Eigen::VectorXd& bnorm) {
     Level& L = levels.back();
     const Csc A(L.A);
-    const int* rank = L.diag_rank.empty() ? nullptr : L.diag_rank.data();
     std::vector<double> rn(s, 0.0);
     for (int o = 0; o < int(s); o += 4) {
       struct Acc {
@@ -872,7 +851,9 @@ struct MultigridSolver::Impl {
           tbb::blocked_range<int>(0, A.cols, 4096), Acc{},
           [&](const tbb::blocked_range<int>& r, Acc acc) {
             for (int i = r.begin(); i < r.end(); ++i) {
-              const v4 res = row_residual(A, rank, L.b.data(), L.x.data(), s, o, i);
+              v4 res0 = load4(L.b.data() + std::size_t(i) * s + o), res1 = splat(0.0);
+              gather_sub(A, L.x.data(), s, o, A.outer[i], A.outer[i + 1], res0, res1);
+              const v4 res = res0 + res1;
               acc.v += res * res;
             }
             return acc;

@@ -35,7 +35,8 @@
 // entry by entry in the same walk). The finest level of a hierarchy stores each column's diagonal
 // last, so a sweep reads a row's off-diagonal entries as one run of the matrix itself. Only the
 // order in which a row's terms are added differs from the caller's numbering (the finest level's
-// residual and sweeps add them in the caller's order, coarse levels in internal order);
+// sweeps add them in the caller's order, its residual too but for the diagonal's term, which it
+// adds last; coarse levels add in internal order);
 // level_matrix() converts back. A level whose
 // given colouring is invalid keeps the internal order and is relaxed serially in it.
 //
