@@ -94,6 +94,7 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
     mesh_.vertices = vertices;
   }
   ++build_id_;
+  released_ = false;
   stats_ = BasisStats{};
 
   auto t0 = Clock::now();
@@ -149,6 +150,11 @@ void RebuiltOctreeBasis::release_assembly(SparseMatrix& mass, SparseMatrix& stif
   // swap with empty vectors: clear() alone keeps the capacity (6.5e6 pieces at depth 9: ~600 MB).
   std::vector<ClippedTriangle>().swap(pieces_);
   std::vector<int>().swap(piece_cells_);
+  system_->release_pieces();
+  // The tracked basis keeps the stencils of the input's vertices itself (~40 MB at 416k vertices).
+  std::vector<PointStencil>().swap(stencils_);
+  std::vector<int>().swap(referenced_);
+  released_ = true;
 }
 
 Coefficients RebuiltOctreeBasis::initial_coefficients() const {
@@ -163,6 +169,8 @@ void RebuiltOctreeBasis::update(const Coefficients& x, bool, bool) {
 Positions RebuiltOctreeBasis::evaluate_vertices(const Coefficients& x) const {
   if (x.rows() != dimension())
     throw std::invalid_argument("RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
+  if (released_)
+    throw std::logic_error("RebuiltOctreeBasis::evaluate_vertices: the stencils were released (release_assembly)");
   Positions all = mesh_.vertices;
   if (static_cast<Eigen::Index>(referenced_.size()) == all.rows()) {
     all = evaluate_stencils(stencils_, x);

@@ -72,9 +72,11 @@ class RebuiltOctreeBasis : public Basis {
   /// the assembled mass and stiffness into `mass` and `stiffness`, so their memory (allocated and
   /// touched already) is reused instead of a fresh copy of the pattern — a swap, because Eigen
   /// 3.4's SparseMatrix has no move constructor — and frees the pieces and their cells (the
-  /// tracked basis keeps its own compact copy). Afterwards mass(), stiffness() and pieces() are empty and
-  /// system() can no longer assemble; octree, hierarchy, stencils and stats stay. rebuild() starts
-  /// over from scratch as usual.
+  /// tracked basis keeps its own compact copy), the system's row indices and piece order
+  /// (OctreeSystem::release_pieces) and the vertex stencils (the tracked basis computes those of
+  /// the input's vertices). Afterwards mass(), stiffness() and pieces() are empty, system() can no
+  /// longer assemble or hand out its pattern, and evaluate_vertices() throws std::logic_error;
+  /// octree, hierarchy, locked functions and stats stay. rebuild() starts over from scratch as usual.
   void release_assembly(SparseMatrix& mass, SparseMatrix& stiffness);
 
  private:
@@ -93,6 +95,7 @@ class RebuiltOctreeBasis : public Basis {
   std::vector<int> locked_;
   BasisStats stats_;
   long long build_id_ = 0;
+  bool released_ = false;  ///< release_assembly() since the last rebuild()
   mutable Positions last_evaluated_;  ///< refine_input: all working-mesh vertices of the last evaluation
   mutable long long last_evaluated_build_ = -1;
 };

@@ -122,6 +122,7 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
   });
   for (std::size_t J = 0; J < nf; ++J) outer[J + 1] += outer[J];
   inner_.resize(static_cast<std::size_t>(outer[nf]));
+  non_zeros_ = static_cast<Eigen::Index>(inner_.size());
   int* inner = inner_.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t J = r.begin(); J != r.end(); ++J) {
@@ -154,7 +155,17 @@ void set_pattern(SparseMatrix& A, const std::vector<int>& outer, const std::vect
 }
 }  // namespace
 
+void OctreeSystem::release_pieces() {
+  // swap with empty vectors: clear() alone keeps the capacity.
+  std::vector<int>().swap(piece_cell_);
+  std::vector<int>().swap(piece_order_);
+  std::vector<int>().swap(inner_);
+  released_ = true;
+}
+
 SparseMatrix OctreeSystem::pattern() const {
+  if (released_)
+    throw std::logic_error("OctreeSystem::pattern: the row indices were released (RebuiltOctreeBasis::release_assembly)");
   SparseMatrix A;
   set_pattern(A, outer_, inner_);
   return A;
@@ -165,7 +176,7 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
   const GridCube& cube = octree_->cube;
   const double h = cube.cell_size(L.depth), inv_h = 1.0 / h;
   // The pieces are held by reference; the tracked basis frees them once it has its own copy.
-  if (pieces_->size() != piece_cell_.size())
+  if (released_ || pieces_->size() != piece_cell_.size())
     throw std::logic_error("OctreeSystem::assemble: the pieces were released (RebuiltOctreeBasis::release_assembly)");
   set_pattern(mass, outer_, inner_);
   set_pattern(stiffness, outer_, inner_);

@@ -72,10 +72,12 @@ class OctreeSystem {
 
   int level() const { return level_; }
   Eigen::Index dimension() const { return static_cast<Eigen::Index>(outer_.size()) - 1; }
-  Eigen::Index non_zeros() const { return static_cast<Eigen::Index>(inner_.size()); }
-  /// A matrix with this pattern and zero values (compressed, full symmetric storage).
+  Eigen::Index non_zeros() const { return non_zeros_; }
+  /// A matrix with this pattern and zero values (compressed, full symmetric storage). Throws
+  /// std::logic_error after release_pieces().
   SparseMatrix pattern() const;
-  /// Column starts (dimension+1) and row indices of the pattern.
+  /// Column starts (dimension+1) and row indices of the pattern (inner() is empty after
+  /// release_pieces()).
   const std::vector<int>& outer() const { return outer_; }
   const std::vector<int>& inner() const { return inner_; }
   int slot(int cell, int corner_row, int corner_col) const {
@@ -142,6 +144,14 @@ class OctreeSystem {
   }
   const std::vector<int>& piece_cell() const { return piece_cell_; }
 
+  /// For the tracked basis, once it holds its own compact copy of the pieces and the matrices
+  /// with this pattern: frees what only assemble() and pattern() read — the pieces' cells and
+  /// order and the row indices (at depth 9 ~52 MB and ~94 MB, the latter a third copy of the
+  /// pattern beside M's and K's). outer(), the masks, the tiles, cell_start() and non_zeros()
+  /// stay, so add_cell_blocks() still works; assemble() and pattern() then throw.
+  void release_pieces();
+  bool pieces_released() const { return released_; }
+
   /// Mass and stiffness with the identity metric (the pieces' own geometry), any cubature rule.
   /// M and K get this system's pattern; accumulation is lock-free (tiles(): 8 colour passes,
   /// parallel over the tiles of a pass) and deterministic.
@@ -156,6 +166,8 @@ class OctreeSystem {
   CellTiles tiles_;
   std::vector<std::uint32_t> mask_;
   std::vector<int> outer_, inner_;  // the pattern (no values stored: M and K carry their own)
+  Eigen::Index non_zeros_ = 0;      // inner_.size(), kept when inner_ is released
+  bool released_ = false;
 };
 
 /// Finest-cell index of every piece (binary search, parallel). Throws if a piece's cell is inactive.

@@ -35,9 +35,35 @@ TEST(TrackedOctree, StepZeroEqualsRebuilt) {
     SparseMatrix M, K;
     EXPECT_THROW(tracked.initial().system().assemble(cubature_rule(cubature), M, K), std::logic_error) << cubature;
     EXPECT_EQ(M.rows() + K.rows(), 0) << cubature;  // outputs untouched by the refusal
+    // What only the assembly read is freed too (OctreeSystem::release_pieces): the system's row
+    // indices, its piece order and the initial basis's stencils; the pattern's size stays.
+    const OctreeSystem& system = tracked.initial().system();
+    EXPECT_TRUE(system.pieces_released()) << cubature;
+    EXPECT_TRUE(system.inner().empty() && system.piece_order().empty() && system.piece_cell().empty()) << cubature;
+    EXPECT_EQ(system.non_zeros(), fresh.mass().nonZeros()) << cubature;
+    EXPECT_THROW((void)system.pattern(), std::logic_error) << cubature;
+    EXPECT_THROW((void)tracked.initial().evaluate_vertices(tracked.initial_coefficients()), std::logic_error) << cubature;
     EXPECT_EQ(tracked.evaluate_vertices(tracked.initial_coefficients()).rows(), mesh.num_vertices());
     EXPECT_LT((tracked.evaluate_vertices(tracked.initial_coefficients()) - mesh.vertices).cwiseAbs().maxCoeff(), 1e-12);
   }
+}
+
+// A released rebuilt basis is whole again after rebuild(): same matrices, stencils back.
+TEST(TrackedOctree, RebuildAfterReleaseStartsOver) {
+  const TriangleMesh mesh = test_icosphere(2, 1.0);
+  OctreeOptions o;
+  o.depth = 5;
+  RebuiltOctreeBasis fresh(mesh, o), released(mesh, o);
+  SparseMatrix M, K;
+  released.release_assembly(M, K);
+  EXPECT_EQ(relative_difference(M, fresh.mass()), 0.0);
+  EXPECT_EQ(relative_difference(K, fresh.stiffness()), 0.0);
+  released.rebuild(mesh.vertices);
+  EXPECT_FALSE(released.system().pieces_released());
+  EXPECT_EQ(relative_difference(released.mass(), fresh.mass()), 0.0);
+  EXPECT_EQ(relative_difference(released.stiffness(), fresh.stiffness()), 0.0);
+  EXPECT_EQ(released.evaluate_vertices(released.initial_coefficients()),
+            fresh.evaluate_vertices(fresh.initial_coefficients()));
 }
 
 TEST(TrackedOctree, InitialMetricIsIdentity) {
