@@ -41,17 +41,44 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   cell_start_ = system.cell_start();
   identity_ = initial_->initial_coefficients();
 
-  // Pieces in cell order, corners in their cell's local coordinates (p - cell origin) / h.
-  // One double of padding: the last piece's third corner is read as four doubles.
-  local_corners_.assign(9 * order.size() + 1, 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, L.cells.size(), 256), [&](const auto& r) {
+  // Pieces in cell order, corners in their cell's local coordinates (p - cell origin) / h, stored
+  // as fans (see the header): two passes over the cells, one to find the continuations and count
+  // each cell's points, one to write them.
+  const std::size_t nc = L.cells.size();
+  const auto local_corners = [&](std::size_t c, int s, double q[9]) {
+    const auto ijk = grid_index(L.cells[c]);
+    const ClippedTriangle& t = pieces[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
+    for (int v = 0; v < 3; ++v)
+      for (int a = 0; a < 3; ++a) q[3 * v + a] = (t.corners[v][a] - cube.origin[a]) * inv_h - ijk[a];
+  };
+  continues_.assign(order.size(), 0);
+  point_start_.assign(nc + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 256), [&](const auto& r) {
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      const auto ijk = grid_index(L.cells[c]);
+      double prev[9], q[9];
+      int points = 0;
       for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
-        const ClippedTriangle& t = pieces[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
-        for (int v = 0; v < 3; ++v)
-          for (int a = 0; a < 3; ++a)
-            local_corners_[9 * std::size_t(s) + 3 * v + a] = (t.corners[v][a] - cube.origin[a]) * inv_h - ijk[a];
+        local_corners(c, s, q);
+        const bool fan = s > cell_start_[c] && std::memcmp(q, prev, 3 * sizeof(double)) == 0 &&
+                         std::memcmp(q + 3, prev + 6, 3 * sizeof(double)) == 0;
+        continues_[std::size_t(s)] = fan;
+        points += fan ? 1 : 3;
+        std::memcpy(prev, q, sizeof(q));
+      }
+      point_start_[c + 1] = points;
+    }
+  });
+  for (std::size_t c = 0; c < nc; ++c) point_start_[c + 1] += point_start_[c];
+  // One double of padding: the last corner is read as four doubles.
+  fan_points_.assign(3 * std::size_t(point_start_[nc]) + 1, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 256), [&](const auto& r) {
+    for (std::size_t c = r.begin(); c != r.end(); ++c) {
+      double* out = &fan_points_[3 * std::size_t(point_start_[c])];
+      double q[9];
+      for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
+        local_corners(c, s, q);
+        const int skip = continues_[std::size_t(s)] ? 6 : 0;
+        out = std::copy(q + skip, q + 9, out);
       }
     }
   });
@@ -75,7 +102,12 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
 }
 
 std::size_t TrackedOctreeBasis::preprocessed_bytes() const {
-  return local_corners_.size() * sizeof(double) + cell_start_.size() * sizeof(int);
+  return fan_points_.size() * sizeof(double) + continues_.size() * sizeof(std::uint8_t) +
+         (cell_start_.size() + point_start_.size()) * sizeof(int);
+}
+
+long long TrackedOctreeBasis::fan_continuations() const {
+  return std::count(continues_.begin(), continues_.end(), std::uint8_t(1));
 }
 
 namespace {
@@ -132,12 +164,31 @@ inline void staged_metric(StagedPoints& P, const double (&edge)[3][4][3]) {
   }
 }
 
+/// Walks one cell's pieces through its fans (see the header): p0, p1, p2 point at the current
+/// piece's corners inside the cell's fan points.
+struct FanCursor {
+  const double* next;
+  const double *p0 = nullptr, *p1 = nullptr, *p2 = nullptr;
+  void advance(bool continues) {
+    if (continues) {  // (p0, p_k, p_k+1) after (p0, p_k-1, p_k): one new corner
+      p1 = p2;
+      p2 = next;
+      next += 3;
+    } else {
+      p0 = next;
+      p1 = next + 3;
+      p2 = next + 6;
+      next += 9;
+    }
+  }
+};
+
 /// One cell of SetSystemMatrices at the coefficients xc of its 8 corners: every cubature point of
-/// its pieces (corners in cell-local coordinates) goes into `blocks`. Returns the number of
-/// degenerate points, which contribute nothing.
+/// its pieces (corners in cell-local coordinates, stored as fans: `points`, `continues`) goes into
+/// `blocks`. Returns the number of degenerate points, which contribute nothing.
 template <class Blocks>
-int integrate_cell(const double xc[8][3], const double* corners, int pieces, const CubatureRule& rule, double h,
-                   Blocks& blocks) {
+int integrate_cell(const double xc[8][3], const double* points, const std::uint8_t* continues, int pieces,
+                   const CubatureRule& rule, double h, Blocks& blocks) {
   const double inv_h = 1.0 / h;
   // Edge differences of the trilinear map X(t) = Σ_c xc_c β_c(t) along each axis a, one per
   // cell edge: ∂X/∂t_a at t is their bilinear interpolation in the two other coordinates.
@@ -174,17 +225,18 @@ int integrate_cell(const double xc[8][3], const double* corners, int pieces, con
     P.n = 0;
   };
   const int nq = rule.size();
+  FanCursor fan{points};
   for (int s = 0; s < pieces; ++s) {
-    const double* p = corners + 9 * s;
+    fan.advance(continues[s]);
     // Orthonormal frame (e1, e2) of the piece's plane on X_0 (ComputeDifferential), in cell
     // units; tangent derivatives in world units: ∂/∂e = (e / h) · ∇_t.
     double f1[3], f2[3];
-    const double len = piece_frame(p, p + 3, p + 6, inv_h, f1, f2);
+    const double len = piece_frame(fan.p0, fan.p1, fan.p2, inv_h, f1, f2);
     if (!(len > 0.0)) continue;
     const double area = 0.5 * len * h * h;
     // The corners as vectors (x, y, z, next value), so a point is three vector multiply-adds
     // and a clamp (scalar, the coordinates' arithmetic was ~10% of the update's instructions).
-    const v4 c0 = load4(p), c1 = load4(p + 3), c2 = load4(p + 6);
+    const v4 c0 = load4(fan.p0), c1 = load4(fan.p1), c2 = load4(fan.p2);
     for (int q = 0; q < nq; ++q) {
       if (P.n == StagedPoints::kCapacity) flush();
       const auto& bc = rule.points[std::size_t(q)];
@@ -207,7 +259,8 @@ int integrate_cell(const double xc[8][3], const double* corners, int pieces, con
 /// share no function, so the loop is lock-free and sums in the same order for any thread count.
 template <bool Mass, bool Stiffness>
 long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const Coefficients& x,
-                       const std::vector<double>& local_corners, const std::vector<int>& cell_start,
+                       const std::vector<double>& fan_points, const std::vector<std::uint8_t>& continues,
+                       const std::vector<int>& cell_start, const std::vector<int>& point_start,
                        const CubatureRule& rule, double h, double* Mv, double* Kv) {
   const double* X = x.data();
   const Eigen::Index ld = x.rows();  // column-major n x 3
@@ -222,8 +275,9 @@ long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const C
         for (int d = 0; d < 3; ++d) xc[a][d] = X[d * ld + f[std::size_t(a)]];
       blocks.clear();
       const int first = cell_start[std::size_t(c)];
-      degenerate += integrate_cell(xc, &local_corners[9 * std::size_t(first)], cell_start[std::size_t(c) + 1] - first,
-                                   rule, h, blocks);
+      degenerate += integrate_cell(xc, &fan_points[3 * std::size_t(point_start[std::size_t(c)])],
+                                   &continues[std::size_t(first)], cell_start[std::size_t(c) + 1] - first, rule, h,
+                                   blocks);
       system.add_cell_blocks(c, blocks, Mass ? Mv : nullptr, Stiffness ? Kv : nullptr);
     }
     return degenerate;
@@ -252,12 +306,12 @@ void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool up
   if (update_stiffness) reset(stiffness_);
   double* Mv = update_mass ? mass_.valuePtr() : nullptr;
   double* Kv = update_stiffness ? stiffness_.valuePtr() : nullptr;
-  const auto& corners = local_corners_;
-  const long long degenerate =
-      update_mass && update_stiffness
-          ? update_cells<true, true>(system, L, x, corners, cell_start_, *rule_, h, Mv, Kv)
-      : update_mass ? update_cells<true, false>(system, L, x, corners, cell_start_, *rule_, h, Mv, Kv)
-                    : update_cells<false, true>(system, L, x, corners, cell_start_, *rule_, h, Mv, Kv);
+  const auto run = [&](auto kernel) {
+    return kernel(system, L, x, fan_points_, continues_, cell_start_, point_start_, *rule_, h, Mv, Kv);
+  };
+  const long long degenerate = update_mass && update_stiffness ? run(update_cells<true, true>)
+                               : update_mass                   ? run(update_cells<true, false>)
+                                                               : run(update_cells<false, true>);
   degenerate_points_ = degenerate;
 }
 
@@ -268,8 +322,9 @@ double TrackedOctreeBasis::max_metric_deviation(const Coefficients& x) const {
   double worst = 0;
   for (std::size_t c = 0; c < L.cells.size(); ++c) {
     const auto& f = L.cell_functions[c];
-    for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
-      const double* p = &local_corners_[9 * std::size_t(s)];
+    const std::vector<double> corners = cell_local_corners(int(c));
+    for (int s = 0; s < cell_start_[c + 1] - cell_start_[c]; ++s) {
+      const double* p = &corners[9 * std::size_t(s)];
       const Eigen::Vector3d p0(p[0], p[1], p[2]), p1(p[3], p[4], p[5]), p2(p[6], p[7], p[8]);
       const Eigen::Vector3d e1 = (p1 - p0).normalized();
       const Eigen::Vector3d e2 = (p1 - p0).cross(p2 - p0).normalized().cross(e1);
@@ -289,6 +344,17 @@ double TrackedOctreeBasis::max_metric_deviation(const Coefficients& x) const {
     }
   }
   return worst;
+}
+
+std::vector<double> TrackedOctreeBasis::cell_local_corners(int c) const {
+  const auto cell = static_cast<std::size_t>(c);
+  std::vector<double> out;
+  FanCursor fan{&fan_points_[3 * std::size_t(point_start_[cell])]};
+  for (int s = cell_start_[cell]; s < cell_start_[cell + 1]; ++s) {
+    fan.advance(continues_[std::size_t(s)]);
+    for (const double* p : {fan.p0, fan.p1, fan.p2}) out.insert(out.end(), p, p + 3);
+  }
+  return out;
 }
 
 Positions TrackedOctreeBasis::evaluate_vertices(const Coefficients& x) const {
