@@ -14,7 +14,8 @@
 // that order, so the corners are stored as fans: a piece that continues the previous one's fan
 // (the same p0, its p1 the previous p2, bitwise) stores only its new corner (3 doubles instead of
 // 9) and a flag. The corners read are the very same doubles, so M and K are bitwise those of
-// storing 9 per piece; at depth 9 the armadillo needs ~40% fewer bytes.
+// storing 9 per piece; at depth 9 the armadillo needs 28% fewer bytes (17.4 per cubature point
+// instead of 24.1: 45% of its pieces continue a fan).
 
 #include "bases/octree_basis.h"
 
