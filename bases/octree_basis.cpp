@@ -94,7 +94,6 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
     mesh_.vertices = vertices;
   }
   ++build_id_;
-  released_ = false;
   stats_ = BasisStats{};
 
   auto t0 = Clock::now();
@@ -154,7 +153,6 @@ void RebuiltOctreeBasis::release_assembly(SparseMatrix& mass, SparseMatrix& stif
   // The tracked basis keeps the stencils of the input's vertices itself (~40 MB at 416k vertices).
   std::vector<PointStencil>().swap(stencils_);
   std::vector<int>().swap(referenced_);
-  released_ = true;
 }
 
 Coefficients RebuiltOctreeBasis::initial_coefficients() const {
@@ -169,7 +167,7 @@ void RebuiltOctreeBasis::update(const Coefficients& x, bool, bool) {
 Positions RebuiltOctreeBasis::evaluate_vertices(const Coefficients& x) const {
   if (x.rows() != dimension())
     throw std::invalid_argument("RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
-  if (released_)
+  if (system_->pieces_released())
     throw std::logic_error("RebuiltOctreeBasis::evaluate_vertices: the stencils were released (release_assembly)");
   Positions all = mesh_.vertices;
   if (static_cast<Eigen::Index>(referenced_.size()) == all.rows()) {

@@ -95,7 +95,6 @@ class RebuiltOctreeBasis : public Basis {
   std::vector<int> locked_;
   BasisStats stats_;
   long long build_id_ = 0;
-  bool released_ = false;  ///< release_assembly() since the last rebuild()
   mutable Positions last_evaluated_;  ///< refine_input: all working-mesh vertices of the last evaluation
   mutable long long last_evaluated_build_ = -1;
 };

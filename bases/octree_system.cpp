@@ -176,7 +176,7 @@ void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, Sparse
   const GridCube& cube = octree_->cube;
   const double h = cube.cell_size(L.depth), inv_h = 1.0 / h;
   // The pieces are held by reference; the tracked basis frees them once it has its own copy.
-  if (released_ || pieces_->size() != piece_cell_.size())
+  if (released_)
     throw std::logic_error("OctreeSystem::assemble: the pieces were released (RebuiltOctreeBasis::release_assembly)");
   set_pattern(mass, outer_, inner_);
   set_pattern(stiffness, outer_, inner_);

@@ -164,12 +164,11 @@ MCF_KERNEL_INLINE void transpose_rows(const Csc& M, const double* v, double* y, 
 ///   the finest residual, which is exact, so the cycle still converges to the solution of A x = b.
 /// Unused when some column lies farther than 16 bits from its row (the sweeps then read the CSC).
 struct SmootherRows {
-  bool in_use = false;
   bool aligned = false;                 // finest level: offset[p] belongs to CSC entry p
   std::vector<int> start;               // coarse levels: row i's entries [start[i], start[i+1])
   std::vector<std::int16_t> offset;     // column - row
   std::vector<float> single;            // coarse levels' values
-  bool empty() const { return !in_use; }
+  bool empty() const { return !aligned && start.empty(); }
 };
 
 /// acc0/acc1 -= Σ_p val[p] x[i + offset[p]] over the compact entries [begin, end).
@@ -532,7 +531,7 @@ struct MultigridSolver::Impl {
           offset[std::size_t(p)] = std::int16_t(d);
         }
       S.offset = std::move(offset);
-      S.aligned = S.in_use = true;
+      S.aligned = true;
       return;
     }
     std::vector<int> start(std::size_t(L.n()) + 1, 0);
@@ -553,7 +552,6 @@ struct MultigridSolver::Impl {
     S.start = std::move(start);
     S.offset = std::move(offset);
     S.single.assign(S.offset.size(), 0.0f);
-    S.in_use = true;
   }
 
   /// A coarse level's compact values from its matrix (same order, diagonal skipped, rounded to

@@ -23,8 +23,9 @@
 // Smoother matrix: the sweeps read each level's off-diagonal entries with 16-bit column offsets,
 // in single precision on coarse levels (6 bytes an entry instead of 12) and in double precision on
 // the finest (10 bytes; the values are the finest matrix's own, so the largest matrix is stored
-// once): the sweeps stream the matrix ten times per level visit and are bound by its bytes. Coarse-level sweeps only shape a correction of the finest level's residual, which
-// the residual, the transfers and the coarse operators keep exact, so the cycle converges to the
+// once): the sweeps stream the matrix ten times per level visit and are bound by its bytes.
+// Coarse-level sweeps only shape a correction of the finest level's residual, which the
+// residual, the transfers and the coarse operators keep exact, so the cycle converges to the
 // solution of A x = b; a rounded finest-level matrix would not (multigrid.cpp, SmootherRows).
 // A level whose couplings lie farther apart than 16 bits reach keeps CSC sweeps.
 //
@@ -36,8 +37,7 @@
 // last, so a sweep reads a row's off-diagonal entries as one run of the matrix itself. Only the
 // order in which a row's terms are added differs from the caller's numbering (the finest level's
 // sweeps add them in the caller's order, its residual too but for the diagonal's term, which it
-// adds last; coarse levels add in internal order);
-// level_matrix() converts back. A level whose
+// adds last; coarse levels add in internal order); level_matrix() converts back. A level whose
 // given colouring is invalid keeps the internal order and is relaxed serially in it.
 //
 // Layout and cost: right-hand sides are interleaved (row-major n x k, the row padded to a multiple
