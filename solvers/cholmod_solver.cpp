@@ -175,7 +175,7 @@ SolveReport CholmodSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hie
   return r;
 }
 
-SolveReport CholmodSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
+SolveReport CholmodSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
   if (!factor_ok_) return make_report(last_status_, last_message_);
   const Long n = rows_;
   const Long k = B.cols();
@@ -183,17 +183,17 @@ SolveReport CholmodSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
   SolveReport report;
   report.iterations = 1;
   if (k == 0) {
-    X.resize(n, 0);
     report.residuals = {0.0};
     return report;
   }
 
-  // Wrap B without copying; CHOLMOD only reads it.
+  // Wrap B without copying (its leading dimension is its column stride); CHOLMOD only reads it.
+  const Long ldb = B.outerStride();
   cholmod_dense b{};
   b.nrow = static_cast<size_t>(n);
   b.ncol = static_cast<size_t>(k);
-  b.nzmax = static_cast<size_t>(n * k);
-  b.d = static_cast<size_t>(n);
+  b.nzmax = static_cast<size_t>(ldb * k);  // nominal (CHOLMOD checks d * ncol); it reads nrow a column
+  b.d = static_cast<size_t>(ldb);
   b.x = const_cast<double*>(B.data());
   b.z = nullptr;
   b.xtype = CHOLMOD_REAL;
@@ -205,18 +205,16 @@ SolveReport CholmodSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
     return make_report(SolveStatus::failed,
                        "cholmod_solve failed (status " + std::to_string(common_.status) + ")");
 
-  X.resize(n, k);
   const auto* xs = static_cast<const double*>(x_->x);
   for (Long c = 0; c < k; ++c)
-    std::copy(xs + c * static_cast<Long>(x_->d), xs + c * static_cast<Long>(x_->d) + n,
-              X.data() + c * n);
+    std::copy(xs + c * static_cast<Long>(x_->d), xs + c * static_cast<Long>(x_->d) + n, X.col(c).data());
 
   // True residual r = b - A x through the cached lower triangle (sdmult honours stype, so no
   // copy of the full A is kept).
   if (!cholmod_l_ensure_dense(&r_, n, k, n, CHOLMOD_REAL, &common_))
     return make_report(SolveStatus::failed, "cholmod_ensure_dense failed");
   auto* rs = static_cast<double*>(r_->x);
-  std::copy(B.data(), B.data() + n * k, rs);
+  for (Long c = 0; c < k; ++c) std::copy(B.col(c).data(), B.col(c).data() + n, rs + c * n);
   double minus_one[2] = {-1.0, 0.0};
   double one[2] = {1.0, 0.0};
   cholmod_l_sdmult(lower_, 0, minus_one, one, x_, r_, &common_);

@@ -29,10 +29,6 @@ class CholmodSolver final : public LinearSolver {
   /// factorization meets a non-positive pivot (no abort, no output).
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
 
-  /// Solves all columns of B in one cholmod_solve call; X's input is ignored. Reports
-  /// iterations = 1 and the true relative residual max_c ||b_c - A x_c|| / ||b_c||.
-  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
-
   /// Number of symbolic analyses done so far (tests check that refactorization reuses it).
   int analyses() const { return analyses_; }
   /// Number of numeric factorizations done so far.
@@ -46,6 +42,11 @@ class CholmodSolver final : public LinearSolver {
 
   /// "CHOLMOD x.y.z" of the headers compiled against, for result.json "libraries".
   static std::string version();
+
+ protected:
+  /// Solves all columns of B in one cholmod_solve call; X's input is ignored. Reports
+  /// iterations = 1 and the true relative residual max_c ||b_c - A x_c|| / ||b_c||.
+  SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override;
 
  private:
   void free_all();

@@ -33,7 +33,7 @@ SolveReport DenseLltSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hi
   return rep;
 }
 
-SolveReport DenseLltSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
+SolveReport DenseLltSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
   SolveReport rep;
   if (status_ != SolveStatus::converged) {
     rep.status = status_;

@@ -20,7 +20,8 @@ class DenseLltSolver final : public LinearSolver {
   explicit DenseLltSolver(Eigen::Index max_dimension = 5000) : max_dimension_(max_dimension) {}
   std::string name() const override { return "dense-llt"; }
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
-  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
+ protected:
+  SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override;
 
  private:
   Eigen::Index max_dimension_;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <string>
 
 namespace mcf {
 
@@ -66,6 +67,23 @@ SolveReport LinearSolver::set_matrix_sum(double a, const SparseMatrix& M, double
   sum_key_ = key;
   sum_on_pattern(a, M, b, K, sum_);
   return set_matrix(sum_, hierarchy);
+}
+
+SolveReport LinearSolver::solve(const ConstMatrixRef& B, MatrixRef X) {
+  if (X.rows() != B.rows() || X.cols() != B.cols()) {
+    SolveReport report;
+    report.status = SolveStatus::failed;
+    report.message = "warm start has " + std::to_string(X.rows()) + " x " + std::to_string(X.cols()) +
+                     " entries, the right-hand side " + std::to_string(B.rows()) + " x " +
+                     std::to_string(B.cols());
+    return report;
+  }
+  return solve_in_place(B, X);
+}
+
+SolveReport LinearSolver::solve(const ConstMatrixRef& B, Eigen::MatrixXd& X) {
+  if (X.rows() != B.rows() || X.cols() != B.cols()) X.setZero(B.rows(), B.cols());
+  return solve_in_place(B, MatrixRef(X));
 }
 
 }  // namespace mcf

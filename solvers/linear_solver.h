@@ -76,6 +76,11 @@ SparseMatrix general_sum(double a, const SparseMatrix& M, double b, const Sparse
 /// a fixed pattern makes once.
 bool summable(const SparseMatrix& M, const SparseMatrix& K);
 
+/// Dense blocks of right-hand sides and solutions, n x k, column-major (Eigen::Ref: any column
+/// stride, so a block of a larger matrix binds as well).
+using ConstMatrixRef = Eigen::Ref<const Eigen::MatrixXd>;
+using MatrixRef = Eigen::Ref<Eigen::MatrixXd>;
+
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
@@ -96,8 +101,16 @@ class LinearSolver {
                                      HierarchyView hierarchy = {});
 
   /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers
-  /// use it; direct solvers ignore it) and the solution on exit.
-  virtual SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
+  /// use it; direct solvers ignore it) and the solution on exit. Any column-major matrix binds
+  /// to B and X without a copy (the flows' n x 3 Coefficients too: at depth 9 each copy was
+  /// 31 MB); X must have B's shape, else the report is `failed` and X is left alone.
+  SolveReport solve(const ConstMatrixRef& B, MatrixRef X);
+  /// The same for a resizable X: one of another shape than B's is first set to zero.
+  SolveReport solve(const ConstMatrixRef& B, Eigen::MatrixXd& X);
+
+ protected:
+  /// What every solver implements: solve() with X already of B's shape.
+  virtual SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) = 0;
 
  private:
   SparseMatrix sum_;              // the default set_matrix_sum's a M + b K

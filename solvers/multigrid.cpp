@@ -873,7 +873,7 @@ struct MultigridSolver::Impl {
   }
 
   /// Caller's n x k matrix -> a level's interleaved buffer in its internal numbering, and back.
-  void load(const Level& L, Buffer& dst, const Eigen::MatrixXd& src) {
+  void load(const Level& L, Buffer& dst, const ConstMatrixRef& src) {
     for_rows(int(src.rows()), [&](int b, int e) {
       for (int r = b; r < e; ++r) {
         const int i = old_index(L.perm, r);
@@ -881,7 +881,7 @@ struct MultigridSolver::Impl {
       }
     });
   }
-  void store(const Level& L, const Buffer& src, Eigen::MatrixXd& dst) {
+  void store(const Level& L, const Buffer& src, MatrixRef dst) {
     for_rows(int(dst.rows()), [&](int b, int e) {
       for (int r = b; r < e; ++r) {
         const int i = old_index(L.perm, r);
@@ -1019,7 +1019,7 @@ SolveReport MultigridSolver::set_levels(const SparseMatrix& A_in, double a, doub
   return rep;
 }
 
-SolveReport MultigridSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) {
+SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
   SolveReport rep;
   Impl& m = *impl_;
   if (!m.ready) {
@@ -1034,7 +1034,6 @@ SolveReport MultigridSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X)
     return rep;
   }
   const int k = int(B.cols());
-  if (X.rows() != n || X.cols() != k) X.setZero(n, k);
   if (k == 0) return rep;
   m.ensure_buffers(k);
   auto& fine = m.levels.back();

@@ -111,10 +111,6 @@ class MultigridSolver : public LinearSolver {
   SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
                              HierarchyView hierarchy = {}) override;
 
-  /// Runs cycles from the warm start X (resized to zero if its shape does not match B).
-  /// residuals[c] = max over columns of ||B - A X|| / ||B|| after cycle c.
-  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
-
   /// z = one cycle applied to r from z = 0 (a symmetric operator when pre_smooth ==
   /// post_smooth); meant as a preconditioner for PCG. z is resized as needed.
   void precondition(const Eigen::MatrixXd& r, Eigen::MatrixXd& z);
@@ -151,6 +147,11 @@ class MultigridSolver : public LinearSolver {
   /// relaxation_order(l, reverse) lists (header, "Smoother ordering"). X is updated in place.
   void gauss_seidel(int l, const Eigen::MatrixXd& B, Eigen::MatrixXd& X, int sweeps,
                     bool reverse = false);
+
+ protected:
+  /// Runs cycles from the warm start X (solve(): zero if a resizable X has another shape).
+  /// residuals[c] = max over columns of ||B - A X|| / ||B|| after cycle c.
+  SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override;
 
  private:
   struct Impl;

@@ -15,7 +15,8 @@ class MultigridPcgSolver final : public LinearSolver {
   /// Both halves take M and K (each keeps its one copy of the sum).
   SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
                              HierarchyView hierarchy = {}) override;
-  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override { return pcg_.solve(B, X); }
+ protected:
+  SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override { return pcg_.solve(B, X); }
 
  private:
   MultigridSolver multigrid_;

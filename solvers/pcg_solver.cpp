@@ -51,7 +51,7 @@ void combine(const std::vector<double>& partials, Index k, VectorXd& out) {
 }
 
 /// out[c] = U.col(c) . V.col(c), deterministic for any thread count.
-void column_dots(const MatrixXd& U, const MatrixXd& V, VectorXd& out) {
+void column_dots(const ConstMatrixRef& U, const ConstMatrixRef& V, VectorXd& out) {
   const Index n = U.rows(), k = U.cols();
   const Index chunks = (n + kChunk - 1) / kChunk;
   std::vector<double> partials(static_cast<std::size_t>(chunks * k), 0.0);
@@ -98,7 +98,7 @@ void PcgSolver::set_preconditioner(Preconditioner preconditioner) {
   external_ = std::move(preconditioner);
 }
 
-void PcgSolver::multiply(const MatrixXd& X, MatrixXd& Y) const { symmetric_multiply(A_, X, Y); }
+void PcgSolver::multiply(const ConstMatrixRef& X, MatrixXd& Y) const { symmetric_multiply(A_, X, Y); }
 
 SolveReport PcgSolver::build_preconditioner() {
   SolveReport rep;
@@ -235,7 +235,7 @@ void PcgSolver::apply_preconditioner(const MatrixXd& r, MatrixXd& z) const {
   }
 }
 
-SolveReport PcgSolver::solve(const MatrixXd& B, MatrixXd& X) {
+SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
   SolveReport rep;
   if (!have_matrix_ || matrix_status_ != SolveStatus::converged) {
     rep.status = matrix_status_;
@@ -253,7 +253,6 @@ SolveReport PcgSolver::solve(const MatrixXd& B, MatrixXd& X) {
     rep.message = "external preconditioner selected but none set";
     return rep;
   }
-  if (X.rows() != n || X.cols() != k) X.setZero(n, k);
   const double tol = options_.relative_tolerance;
 
   VectorXd bnorm;

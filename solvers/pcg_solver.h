@@ -56,13 +56,14 @@ class PcgSolver final : public LinearSolver {
   SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
                              HierarchyView hierarchy = {}) override;
 
-  /// Block PCG from the warm start X (resized to zero if its shape does not match B).
+  /// Y = A X with the deterministic parallel row SpMV (exposed for tests and other solvers).
+  void multiply(const ConstMatrixRef& X, Eigen::MatrixXd& Y) const;
+
+ protected:
+  /// Block PCG from the warm start X (solve(): zero if a resizable X has another shape).
   /// residuals[i] = max relative residual over columns after iteration i+1; the last entry
   /// and relative_residual are the true residual recomputed at exit.
-  SolveReport solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override;
-
-  /// Y = A X with the deterministic parallel row SpMV (exposed for tests and other solvers).
-  void multiply(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const;
+  SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override;
 
  private:
   SolveReport build_preconditioner();

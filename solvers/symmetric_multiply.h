@@ -20,13 +20,19 @@ namespace mcf {
 /// gives Aᵀ X.
 void symmetric_multiply(const SparseMatrix& A, const double* X, Eigen::Index k, double* Y);
 
-/// Y = A X for column-major dense Eigen matrices (MatrixXd, the flows' n x 3 coefficients).
+/// Y = A X for column-major dense Eigen matrices (MatrixXd, the flows' n x 3 coefficients, an
+/// Eigen::Ref); Y must be resizable.
 template <class In, class Out>
 void symmetric_multiply(const SparseMatrix& A, const In& X, Out& Y) {
   static_assert(!In::IsRowMajor && !Out::IsRowMajor, "symmetric_multiply: column-major dense matrices only");
   if (X.rows() != A.cols()) throw std::invalid_argument("symmetric_multiply: sizes do not match");
   Y.resize(A.rows(), X.cols());
-  symmetric_multiply(A, X.data(), X.cols(), Y.data());
+  if (X.outerStride() == X.rows()) {
+    symmetric_multiply(A, X.data(), X.cols(), Y.data());
+  } else {  // columns apart (a block of a larger matrix): the kernel reads one leading dimension
+    const Eigen::MatrixXd contiguous = X;
+    symmetric_multiply(A, contiguous.data(), contiguous.cols(), Y.data());
+  }
 }
 
 template <class Dense>

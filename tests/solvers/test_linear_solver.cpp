@@ -87,7 +87,7 @@ class RecordingSolver : public mcf::LinearSolver {
     ++calls;
     return {};
   }
-  mcf::SolveReport solve(const Eigen::MatrixXd&, Eigen::MatrixXd&) override { return {}; }
+  mcf::SolveReport solve_in_place(const mcf::ConstMatrixRef&, mcf::MatrixRef) override { return {}; }
   SparseMatrix given;
   std::uint64_t key = 0;
   int calls = 0;

@@ -4,7 +4,10 @@
 // (a spherical shell, as an octree around a surface would; or random), so P loses rows/columns.
 
 #include "solvers/multigrid.h"
+#include "solvers/cholmod_solver.h"
+#include "solvers/dense_reference.h"
 #include "solvers/multigrid_pcg.h"
+#include "solvers/pcg_solver.h"
 
 #include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
@@ -15,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -832,6 +836,71 @@ TEST(Multigrid, ReportsNotPositiveDefiniteAndFailures) {
   Bn(3, 0) = std::nan("");
   X.resize(0, 0);
   EXPECT_EQ(mg.solve(Bn, X).status, SolveStatus::numerical_issue);
+}
+
+// LinearSolver::solve binds any column-major block without a copy (solvers/linear_solver.h).
+// Every solver gives bitwise the same X for an n x 3 matrix with a fixed column count (the
+// flows' Coefficients) and for a block of larger matrices (a column stride other than n) as for
+// a plain MatrixXd, and leaves the entries around the block alone. A block of another shape than
+// B's fails and is left as it was; a MatrixXd of another shape starts from zero.
+TEST(LinearSolverInterface, AnyColumnMajorBlockSolvesInPlaceBitwise) {
+  const Problem pr = make_problem(4, 1, 0.05, Drop::shell);
+  const Eigen::Index n = pr.A.rows();
+  const Eigen::MatrixXd B = random_matrix(n, 3, 21);
+  const Eigen::MatrixXd warm = 0.1 * random_matrix(n, 3, 22);
+  MultigridOptions cycle;
+  cycle.cycle = MultigridCycle::W;
+  cycle.cycles = 2;
+  cycle.tolerance = 0.0;
+  mcf::PcgOptions pcg;
+  pcg.max_iterations = 6;
+  pcg.relative_tolerance = 1e-14;
+  std::vector<std::unique_ptr<mcf::LinearSolver>> solvers;
+  solvers.push_back(std::make_unique<MultigridSolver>(cycle));
+  solvers.push_back(std::make_unique<mcf::PcgSolver>(pcg));
+  solvers.push_back(std::make_unique<mcf::MultigridPcgSolver>(cycle, pcg));
+  solvers.push_back(std::make_unique<mcf::CholmodSolver>());
+  solvers.push_back(std::make_unique<mcf::DenseLltSolver>());
+  const auto bitwise = [](const auto& X, const auto& Y) {
+    return X.rows() == Y.rows() && X.cols() == Y.cols() && (X.array() == Y.array()).all();
+  };
+  for (auto& solver : solvers) {
+    SCOPED_TRACE(solver->name());
+    ASSERT_TRUE(solver->set_matrix(pr.A, pr.view()).ok());
+    Eigen::MatrixXd X = warm;
+    const mcf::SolveReport plain = solver->solve(B, X);
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    ASSERT_FALSE(bitwise(X, warm));  // it solved something
+
+    Eigen::Matrix<double, Eigen::Dynamic, 3> Bc = B, Xc = warm;
+    const mcf::SolveReport fixed = solver->solve(Bc, Xc);
+    EXPECT_TRUE(fixed.ok());
+    EXPECT_TRUE(bitwise(Xc, X));
+    EXPECT_EQ(fixed.relative_residual, plain.relative_residual);
+
+    // Rows 2..n+1 and columns 1..3 of (n + 5) x 5 matrices: the column stride is n + 5.
+    Eigen::MatrixXd Bw = Eigen::MatrixXd::Constant(n + 5, 5, 7.0), Xw = Eigen::MatrixXd::Constant(n + 5, 5, -3.0);
+    Bw.block(2, 1, n, 3) = B;
+    Xw.block(2, 1, n, 3) = warm;
+    const mcf::SolveReport strided = solver->solve(Bw.block(2, 1, n, 3), Xw.block(2, 1, n, 3));
+    EXPECT_TRUE(strided.ok());
+    EXPECT_TRUE(bitwise(Eigen::MatrixXd(Xw.block(2, 1, n, 3)), X));
+    EXPECT_EQ(strided.relative_residual, plain.relative_residual);
+    Eigen::MatrixXd around = Xw;
+    around.block(2, 1, n, 3).setConstant(-3.0);
+    EXPECT_TRUE((around.array() == -3.0).all());
+
+    // Another shape: a block fails untouched; a resizable matrix is zeroed, then solved.
+    Eigen::Matrix<double, Eigen::Dynamic, 3> short_block = Eigen::Matrix<double, Eigen::Dynamic, 3>::Constant(n - 1, 3, 5.0);
+    const mcf::SolveReport refused = solver->solve(B, short_block);
+    EXPECT_EQ(refused.status, SolveStatus::failed);
+    EXPECT_NE(refused.message.find("warm start"), std::string::npos) << refused.message;
+    EXPECT_TRUE((short_block.array() == 5.0).all());
+    Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(n, 3), resized(n - 1, 2);
+    ASSERT_TRUE(solver->solve(B, zero).ok());
+    ASSERT_TRUE(solver->solve(B, resized).ok());
+    EXPECT_TRUE(bitwise(resized, zero));
+  }
 }
 
 }  // namespace
