@@ -39,7 +39,6 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   const auto& pieces = initial_->pieces();
   const auto& order = system.piece_order();
   cell_start_ = system.cell_start();
-  identity_ = initial_->initial_coefficients();
 
   // Pieces in cell order, corners in their cell's local coordinates (p - cell origin) / h, stored
   // as fans (see the header): two passes over the cells, one to find the continuations and count
@@ -91,7 +90,7 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   const double preprocess = seconds_since(t0);
 
   const auto t1 = Clock::now();
-  update(identity_, true, true);
+  update(initial_coefficients(), true, true);
   const double integrate = seconds_since(t1);
 
   stats_ = initial_->stats();
