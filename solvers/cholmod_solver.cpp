@@ -192,7 +192,7 @@ SolveReport CholmodSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) 
   cholmod_dense b{};
   b.nrow = static_cast<size_t>(n);
   b.ncol = static_cast<size_t>(k);
-  b.nzmax = static_cast<size_t>(ldb * k);  // nominal (CHOLMOD checks d * ncol); it reads nrow a column
+  b.nzmax = static_cast<size_t>(ldb * k);  // as if allocated d x ncol; CHOLMOD reads nrow a column
   b.d = static_cast<size_t>(ldb);
   b.x = const_cast<double*>(B.data());
   b.z = nullptr;
