@@ -267,9 +267,11 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
                                 {"radius_semi_implicit", sphere->discrete},
                                 {"radius_continuous", sphere->continuous(t)}};
     }
-    x_prev = std::move(x);
-    x = std::move(x_new);
-    has_prev = true;
+    if (integrator->uses_previous()) {
+      x_prev = std::move(x);
+      has_prev = true;
+    }
+    x = std::move(x_new);  // for a one-step scheme this frees X_{n-1}
     V = std::move(V_new);
     record["seconds"] = {{"update", ctx.update_seconds_},
                          {"solve", ctx.solve_seconds_},

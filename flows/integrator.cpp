@@ -38,6 +38,7 @@ class TwoStep : public Integrator {
     if (!c.previous()) return SemiImplicitEuler().step(c);
     return two_step(c, c.current(), *c.previous());
   }
+  bool uses_previous() const override { return true; }
 
  protected:
   virtual Coefficients two_step(StepContext& c, const Coefficients& x, const Coefficients& x_prev) = 0;

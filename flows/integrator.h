@@ -15,6 +15,8 @@ class Integrator {
   virtual std::string name() const = 0;
   /// Returns X_{n+1}. Leaves the operators as evaluated for this step.
   virtual Coefficients step(StepContext& ctx) = 0;
+  /// Whether step() reads X_{n-1} (ctx.previous()): the flow keeps it only then (31 MB at depth 9).
+  virtual bool uses_previous() const { return false; }
 };
 
 /// explicit-euler, semi-implicit, crank-nicolson, bdf2, taylor2, neumann2.
