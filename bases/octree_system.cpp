@@ -122,7 +122,6 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
   });
   for (std::size_t J = 0; J < nf; ++J) outer[J + 1] += outer[J];
   inner_.resize(static_cast<std::size_t>(outer[nf]));
-  non_zeros_ = static_cast<Eigen::Index>(inner_.size());
   int* inner = inner_.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t J = r.begin(); J != r.end(); ++J) {

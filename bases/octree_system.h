@@ -72,7 +72,8 @@ class OctreeSystem {
 
   int level() const { return level_; }
   Eigen::Index dimension() const { return static_cast<Eigen::Index>(outer_.size()) - 1; }
-  Eigen::Index non_zeros() const { return non_zeros_; }
+  /// From the column starts, so it stays after release_pieces().
+  Eigen::Index non_zeros() const { return outer_.empty() ? 0 : outer_.back(); }
   /// A matrix with this pattern and zero values (compressed, full symmetric storage). Throws
   /// std::logic_error after release_pieces().
   SparseMatrix pattern() const;
@@ -166,7 +167,6 @@ class OctreeSystem {
   CellTiles tiles_;
   std::vector<std::uint32_t> mask_;
   std::vector<int> outer_, inner_;  // the pattern (no values stored: M and K carry their own)
-  Eigen::Index non_zeros_ = 0;      // inner_.size(), kept when inner_ is released
   bool released_ = false;
 };
 
