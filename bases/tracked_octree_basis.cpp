@@ -38,7 +38,6 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   const OctreeSystem& system = initial_->system();
   const auto& pieces = initial_->pieces();
   const auto& order = system.piece_order();
-  cell_start_ = system.cell_start();
 
   // Pieces in cell order, corners in their cell's local coordinates (p - cell origin) / h, stored
   // as fans (see the header): two passes over the cells, one to find the continuations and count
@@ -56,9 +55,9 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       double prev[9], q[9];
       int points = 0;
-      for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
+      for (int s = cell_start()[c]; s < cell_start()[c + 1]; ++s) {
         local_corners(c, s, q);
-        const bool fan = s > cell_start_[c] && std::memcmp(q, prev, 3 * sizeof(double)) == 0 &&
+        const bool fan = s > cell_start()[c] && std::memcmp(q, prev, 3 * sizeof(double)) == 0 &&
                          std::memcmp(q + 3, prev + 6, 3 * sizeof(double)) == 0;
         continues_[std::size_t(s)] = fan;
         points += fan ? 1 : 3;
@@ -74,7 +73,7 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       double* out = &fan_points_[3 * std::size_t(point_start_[c])];
       double q[9];
-      for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
+      for (int s = cell_start()[c]; s < cell_start()[c + 1]; ++s) {
         local_corners(c, s, q);
         const int skip = continues_[std::size_t(s)] ? 6 : 0;
         out = std::copy(q + skip, q + 9, out);
@@ -102,7 +101,7 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
 
 std::size_t TrackedOctreeBasis::preprocessed_bytes() const {
   return fan_points_.size() * sizeof(double) + continues_.size() * sizeof(std::uint8_t) +
-         (cell_start_.size() + point_start_.size()) * sizeof(int);
+         (cell_start().size() + point_start_.size()) * sizeof(int);
 }
 
 long long TrackedOctreeBasis::fan_continuations() const {
@@ -306,7 +305,7 @@ void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool up
   double* Mv = update_mass ? mass_.valuePtr() : nullptr;
   double* Kv = update_stiffness ? stiffness_.valuePtr() : nullptr;
   const auto run = [&](auto kernel) {
-    return kernel(system, L, x, fan_points_, continues_, cell_start_, point_start_, *rule_, h, Mv, Kv);
+    return kernel(system, L, x, fan_points_, continues_, cell_start(), point_start_, *rule_, h, Mv, Kv);
   };
   const long long degenerate = update_mass && update_stiffness ? run(update_cells<true, true>)
                                : update_mass                   ? run(update_cells<true, false>)
@@ -322,7 +321,7 @@ double TrackedOctreeBasis::max_metric_deviation(const Coefficients& x) const {
   for (std::size_t c = 0; c < L.cells.size(); ++c) {
     const auto& f = L.cell_functions[c];
     const std::vector<double> corners = cell_local_corners(int(c));
-    for (int s = 0; s < cell_start_[c + 1] - cell_start_[c]; ++s) {
+    for (int s = 0; s < cell_start()[c + 1] - cell_start()[c]; ++s) {
       const double* p = &corners[9 * std::size_t(s)];
       const Eigen::Vector3d p0(p[0], p[1], p[2]), p1(p[3], p[4], p[5]), p2(p[6], p[7], p[8]);
       const Eigen::Vector3d e1 = (p1 - p0).normalized();
@@ -349,7 +348,7 @@ std::vector<double> TrackedOctreeBasis::cell_local_corners(int c) const {
   const auto cell = static_cast<std::size_t>(c);
   std::vector<double> out;
   FanCursor fan{&fan_points_[3 * std::size_t(point_start_[cell])]};
-  for (int s = cell_start_[cell]; s < cell_start_[cell + 1]; ++s) {
+  for (int s = cell_start()[cell]; s < cell_start()[cell + 1]; ++s) {
     fan.advance(continues_[std::size_t(s)]);
     for (const double* p : {fan.p0, fan.p1, fan.p2}) out.insert(out.end(), p, p + 3);
   }

@@ -68,11 +68,14 @@ class TrackedOctreeBasis final : public Basis {
   const RebuiltOctreeBasis& initial() const { return *initial_; }
 
  private:
+  /// Pieces of cell c: [cell_start()[c], cell_start()[c+1]), the system's own (it stays after
+  /// release_assembly).
+  const std::vector<int>& cell_start() const { return initial_->system().cell_start(); }
+
   std::unique_ptr<RebuiltOctreeBasis> initial_;  // octree, pieces, pattern, hierarchy on X_0
   const CubatureRule* rule_;
   std::vector<double> fan_points_;     // fans' corners, cells in order, local coords in [0,1]
   std::vector<std::uint8_t> continues_;  // per piece (cell order): 1 = continues the previous fan
-  std::vector<int> cell_start_;        // pieces of cell c: [cell_start_[c], cell_start_[c+1])
   std::vector<int> point_start_;       // cell c's fan points: [point_start_[c], point_start_[c+1]), 3 doubles each
   std::vector<PointStencil> stencils_; // original vertices
   SparseMatrix mass_, stiffness_;
