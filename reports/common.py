@@ -123,11 +123,38 @@ def varying_keys(results, exclude=()):
     return sorted(k for k in keys if k not in exclude)
 
 
+def key_name(key):
+    """A config key as a legend names it: its last component ("octree.depth" -> "depth"), or the
+    one before a last component called "name" ("solver.name" -> "solver")."""
+    parts = key.split(".")
+    return parts[-2] if parts[-1] == "name" and len(parts) > 1 else parts[-1]
+
+
 def label(result, keys):
-    """Legend label: the values of `keys` in the result's assignment, "key=value" joined."""
+    """Legend label: the values of `keys` in the result's assignment, "key=value" joined; a true
+    flag is its key alone and a false one is left out ("tracking=rebuilt, refine_input" beside
+    "tracking=rebuilt"), unless false flags are all there is to tell the variants apart."""
     a = assignment(result)
-    parts = ["%s=%s" % (k.split(".")[-1], short_value(a[k])) for k in keys if k in a]
+    present = [k for k in keys if k in a]
+    parts = [key_name(k) if a[k] is True else "%s=%s" % (key_name(k), short_value(a[k]))
+             for k in present if a[k] is not False]
+    if not parts:
+        parts = ["%s=%s" % (key_name(k), short_value(a[k])) for k in present]
     return ", ".join(parts) if parts else short_value(get(result, "config.mesh", result["_stem"]))
+
+
+def legend_beside(axes):
+    """One legend for the whole figure, right of its panels, each label once. The panels of a
+    figure plot the same variants, and a legend inside a panel hides the curves it names (the
+    papers' log plots leave no empty corner). Returns whether there was anything to name."""
+    handles = {}
+    for ax in axes:
+        for h, text in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(text, h)
+    if handles:  # attached to the last panel, so it sits right beside it at any figure width
+        axes[-1].legend(list(handles.values()), list(handles.keys()), loc="center left",
+                        bbox_to_anchor=(1.02, 0.5))
+    return bool(handles)
 
 
 def group_by(results, keyfunc):

@@ -40,7 +40,7 @@ def make(results, out_dir, reference, written):
     ax.set_xlabel("step")
     ax.set_ylabel("distance to cotangent reference")
     common.log_if_positive(ax, values)
-    ax.legend()
+    common.legend_beside([ax])
     title = "Real model: distance to the cotangent-Laplacian flow (Fig. 6 left)"
     ax.set_title(title, fontsize=9)
     fig.text(0.01, -0.03, common.sources_line(cells), fontsize=6, wrap=True)

@@ -8,7 +8,8 @@ import common
 
 
 def plot_radial_errors(results, out_dir, name, title, reference, written, keys=None):
-    """Two panels (RMS, max) of steps[*].radial_error vs step; one colour per variant.
+    """Two panels (RMS, max) of steps[*].radial_error vs step; one colour per variant, named once
+    in a legend beside the panels.
     Shared with cubature.py (Fig. 8 has the same axes)."""
     cells = common.first_repetition(results)
     keys = keys if keys is not None else common.varying_keys(cells)
@@ -29,8 +30,7 @@ def plot_radial_errors(results, out_dir, name, title, reference, written, keys=N
         ax.set_xlabel("step")
         ax.set_ylabel("%s radial error" % ("RMS" if metric == "rms" else "max"))
         common.log_if_positive(ax, everything)
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend()
+    common.legend_beside(list(axes))
     fig.suptitle(title)
     fig.text(0.01, -0.02, common.sources_line(cells), fontsize=6, wrap=True)
     return common.save_figure(fig, out_dir, name, cells, title, written)

@@ -85,41 +85,91 @@ def fit_slope(points):
     return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
 
 
+# Integrators in the order DESIGN.md lists them: each keeps its colour and marker in every
+# flow's panel, so one integrator reads the same in the mcf and the heat panel.
+INTEGRATORS = ("explicit-euler", "semi-implicit", "crank-nicolson", "bdf2", "taylor2", "neumann2")
+MARKERS = "osD^vP*Xhp<>"
+
+
+def split_variant(name):
+    """(flow, integrator, frozen) of a variant() name."""
+    flow, _, rest = name.partition(": ")
+    frozen = rest.endswith(" (frozen)")
+    return flow, rest[:-len(" (frozen)")] if frozen else rest, frozen
+
+
+def styles(names):
+    """{variant name: (colour, marker, linestyle, marker face)}: colour and marker by integrator
+    (the known ones first, in INTEGRATORS order, then others sorted), dashed with open markers
+    when the operators were frozen. Distinct within a flow for up to 10 integrators."""
+    integrators = sorted({split_variant(n)[1] for n in names},
+                         key=lambda g: (INTEGRATORS.index(g) if g in INTEGRATORS else len(INTEGRATORS), g))
+    out = {}
+    for n in names:
+        _, integ, frozen = split_variant(n)
+        i = integrators.index(integ)
+        color = "C%d" % (i % 10)
+        out[n] = (color, MARKERS[i % len(MARKERS)], "--" if frozen else "-", "none" if frozen else color)
+    return out
+
+
+def order_guides(ax, pts):
+    """Grey dotted lines of slope 1 and 2 through the middle of a panel's points, to read the
+    fitted orders against."""
+    dts = sorted({p[0] for p in pts})
+    errs = sorted(p[1] for p in pts)
+    if len(dts) < 2 or errs[0] <= 0:
+        return
+    x0, y0 = math.sqrt(dts[0] * dts[-1]), math.sqrt(errs[0] * errs[-1])
+    for order, style in ((1, ":"), (2, "-.")):
+        ax.plot([dts[0], dts[-1]], [y0 * (dts[0] / x0) ** order, y0 * (dts[-1] / x0) ** order], style,
+                color="0.6", lw=1, label="δ%s guide" % ("¹" if order == 1 else "²"))
+
+
 def make(results, out_dir, reference, written):
-    """Write time_order.png and time_order.md."""
+    """Write time_order.png (one log-log panel per flow, its legend beside it) and time_order.md."""
     cells = common.first_repetition(results)
     refs = reference_runs(cells)
     # The reference runs themselves are left out of the fits.
     groups = common.group_by([c for c in cells if not any(c is r for r in refs.values())], variant)
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    rows, values = [], []
+    flows = list(dict.fromkeys(split_variant(name)[0] for name in groups)) or ["mcf"]
+    style = styles(list(groups))
+    fig, axes = plt.subplots(len(flows), 1, figsize=(6.5, 3.4 * len(flows)), squeeze=False)
+    axes = {flow: ax for flow, ax in zip(flows, axes[:, 0])}
+    rows, values, panel_pts = [], {f: [] for f in flows}, {f: [] for f in flows}
     reference = reference if isinstance(reference, dict) else {}
     expected = reference.get("orders", {})
     threshold = reference.get("stability_threshold")
-    for i, (name, rs) in enumerate(groups.items()):
+    for name, rs in groups.items():
+        flow = split_variant(name)[0]
         with_dt = [r for r in rs if common.finite(common.get(r, "config.dt"))]
         pts = sorted((common.get(r, "config.dt"), final_error(r, refs)) for r in with_dt if stable(r, threshold, refs))
         slope = fit_slope(pts)
-        color = "C%d" % (i % 10)
         if pts:
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=color, ms=4,
-                    label="%s (slope %s)" % (name, common.fmt(slope, "%.2f")))
-            values += [p[1] for p in pts]
+            color, marker, line, face = style[name]
+            axes[flow].plot([p[0] for p in pts], [p[1] for p in pts], line, color=color, marker=marker, ms=4,
+                            mfc=face, label="%s (slope %s)" % (name.partition(": ")[2], common.fmt(slope, "%.2f")))
+            values[flow] += [p[1] for p in pts]
+            panel_pts[flow] += pts
         stable_dts = [common.get(r, "config.dt") for r in with_dt if stable(r, threshold, refs)]
         unstable = [common.get(r, "config.dt") for r in with_dt if not stable(r, threshold, refs)]
         rows.append([name, common.fmt(slope, "%.2f"), len(pts), common.fmt(max(stable_dts) if stable_dts else None),
                      common.fmt(min(unstable) if unstable else None),
                      str(expected.get(name, expected.get(name.split(": ")[-1],
                                                           expected.get(name.split(": ")[-1].split(" ")[0], "—"))))])
-    ax.set_xscale("log")
-    common.log_if_positive(ax, values)
-    ax.set_xlabel("time step δ")
-    ax.set_ylabel("error at final time")
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend()
+    for flow, ax in axes.items():
+        order_guides(ax, panel_pts[flow])
+        ax.set_xscale("log")
+        common.log_if_positive(ax, values[flow])
+        ax.set_xlabel("time step δ")
+        ax.set_ylabel("error at final time")
+        ax.set_title(flow, fontsize=9)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="center left", bbox_to_anchor=(1.02, 0.5))
     title = "Temporal convergence: error vs δ per integrator"
-    ax.set_title(title, fontsize=9)
-    fig.text(0.01, -0.03, common.sources_line(cells), fontsize=6, wrap=True)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.text(0.01, -0.03 / len(flows), common.sources_line(cells), fontsize=6, wrap=True)
     common.save_figure(fig, out_dir, "time_order", cells, title, written)
     note = "Errors are |mean radius − reference| at the final time, the reference being the smallest-δ " \
         "extrapolated Crank–Nicolson run of the same flow (%s).\n\n" % ", ".join(

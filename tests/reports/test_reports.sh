@@ -58,6 +58,37 @@ for f in "$work"/out/*.png "$work"/out/*.md; do
   b=$(basename "$f"); [ "$b" = index.md ] && continue
   grep -q "$b" "$work/out/index.md" || { echo "FAIL: index.md does not link $b"; fail=1; }
 done
+# Legibility: time_order gives every integrator (and its frozen variant) its own style within a
+# flow's panel and the same colour in every panel; legend labels name "solver.name" as "solver" and
+# a true flag by its key; cmcf's quasi-conformal panel is logarithmic (a pinching MCF reaches 1e9
+# there, which on a linear axis flattens the cMCF and heat curves onto 0).
+"$py" - "$root/reports" >"$work/style_log" 2>&1 <<'PY' || { cat "$work/style_log"; echo "FAIL: report legibility checks"; fail=1; }
+import sys
+sys.path.insert(0, sys.argv[1])
+import common, cmcf, time_order
+flows = ("mcf", "heat")
+names = ["%s: %s%s" % (f, g, frozen) for f in flows for g in time_order.INTEGRATORS + ("rk4",)
+         for frozen in ("", " (frozen)")]
+style = time_order.styles(names)
+for f in flows:
+    mine = [style[n][:3] for n in names if n.startswith(f + ": ")]
+    assert len(set(mine)) == len(mine), "time_order: two variants of %s share a style" % f
+assert style["mcf: bdf2"][:2] == style["heat: bdf2"][:2], "time_order: bdf2 changes colour between panels"
+r = {"_stem": "x", "config": {"basis": "octree", "solver": {"name": "multigrid"},
+                              "octree": {"refine_input": True, "tracking": "rebuilt"}}}
+keys = ["basis", "octree.refine_input", "octree.tracking", "solver.name"]
+assert common.label(r, keys) == "basis=octree, refine_input, tracking=rebuilt, solver=multigrid", common.label(r, keys)
+r["config"]["octree"]["refine_input"] = False
+assert common.label(r, keys) == "basis=octree, tracking=rebuilt, solver=multigrid", common.label(r, keys)
+assert common.label(r, ["octree.refine_input"]) == "refine_input=False", common.label(r, ["octree.refine_input"])
+figures = []
+common.save_figure = lambda fig, *args: figures.append(fig)
+cells = [{"_stem": f, "_path": f + ".json", "config": {"flow": f, "mesh": "m"}, "status": "ok",
+          "steps": [{"step": n, "metrics": {"quasi_conformal": qc}} for n, qc in enumerate(qcs, 1)]}
+         for f, qcs in (("mcf", [2.0, 3e9]), ("cmcf", [1.1, 1.2]))]
+cmcf.plot_model("m", cells, "unused", None, [], 0)
+assert figures and figures[0].axes[1].get_yscale() == "log", "cmcf: quasi-conformal panel is not logarithmic"
+PY
 # Partial data: each study with a single cell (and frames dropped) must still report cleanly.
 solo=""
 for s in $studies; do
