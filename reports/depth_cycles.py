@@ -69,7 +69,7 @@ def plot_hausdorff(ax, cells):
     for c, rs in sorted(common.group_by(cells, cycles).items(), key=lambda kv: (kv[0] is None, kv[0] or 0)):
         pts = sorted((depth(r), hausdorff(r)) for r in rs if depth(r) is not None and common.finite(hausdorff(r)))
         if pts:
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label="%s W-cycles" % c)
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label="%s W-cycle%s" % (c, "" if c == 1 else "s"))
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("octree depth")
     ax.set_ylabel("Hausdorff distance")
