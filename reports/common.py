@@ -146,7 +146,7 @@ def label(result, keys):
 def legend_beside(axes):
     """One legend for the whole figure, right of its panels, each label once. The panels of a
     figure plot the same variants, and a legend inside a panel hides the curves it names (the
-    papers' log plots leave no empty corner). Returns whether there was anything to name."""
+    papers' log plots leave no empty corner)."""
     handles = {}
     for ax in axes:
         for h, text in zip(*ax.get_legend_handles_labels()):
@@ -154,7 +154,6 @@ def legend_beside(axes):
     if handles:  # attached to the last panel, so it sits right beside it at any figure width
         axes[-1].legend(list(handles.values()), list(handles.keys()), loc="center left",
                         bbox_to_anchor=(1.02, 0.5))
-    return bool(handles)
 
 
 def group_by(results, keyfunc):

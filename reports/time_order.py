@@ -67,11 +67,17 @@ def stable(result, threshold=None, refs=None):
 
 
 def variant(result):
-    """Flow and integrator name, with "(frozen)" when the operators were not extrapolated."""
-    name = common.get(result, "config.flow", "mcf") + ": " + common.get(result, "config.integrator", "?")
-    if common.get(result, "config.extrapolate") is False:
-        name += " (frozen)"
-    return name
+    """(flow, integrator, frozen): what tells a study's runs apart besides δ; frozen when the
+    operators were not extrapolated."""
+    return (common.get(result, "config.flow", "mcf"), common.get(result, "config.integrator", "?"),
+            common.get(result, "config.extrapolate") is False)
+
+
+def variant_name(key, with_flow=True):
+    """"mcf: bdf2 (frozen)", or without the flow "bdf2 (frozen)" (inside the flow's own panel)."""
+    flow, integrator, frozen = key
+    name = integrator + (" (frozen)" if frozen else "")
+    return flow + ": " + name if with_flow else name
 
 
 def fit_slope(points):
@@ -91,25 +97,18 @@ INTEGRATORS = ("explicit-euler", "semi-implicit", "crank-nicolson", "bdf2", "tay
 MARKERS = "osD^vP*Xhp<>"
 
 
-def split_variant(name):
-    """(flow, integrator, frozen) of a variant() name."""
-    flow, _, rest = name.partition(": ")
-    frozen = rest.endswith(" (frozen)")
-    return flow, rest[:-len(" (frozen)")] if frozen else rest, frozen
-
-
-def styles(names):
-    """{variant name: (colour, marker, linestyle, marker face)}: colour and marker by integrator
+def styles(keys):
+    """{variant() key: (colour, marker, linestyle, marker face)}: colour and marker by integrator
     (the known ones first, in INTEGRATORS order, then others sorted), dashed with open markers
     when the operators were frozen. Distinct within a flow for up to 10 integrators."""
-    integrators = sorted({split_variant(n)[1] for n in names},
+    integrators = sorted({integ for _, integ, _ in keys},
                          key=lambda g: (INTEGRATORS.index(g) if g in INTEGRATORS else len(INTEGRATORS), g))
     out = {}
-    for n in names:
-        _, integ, frozen = split_variant(n)
+    for key in keys:
+        _, integ, frozen = key
         i = integrators.index(integ)
         color = "C%d" % (i % 10)
-        out[n] = (color, MARKERS[i % len(MARKERS)], "--" if frozen else "-", "none" if frozen else color)
+        out[key] = (color, MARKERS[i % len(MARKERS)], "--" if frozen else "-", "none" if frozen else color)
     return out
 
 
@@ -132,7 +131,7 @@ def make(results, out_dir, reference, written):
     refs = reference_runs(cells)
     # The reference runs themselves are left out of the fits.
     groups = common.group_by([c for c in cells if not any(c is r for r in refs.values())], variant)
-    flows = list(dict.fromkeys(split_variant(name)[0] for name in groups)) or ["mcf"]
+    flows = list(dict.fromkeys(flow for flow, _, _ in groups)) or ["mcf"]
     style = styles(list(groups))
     fig, axes = plt.subplots(len(flows), 1, figsize=(6.5, 3.4 * len(flows)), squeeze=False)
     axes = {flow: ax for flow, ax in zip(flows, axes[:, 0])}
@@ -140,23 +139,30 @@ def make(results, out_dir, reference, written):
     reference = reference if isinstance(reference, dict) else {}
     expected = reference.get("orders", {})
     threshold = reference.get("stability_threshold")
-    for name, rs in groups.items():
-        flow = split_variant(name)[0]
-        with_dt = [r for r in rs if common.finite(common.get(r, "config.dt"))]
-        pts = sorted((common.get(r, "config.dt"), final_error(r, refs)) for r in with_dt if stable(r, threshold, refs))
+    for key, rs in groups.items():
+        flow, integrator, _ = key
+        name = variant_name(key)
+        # One pass: each run is stable (a point of the fit) or not (its δ bounds the stable range).
+        pts, unstable = [], []
+        for r in rs:
+            dt = common.get(r, "config.dt")
+            if not common.finite(dt):
+                continue
+            if stable(r, threshold, refs):
+                pts.append((dt, final_error(r, refs)))
+            else:
+                unstable.append(dt)
+        pts.sort()
         slope = fit_slope(pts)
         if pts:
-            color, marker, line, face = style[name]
+            color, marker, line, face = style[key]
             axes[flow].plot([p[0] for p in pts], [p[1] for p in pts], line, color=color, marker=marker, ms=4,
-                            mfc=face, label="%s (slope %s)" % (name.partition(": ")[2], common.fmt(slope, "%.2f")))
+                            mfc=face, label="%s (slope %s)" % (variant_name(key, False), common.fmt(slope, "%.2f")))
             values[flow] += [p[1] for p in pts]
             panel_pts[flow] += pts
-        stable_dts = [common.get(r, "config.dt") for r in with_dt if stable(r, threshold, refs)]
-        unstable = [common.get(r, "config.dt") for r in with_dt if not stable(r, threshold, refs)]
-        rows.append([name, common.fmt(slope, "%.2f"), len(pts), common.fmt(max(stable_dts) if stable_dts else None),
+        rows.append([name, common.fmt(slope, "%.2f"), len(pts), common.fmt(pts[-1][0] if pts else None),
                      common.fmt(min(unstable) if unstable else None),
-                     str(expected.get(name, expected.get(name.split(": ")[-1],
-                                                          expected.get(name.split(": ")[-1].split(" ")[0], "—"))))])
+                     str(expected.get(name, expected.get(variant_name(key, False), expected.get(integrator, "—"))))])
     for flow, ax in axes.items():
         order_guides(ax, panel_pts[flow])
         ax.set_xscale("log")

@@ -67,19 +67,18 @@ import sys
 sys.path.insert(0, sys.argv[1])
 import common, cmcf, time_order
 flows = ("mcf", "heat")
-names = ["%s: %s%s" % (f, g, frozen) for f in flows for g in time_order.INTEGRATORS + ("rk4",)
-         for frozen in ("", " (frozen)")]
-style = time_order.styles(names)
+keys = [(f, g, frozen) for f in flows for g in time_order.INTEGRATORS + ("rk4",) for frozen in (False, True)]
+style = time_order.styles(keys)
 for f in flows:
-    mine = [style[n][:3] for n in names if n.startswith(f + ": ")]
+    mine = [style[k][:3] for k in keys if k[0] == f]
     assert len(set(mine)) == len(mine), "time_order: two variants of %s share a style" % f
-assert style["mcf: bdf2"][:2] == style["heat: bdf2"][:2], "time_order: bdf2 changes colour between panels"
+assert style[("mcf", "bdf2", False)][:2] == style[("heat", "bdf2", False)][:2], "time_order: bdf2 changes colour between panels"
 r = {"_stem": "x", "config": {"basis": "octree", "solver": {"name": "multigrid"},
                               "octree": {"refine_input": True, "tracking": "rebuilt"}}}
-keys = ["basis", "octree.refine_input", "octree.tracking", "solver.name"]
-assert common.label(r, keys) == "basis=octree, refine_input, tracking=rebuilt, solver=multigrid", common.label(r, keys)
+shown = ["basis", "octree.refine_input", "octree.tracking", "solver.name"]
+assert common.label(r, shown) == "basis=octree, refine_input, tracking=rebuilt, solver=multigrid", common.label(r, shown)
 r["config"]["octree"]["refine_input"] = False
-assert common.label(r, keys) == "basis=octree, tracking=rebuilt, solver=multigrid", common.label(r, keys)
+assert common.label(r, shown) == "basis=octree, tracking=rebuilt, solver=multigrid", common.label(r, shown)
 assert common.label(r, ["octree.refine_input"]) == "refine_input=False", common.label(r, ["octree.refine_input"])
 figures = []
 common.save_figure = lambda fig, *args: figures.append(fig)
