@@ -89,6 +89,18 @@ TEST(HatBasis, ConstantsInKernelMassSumsToArea) {
   }
 }
 
+TEST(HatBasis, LumpedMassIsTheRowSumsOfTheConsistentOne) {
+  // Lumped: M_ii = Σ_{f ∋ i} A_f / 3, the row sums of the consistent mass, and nothing off the
+  // diagonal; the stiffness does not depend on the mass kind.
+  const TriangleMesh m = random_triangle_fan(7);
+  HatBasis lumped(m, MassKind::lumped), consistent(m, MassKind::consistent);
+  const Eigen::MatrixXd M = Eigen::MatrixXd(lumped.mass());
+  const Eigen::VectorXd row_sums = reference_mass(m).rowwise().sum();
+  EXPECT_LT((Eigen::MatrixXd(M.diagonal().asDiagonal()) - M).norm(), 1e-15 * M.norm());
+  EXPECT_LT((M.diagonal() - row_sums).norm(), 1e-12 * row_sums.norm());
+  EXPECT_EQ((Eigen::MatrixXd(lumped.stiffness()) - Eigen::MatrixXd(consistent.stiffness())).norm(), 0.0);
+}
+
 TEST(HatBasis, SphereDirichletEnergyConverges) {
   // Σ_coords ∫|∇_S x|² = ∫ 2 dA = 8π on the unit sphere; the error falls as the mesh refines.
   double previous = 1e9;

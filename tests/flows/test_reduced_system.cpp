@@ -67,7 +67,12 @@ TEST(ReducedSystem, HandsTheSumToTheSolverBitwiseAsItsOwnSum) {
     Eigen::MatrixXd y_ref = x;
     ASSERT_TRUE(by_hand.solve(R, y_ref).ok());
     EXPECT_EQ((y - y_ref).cwiseAbs().maxCoeff(), 0.0);
-    EXPECT_GT((y - x).norm(), 0.0);
+    // With b = 0 the system is M y = M x, so the warm start x is the answer up to the rounding of
+    // its residual, amplified by M's conditioning (measured 3.8e-8 relative). With b = 1e-3 the
+    // coefficients move by O(‖x‖) (0.69 ‖x‖ for a direct solve, measured: at this coarse depth the
+    // functions that barely touch the surface are smoothed hard, while the vertices move ~2δ).
+    if (b != 0) EXPECT_GT((y - x).norm(), 0.1 * x.norm());
+    else EXPECT_LT((y - x).norm(), 1e-6 * x.norm());
   }
 }
 

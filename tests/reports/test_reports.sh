@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reports end to end on fabricated results: every study's figures/tables and the index exist and
-# are non-empty. Skips (exit 0) where Debian's matplotlib is missing for /usr/bin/python3.
+# are non-empty. Skips (exit 77, ctest's SKIP_RETURN_CODE) where Debian's matplotlib is missing for /usr/bin/python3.
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -29,7 +29,7 @@ for want in '| 1 | 2 | 100 | 25% |' '| outside the cycle (copies, final residual
 done
 rm -rf "$sw"
 if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
-  echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 0
+  echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 77
 fi
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 "$py" "$here/make_fake_results.py" "$work/results" || { echo "FAIL: fake results generator"; exit 1; }
