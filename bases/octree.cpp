@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -19,7 +20,12 @@ GridCube choose_cube(const Positions& vertices, int depth, OctreeCube cube) {
   GridCube g;
   g.depth = depth;
   if (cube == OctreeCube::unit || (cube == OctreeCube::automatic && fits)) {
-    if (!fits) throw std::invalid_argument("choose_cube: the mesh does not lie inside the unit cube");
+    if (!fits) {
+      std::ostringstream what;
+      what << "octree cube \"unit\" (octree.cube, --cube): the mesh's bounding box [" << lo.transpose() << "] - ["
+           << hi.transpose() << "] does not lie inside the unit cube [0, 1]^3; use \"auto\" or \"tight\"";
+      throw std::invalid_argument(what.str());
+    }
     g.origin.setZero();
     g.side = 1.0;
     return g;

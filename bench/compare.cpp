@@ -135,6 +135,15 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
     CellSamples& c = set.cells[key];
     c.label = label_of(cell.value("assignment", json::object()), key);
     ++c.repetitions;
+    const std::string status = r.value("status", "error");
+    if (status != "ok") {
+      if (c.failed++ == 0) {
+        std::string reason = r.contains("stop") && r["stop"].is_object() ? r["stop"].value("reason", "") : "";
+        c.failure = status + (reason.empty() ? "" : ": " + reason);
+      }
+    }
+    const int steps = r.contains("steps") && r["steps"].is_array() ? int(r["steps"].size()) : 0;
+    c.min_steps = c.min_steps < 0 ? steps : std::min(c.min_steps, steps);
     if (r.contains("steps"))
       for (const auto& s : r["steps"]) {
         const json* v = json_at_path(s, metric);
@@ -143,6 +152,11 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
     const double err = accuracy_of(r);
     if (std::isfinite(err)) c.errors.push_back(err);
   }
+  bool any_value = false;
+  for (const auto& [key, c] : set.cells) any_value = any_value || !c.values.empty();
+  if (!any_value)
+    throw std::runtime_error(dir_at_commit + ": no step of any cell has the metric \"" + metric +
+                             "\" (--metric is a dotted path in steps[], e.g. seconds.total, seconds.solve, radial_error.rms)");
   return set;
 }
 
@@ -175,11 +189,18 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
       c.error_ratio = std::max(c.new_error, floor) / std::max(c.old_error, floor);
       c.less_accurate = c.error_ratio > 1 + o.threshold;
     }
-    rep.regression = rep.regression || c.slower || c.less_accurate;
+    c.old_steps = std::max(old.min_steps, 0);
+    c.new_steps = std::max(n.min_steps, 0);
+    c.failed = n.failed > 0 && old.failed == 0;
+    c.failure = n.failure;
+    c.stopped_earlier = c.new_steps < c.old_steps;
+    rep.regression = rep.regression || c.slower || c.less_accurate || c.failed || c.stopped_earlier;
     rep.cells.push_back(std::move(c));
   }
   for (const auto& [key, old] : old_set.cells)
     if (!new_set.cells.count(key)) rep.only_old.push_back(old.label);
+  // A cell that vanished from NEW (not run, or its file lost) cannot be vouched for.
+  rep.regression = rep.regression || !rep.only_old.empty();
   return rep;
 }
 
@@ -201,6 +222,9 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, c
     if (c.faster) verdict += "faster ";
     if (c.less_accurate) verdict += "**less accurate** ";
     if (c.has_error && c.error_ratio < 1 / (1 + o.threshold)) verdict += "more accurate ";
+    if (c.failed) verdict += "**failed** (" + c.failure + ") ";
+    if (c.stopped_earlier)
+      verdict += "**stopped earlier** (" + std::to_string(c.new_steps) + " of " + std::to_string(c.old_steps) + " steps) ";
     if (!verdict.empty()) ++changed;
     if (verdict.empty() && !o.show_all) continue;
     table << "| " << c.label << " | " << fmt(c.old_median) << " | " << fmt(c.new_median) << " | "
@@ -211,7 +235,12 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, c
   if (changed || (o.show_all && !r.cells.empty())) md << table.str() << "\n";
   md << r.cells.size() << " cells compared, " << changed << " changed, " << (r.cells.size() - size_t(changed))
      << " unchanged.\n";
-  if (!r.only_old.empty()) md << r.only_old.size() << " cells only in OLD.\n";
+  if (!r.only_old.empty()) {
+    md << r.only_old.size() << " cells only in OLD (missing from NEW: a regression):";
+    for (size_t i = 0; i < r.only_old.size() && i < 5; ++i) md << " `" << r.only_old[i] << "`";
+    if (r.only_old.size() > 5) md << " …";
+    md << "\n";
+  }
   if (!r.only_new.empty()) md << r.only_new.size() << " cells only in NEW.\n";
   md << (r.regression ? "REGRESSION\n" : "no regression\n");
   return md.str();

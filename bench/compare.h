@@ -16,6 +16,9 @@ struct CellSamples {
   std::vector<double> values;        ///< the metric per step, all repetitions pooled
   std::vector<double> errors;        ///< accuracy per repetition (final reference distance or radial rms)
   int repetitions = 0;
+  int failed = 0;                    ///< repetitions whose status is not "ok" (singular or error)
+  std::string failure;               ///< the first such repetition's status and stop reason
+  int min_steps = -1;                ///< fewest steps any repetition recorded
 };
 
 struct ResultSet {
@@ -27,6 +30,7 @@ struct ResultSet {
 /// those of COMMIT (a prefix) when given. A folder holding several commits without @COMMIT is
 /// an error listing them (timings of different code must not be pooled). `metric` is the
 /// dotted path of the per-step value ("seconds.total", "radial_error.rms", ...).
+/// When no step of any cell has `metric` (a misspelt --metric), the set is an error too.
 ResultSet load_result_set(const std::string& dir_at_commit, const std::string& metric);
 
 struct CompareOptions {
@@ -42,11 +46,17 @@ struct CellComparison {
   bool has_error = false;
   double old_error = 0, new_error = 0, error_ratio = 1;
   bool slower = false, faster = false, less_accurate = false;
+  /// NEW failed (status not "ok") where OLD never did, or stopped earlier than OLD's fewest
+  /// steps: a regression whatever the timings say (a cell that errors has no timings at all).
+  bool failed = false, stopped_earlier = false;
+  std::string failure;
+  int old_steps = 0, new_steps = 0;
 };
 
 struct CompareReport {
   std::vector<CellComparison> cells;
   std::vector<std::string> only_old, only_new;  ///< labels of unmatched cells
+  /// Slower, less accurate, failed, stopped earlier, or a cell of OLD missing from NEW.
   bool regression = false;
 };
 

@@ -8,6 +8,7 @@
 #include <tbb/info.h>
 #include <tbb/version.h>
 
+#include <algorithm>
 #include <fstream>
 #include <string>
 #include <sys/resource.h>
@@ -42,7 +43,9 @@ nlohmann::json environment_json(int threads) {
           {"version", MCFBENCH_VERSION},
           {"cpu", cpu_model()},
           {"cores", cores},
-          {"threads", threads > 0 ? threads : tbb::info::default_concurrency()},
+          // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the
+          // config asked for (that request is in "config.threads").
+          {"threads", std::min(threads > 0 ? threads : tbb::info::default_concurrency(), tbb::info::default_concurrency())},
           {"hostname", hostname()},
           {"build", {{"type", MCFBENCH_BUILD_TYPE}, {"compiler", MCFBENCH_CXX_COMPILER}}},
           {"libraries",

@@ -156,17 +156,19 @@ json default_value(const std::string& key) {
 
 /// Exclusion is decided before validation, on the raw config plus the defaults, because
 /// excluding invalid combinations (say hat + multigrid) is exactly what `exclude` is for.
-bool excluded(const json& raw, const json& exclude) {
+/// Whether `raw` matches an entry of `exclude`; `used[i]` is set for every entry i it matches.
+bool excluded(const json& raw, const json& exclude, std::vector<bool>& used) {
   if (!exclude.is_array()) return false;
-  for (const auto& partial : exclude) {
+  bool any = false;
+  for (size_t i = 0; i < exclude.size(); ++i) {
     bool all = true;
-    for (auto it = partial.begin(); it != partial.end() && all; ++it) {
+    for (auto it = exclude[i].begin(); it != exclude[i].end() && all; ++it) {
       const json* v = json_at_path(raw, it.key());
       all = (v ? *v : default_value(it.key())) == *it;
     }
-    if (all) return true;
+    if (all) used[i] = any = true;
   }
-  return false;
+  return any;
 }
 
 }  // namespace
@@ -314,6 +316,7 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
         fail(source, axes_where, "keys \"" + k + "\" and \"" + other + "\" overlap (one contains the other)");
 
   // Odometer over the dimensions, the last one fastest.
+  std::vector<bool> exclude_used(exclude.is_array() ? exclude.size() : 0, false);
   std::vector<size_t> pos(dims.size(), 0);
   int index = 0;
   bool done = false;
@@ -324,7 +327,7 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
         set_json_path(raw, dims[d].keys[k], dims[d].rows[pos[d]][k]);
         assignment[dims[d].keys[k]] = dims[d].rows[pos[d]][k];
       }
-    if (!excluded(raw, exclude)) {
+    if (!excluded(raw, exclude, exclude_used)) {
       const std::string where = assignment.empty() ? source + " (defaults)" : source + " (cell " + assignment.dump() + ")";
       const FlowConfig flow = flow_config_from_json(raw, where);
       for (int r = 0; r < e.repetitions; ++r) {
@@ -347,6 +350,22 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
     }
   }
   if (e.cells.empty()) fail(source, "exclude", "every cell of the matrix is excluded");
+  // An entry that excludes nothing is a typo ("hta") or a value no axis has. The full config's
+  // entries applied to quick.axes may rightly match nothing, so a quick run checks only its own.
+  const bool own_exclude = !quick || (q.is_object() && q.contains("exclude"));
+  for (size_t i = 0; own_exclude && i < exclude_used.size(); ++i)
+    if (!exclude_used[i])
+      fail(source, std::string(quick ? "quick.exclude" : "exclude") + "[" + std::to_string(i) + "]",
+           "matches no cell of the matrix: " + exclude[i].dump());
+  // A frame no cell reaches would silently save nothing (and give no reference distance). As
+  // with exclude, a quick run inherits the full frame list and may rightly stop short of it.
+  int max_steps = 0;
+  for (const Cell& c : e.cells) max_steps = std::max(max_steps, c.flow.steps);
+  const bool own_frames = !quick || (q.is_object() && q.contains("metrics"));
+  for (int f : e.metrics.frames)
+    if (own_frames && f > max_steps)
+      fail(source, quick ? "quick.metrics.frames" : "metrics.frames",
+           "step " + std::to_string(f) + " is beyond every cell's steps (at most " + std::to_string(max_steps) + ")");
   // Two cells with the same full config would share one result file (same key): the second
   // would be "skipped" and `collect` would report it missing. Usually a duplicated axis value.
   std::map<std::string, const Cell*> seen;
@@ -363,14 +382,10 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
 }
 
 ExperimentConfig load_experiment_config(const std::string& path, bool quick) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path + ": cannot open config file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& err) {
-    throw ConfigError(path + ": JSON parse error: " + err.what());
-  }
+  const json j = read_config_file(path);
+  // Without a "quick" section --quick would run the full matrix and label it quick.
+  if (quick && !(j.is_object() && j.contains("quick")))
+    throw ConfigError(path + ": --quick: the config has no \"quick\" section (add one, or run without --quick)");
   return parse_experiment_config(j, path, quick, std::filesystem::path(path).stem().string());
 }
 

@@ -57,6 +57,16 @@ json read_json_file(const std::string& path) {
   }
 }
 
+/// A cell counts as done on a rerun when its file holds a result that did not error: an
+/// errored cell (a mesh that was missing, an exception) is retried, and so is a file that does
+/// not parse (written by something else than the atomic writer), which is replaced.
+bool finished(const std::string& file) {
+  if (!fs::exists(file)) return false;
+  std::ifstream in(file);
+  const json r = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return r.is_object() && r.contains("status") && r["status"].is_string() && r["status"] != "error";
+}
+
 json cell_json(const ExperimentConfig& e, const CellPlan& p) {
   return {{"index", p.cell.index},
           {"key", p.key},
@@ -258,11 +268,12 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
     CellReport report;
     report.plan = &p;
     report.total = s.in_shard;
-    if (!o.force && fs::exists(p.file)) {
+    if (!o.force && finished(p.file)) {
       ++s.skipped;
       report.skipped = true;
       report.status = "skipped";
     } else {
+      if (!o.force && fs::exists(p.file)) ++s.retried;
       const auto t0 = std::chrono::steady_clock::now();
       const json result = run_cell(e, p, meshes, out);
       write_file_atomic(p.file, result.dump(1) + "\n");

@@ -1,7 +1,8 @@
 #pragma once
 // `mcfbench run`: runs the cells of an experiment matrix (or one shard of them), one result
 // file per cell, named by the cell hash and written atomically, so an interrupted or killed
-// run is resumed by running it again (finished cells are skipped, the killed one is redone).
+// run is resumed by running it again (finished cells are skipped, the killed one is redone, and a
+// cell whose result is an error is retried).
 
 #include "bench/experiment_config.h"
 #include "datasets/mesh_spec.h"
@@ -52,6 +53,7 @@ struct RunOptions {
 
 struct RunSummary {
   int total = 0, in_shard = 0, ran = 0, skipped = 0, errors = 0, distances = 0;
+  int retried = 0;  ///< of `ran`: cells whose file held an error (or did not parse), run again
 };
 
 /// The code version stored in hashes: the git commit the binary was built from.

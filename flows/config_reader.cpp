@@ -1,9 +1,38 @@
 #include "flows/config_reader.h"
 
 #include <cmath>
+#include <fstream>
+#include <map>
 #include <sstream>
 
 namespace mcf {
+
+nlohmann::json read_config_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open config file");
+  // Duplicate keys: nlohmann keeps the last one without a word, so track each open object's keys.
+  std::vector<std::set<std::string>> open_objects;
+  std::string duplicate;
+  const nlohmann::json::parser_callback_t track = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    if (event == E::object_start) open_objects.emplace_back();
+    else if (event == E::object_end && !open_objects.empty()) open_objects.pop_back();
+    else if (event == E::key && !open_objects.empty() && !open_objects.back().insert(parsed.get<std::string>()).second &&
+             duplicate.empty())
+      duplicate = parsed.get<std::string>();
+    return true;
+  };
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in, track);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw ConfigError(path + ": JSON parse error: " + e.what());
+  } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range.406: number overflow
+    throw ConfigError(path + ": " + e.what());
+  }
+  if (!duplicate.empty()) throw ConfigError(path + ": key \"" + duplicate + "\" appears twice in one object");
+  return j;
+}
 
 const nlohmann::json& ConfigReader::empty_object() {
   static const nlohmann::json e = nlohmann::json::object();

@@ -17,6 +17,11 @@ struct ConfigError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Reads a JSON config file strictly: a file that cannot be opened, a syntax error (with line
+/// and column), a number out of double range ("dt": 1e400) and a key given twice in one object
+/// (JSON would silently keep the last) all throw ConfigError naming `path`.
+nlohmann::json read_config_file(const std::string& path);
+
 class ConfigReader {
  public:
   /// `source` names the file (or "command line"); `prefix` is the dotted path of this object.

@@ -27,7 +27,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   {
     auto s = r.child("solver");
     c.solver.name = s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "dense"});
-    c.solver.tolerance = s.get_number("tolerance", c.solver.tolerance, -1, 1);
+    c.solver.tolerance = s.get_number("tolerance", c.solver.tolerance, 0, 1);  // absent: -1, the solver's default
     c.solver.max_iterations = int(s.get_integer("max_iterations", c.solver.max_iterations, 1, 100000000));
     c.solver.preconditioner =
         s.get_string("preconditioner", c.solver.preconditioner, {"none", "jacobi", "ichol", "multigrid"});

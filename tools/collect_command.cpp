@@ -34,6 +34,7 @@ struct Group {  // results of one study variant at one commit
   bool quick = false;
   std::map<int, std::vector<std::string>> files_by_index;
   std::vector<int> without_distance;  ///< candidates; reference cells themselves are filtered below
+  std::vector<int> errored;           ///< cells whose result is {"status": "error"}
 };
 
 }  // namespace
@@ -87,6 +88,7 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           g.commit = commit;
           g.quick = entry["quick"];
           g.files_by_index[entry["index"].get<int>()].push_back(path.string());
+          if (entry["status"] == "error") g.errored.push_back(entry["index"].get<int>());
           // Cells of a study with a reference flow that still lack their distances (their
           // reference was not finished when they ran; an unsharded rerun fills them in).
           if (r.contains("study_config") && r["study_config"].contains("metrics") &&
@@ -131,16 +133,21 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         }
         s["missing"] = missing;
         s["duplicates"] = dup;
-        problems = problems || !missing.empty() || !dup.empty();
-        std::printf("%s: %zu cells found%s, %zu missing, %zu duplicated\n", name.c_str(), g.files_by_index.size(),
+        s["errors"] = g.errored;
+        // An errored cell is there but holds no result: as incomplete as a missing one.
+        problems = problems || !missing.empty() || !dup.empty() || !g.errored.empty();
+        std::printf("%s: %zu cells found%s, %zu missing, %zu duplicated, %zu errored\n", name.c_str(), g.files_by_index.size(),
                     s.contains("cells_expected") ? (" of " + std::to_string(s["cells_expected"].get<size_t>())).c_str() : "",
-                    missing.size(), dup.size());
+                    missing.size(), dup.size(), g.errored.size());
         if (!missing.empty()) std::printf("  missing cell indices: %s\n", missing.dump().c_str());
+        if (!g.errored.empty())
+          std::printf("  errored cell indices: %s (rerun `mcfbench run` to retry them)\n", json(g.errored).dump().c_str());
         studies.push_back(s);
       }
       const std::string out = !a->out.empty() ? a->out : (fs::path(a->dirs.front()) / "index.json").string();
       write_file_atomic(out, json{{"schema", 1}, {"dirs", a->dirs}, {"studies", studies}, {"duplicates", duplicates}, {"files", files}}.dump(1) + "\n");
-      std::printf("wrote %s (%zu result files)%s\n", out.c_str(), files.size(), problems ? "; INCOMPLETE or DUPLICATED cells" : "");
+      std::printf("wrote %s (%zu result files)%s\n", out.c_str(), files.size(),
+                  problems ? "; INCOMPLETE (missing or errored) or DUPLICATED cells" : "");
       return problems ? 1 : 0;
     };
   });

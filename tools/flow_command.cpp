@@ -4,6 +4,7 @@
 #include "datasets/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "datasets/mesh_spec.h"
+#include "flows/config_reader.h"
 #include "flows/flow.h"
 #include "flows/flow_config.h"
 #include "flows/integrator.h"
@@ -14,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <set>
 
 namespace mcf {
 namespace {
@@ -46,7 +48,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--cubature", args->cubature, "Octree cubature rule per split triangle: 1 | 3 (default) | 6");
   cmd->add_option("--cube", args->cube, "Octree bounding cube: auto (default: unit cube if the mesh fits) | unit | tight");
   cmd->add_flag("--refine-input", args->refine_input, "Octree: split the input mesh 1-to-4 once first");
-  cmd->add_option("--solver", args->solver, "cholmod (default) | pcg | multigrid");
+  cmd->add_option("--solver", args->solver, "cholmod (default) | pcg | multigrid | dense (LLT of the dense matrix: a reference for small meshes)");
   cmd->add_option("--tolerance", args->tolerance, "Relative residual to stop at (PCG default 1e-10; multigrid default 0 = run --cycles)");
   cmd->add_option("--max-iterations", args->max_iterations, "PCG iteration cap (default 1000)");
   cmd->add_option("--preconditioner", args->preconditioner, "PCG: none | jacobi (default) | ichol | multigrid");
@@ -71,13 +73,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       nlohmann::json j = nlohmann::json::object();
       std::string source = "command line";
       if (!args->config_file.empty()) {
-        std::ifstream in(args->config_file);
-        if (!in) throw std::runtime_error(args->config_file + ": cannot open config file");
-        try {
-          j = nlohmann::json::parse(in);
-        } catch (const nlohmann::json::parse_error& e) {
-          throw std::runtime_error(args->config_file + ": JSON parse error: " + e.what());
-        }
+        j = read_config_file(args->config_file);
         source = args->config_file + " (+ command line)";
       }
       auto given = [&](const char* flag) { return cmd->count(flag) > 0; };
@@ -120,23 +116,41 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
 
       namespace fs = std::filesystem;
       const fs::path out(args->out);
+      // A folder this run creates is removed again if the flow throws (a set-up error such as
+      // `--cube unit` on a mesh outside the unit cube): no empty folder or partial frames left.
+      const bool created = !fs::exists(out);
       fs::create_directories(out);
-      Progress progress("step", config.steps);
-      FlowObserver observer;
-      observer.on_step = [&](int step, double, const Positions& V) {
-        progress.update(step);
-        if (config.save_every > 0 && step % config.save_every == 0) {
-          char name[32];
-          std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-          write_mesh((out / name).string(), TriangleMesh{V, mesh.mesh.faces});
-        }
-      };
-      FlowOutcome outcome = run_flow(config, mesh, observer);
-      progress.finish();
+      std::set<std::string> frames;
+      FlowOutcome outcome;
+      try {
+        Progress progress("step", config.steps);
+        FlowObserver observer;
+        observer.on_step = [&](int step, double, const Positions& V) {
+          progress.update(step);
+          if (config.save_every > 0 && step % config.save_every == 0) {
+            char name[32];
+            std::snprintf(name, sizeof name, "frame_%05d.ply", step);
+            write_mesh((out / name).string(), TriangleMesh{V, mesh.mesh.faces});
+            frames.insert(name);
+          }
+        };
+        outcome = run_flow(config, mesh, observer);
+        progress.finish();
+      } catch (...) {
+        if (created) fs::remove_all(out);
+        throw;
+      }
       outcome.result["environment"] = environment_json(config.threads);
       outcome.result["peak_memory_bytes"] = peak_memory_bytes();
       write_mesh((out / "final.ply").string(), outcome.final_mesh);
       write_file_atomic((out / "result.json").string(), outcome.result.dump(1) + "\n");
+      // Frames of an earlier run into the same folder would sit beside this run's result as if
+      // they were its own: once the new result is in place, they go.
+      for (const auto& entry : fs::directory_iterator(out)) {
+        const std::string name = entry.path().filename().string();
+        if (name.size() == 15 && name.rfind("frame_", 0) == 0 && entry.path().extension() == ".ply" && !frames.count(name))
+          fs::remove(entry.path());
+      }
       const auto& stop = outcome.result["stop"];
       std::fprintf(stderr, "mcfbench flow: %s after %d steps (%s); wrote %s\n",
                    outcome.result["status"].get<std::string>().c_str(), stop["step"].get<int>(),

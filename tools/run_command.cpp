@@ -1,5 +1,6 @@
 // `mcfbench run CONFIG.json`: run an experiment matrix (or one shard of it), one result file per
-// cell; rerunning skips finished cells, so a killed or failed run is resumed by running it again.
+// cell; rerunning skips finished cells and retries errored ones, so a killed or failed run is
+// resumed by running it again.
 
 #include "bench/experiment_config.h"
 #include "bench/runner.h"
@@ -24,7 +25,8 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
   auto a = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand("run", "Run the cells of an experiment matrix; one OUT/<hash>.json per cell.");
   cmd->footer(
-      "Finished cells are skipped on a rerun (--force redoes them); a killed run leaves no partial file.\n"
+      "Finished cells are skipped on a rerun and errored ones retried (--force redoes all); a killed run\n"
+      "leaves no partial file.\n"
       "Slurm: sbatch --array=0-15 --wrap 'mcfbench run cfg.json --shard $SLURM_ARRAY_TASK_ID/16'\n"
       "then `mcfbench collect results/NAME` checks that every cell is there (with metrics.reference, first\n"
       "run `mcfbench run cfg.json` once without --shard: every cell is skipped and the distances to the\n"
@@ -35,7 +37,8 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--shard", a->shard, "Run only cells with index % n == i (i/n, 0-based; default 0/1)");
   cmd->add_flag("--force", a->force, "Rerun cells whose result file exists");
   cmd->add_flag("--quick", a->quick, "Use the config's \"quick\" variant (small, minutes on 2 cores)");
-  cmd->add_option("--threads", a->threads, "Override every cell's thread count (0 = all cores; changes the cell keys)");
+  cmd->add_option("--threads", a->threads, "Override every cell's thread count (0 = all cores; changes the cell keys)")
+      ->check(CLI::Range(0, 4096));
   cmd->callback([a, &run] {
     run = [a]() -> int {
       const ExperimentConfig e = load_experiment_config(a->config, a->quick);
@@ -61,9 +64,10 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
                      r.error.empty() ? "" : ("\n    error: " + r.error).c_str());
       };
       const RunSummary s = run_experiment(e, o);
-      std::printf("%s: %d cells, %d in shard %d/%d: %d ran, %d skipped, %d errors, %d reference distances; results in %s\n",
-                  e.name.c_str(), s.total, s.in_shard, o.shard_index, o.shard_count, s.ran, s.skipped, s.errors,
-                  s.distances, o.out_dir.c_str());
+      std::printf("%s: %d cells, %d in shard %d/%d: %d ran%s, %d skipped, %d errors, %d reference distances; results in %s\n",
+                  e.name.c_str(), s.total, s.in_shard, o.shard_index, o.shard_count, s.ran,
+                  s.retried ? (" (" + std::to_string(s.retried) + " retried after an error)").c_str() : "", s.skipped,
+                  s.errors, s.distances, o.out_dir.c_str());
       return s.errors > 0 ? 1 : 0;
     };
   });

@@ -7,6 +7,7 @@
 #include "bench_test_util.h"
 
 #include <cmath>
+#include <functional>
 #include <random>
 
 namespace mcf {
@@ -94,6 +95,61 @@ TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   c = mcfbench("compare old same@bbbb", dir);
   EXPECT_EQ(c.status, 0) << c.out << c.err;
+}
+
+TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
+  // A cell that errors has no timings and one that stops early has fewer: neither may pass as
+  // "no regression", nor may a cell missing from NEW or a --metric that no step has.
+  const fs::path dir = fresh_dir("compare_status");
+  make_set(dir / "old", "aaaa", 1.0, 0.03, 1.0, 1);
+  auto variant = [&](const std::string& name, const std::function<void(json&)>& edit, const std::string& file) {
+    fs::create_directories(dir / name);
+    for (const auto& f : result_files(dir / "old")) {
+      json r = read_json(f);
+      r["environment"]["commit"] = "bbbb";
+      if (f.filename().string() == file) edit(r);
+      std::ofstream(dir / name / f.filename()) << r.dump();
+    }
+  };
+  variant("errored", [](json& r) {
+    r["status"] = "error";
+    r["stop"] = {{"step", 0}, {"reason", "error: boom"}};
+    r["steps"] = json::array();
+  }, "aaaa10.json");
+  variant("stopped", [](json& r) {
+    r["status"] = "singular";
+    r["stop"] = {{"step", 5}, {"reason", "collapsed area"}};
+    r["steps"].erase(r["steps"].begin() + 5, r["steps"].end());
+  }, "aaaa21.json");
+  variant("shorter_ok", [](json& r) { r["steps"].erase(r["steps"].begin() + 5, r["steps"].end()); }, "aaaa00.json");
+  Command c = mcfbench("compare old errored", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("**failed** (error: error: boom)"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("REGRESSION"), std::string::npos) << c.out;
+  c = mcfbench("compare old stopped", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("**failed** (singular: collapsed area)"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("**stopped earlier** (5 of 15 steps)"), std::string::npos) << c.out;
+  c = mcfbench("compare old shorter_ok", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("**stopped earlier** (5 of 15 steps)"), std::string::npos) << c.out;
+  // The reverse is not a regression: NEW fixed what OLD got wrong.
+  c = mcfbench("compare errored old", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  // A cell missing from NEW.
+  variant("missing", [](json&) {}, "");
+  fs::remove(dir / "missing" / "aaaa20.json");
+  fs::remove(dir / "missing" / "aaaa21.json");
+  c = mcfbench("compare old missing", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("1 cells only in OLD (missing from NEW: a regression): `solver.name=solver2`"), std::string::npos) << c.out;
+  c = mcfbench("compare missing old", dir);  // a cell only in NEW is new work, not a regression
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  // A metric no step has is an error naming it, not "0 changed".
+  c = mcfbench("compare old old --metric seconds.totl", dir);
+  EXPECT_NE(c.status, 0) << c.out;
+  EXPECT_EQ(c.status == 1 && c.out.find("no regression") != std::string::npos, false);
+  EXPECT_NE(c.err.find("\"seconds.totl\""), std::string::npos) << c.err;
 }
 
 TEST(CompareCli, InjectedSlowdownOnARealRun) {

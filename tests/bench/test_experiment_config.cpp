@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <set>
 
 namespace mcf {
@@ -112,7 +115,9 @@ TEST(ExperimentConfig, QuickOverridesTheFullMatrix) {
 }
 
 TEST(ExperimentConfig, MetricsAreReadStrictly) {
-  const auto e = expand({{"defaults", base},
+  json defaults = base;
+  defaults["steps"] = 100;
+  const auto e = expand({{"defaults", defaults},
                          {"axes", {{"solver.name", {"cholmod", "pcg"}}}},
                          {"metrics", {{"quasi_conformal", true}, {"sphericity", true}, {"every", 10},
                                       {"frames", {100, 1, 10}}, {"reference", {{"solver.name", "cholmod"}}}}}});
@@ -146,6 +151,7 @@ TEST(ExperimentConfig, ErrorsNameTheFileAndTheKeyPath) {
   expect_error({{"defaults", base}, {"metrics", {{"every", 0}}}}, "metrics.every");
   expect_error({{"defaults", base}, {"metrics", {{"sphericty", true}}}}, "metrics.sphericty");
   expect_error({{"defaults", base}, {"metrics", {{"frames", {1}}, {"reference", {{"solver.name", "pcg"}}}}}}, "metrics.reference");
+  expect_error({{"defaults", base}, {"metrics", {{"frames", {0, 50}}}}}, "metrics.frames");  // base has 2 steps
   expect_error({{"defaults", base}, {"quick", {{"axis", json::object()}}}}, "quick.axis");
   expect_error({{"defaults", base}, {"quick", {{"defaults", {{"octree", {{"dept", 3}}}}}}}}, "quick.defaults.octree.dept");
   // Wrong type / out of range in a cell: the flow config's own message with the key path.
@@ -153,6 +159,82 @@ TEST(ExperimentConfig, ErrorsNameTheFileAndTheKeyPath) {
   expect_error({{"defaults", base}, {"axes", {{"steps", {"two"}}}}}, "steps");
   expect_error({{"defaults", {{"steps", 2}}}}, "mesh");  // missing mesh
   expect_error({{"defaults", base}, {"axes", {{"dt", {1e-3, 0.001}}}}}, "axes");  // duplicate cells
+  // An exclude entry that removes nothing: a typo in a value, or a value no axis has.
+  expect_error({{"defaults", base}, {"axes", {{"basis", {"hat"}}}}, {"exclude", json::parse(R"([{"basis": "hta"}])")}}, "exclude[0]");
+  expect_error({{"defaults", base}, {"axes", {{"dt", {1e-3}}}}, {"exclude", json::parse(R"([{"dt": 0.005}])")}}, "exclude[0]");
+}
+
+TEST(ExperimentConfig, ExcludeEntriesMustMatchInTheirOwnVariant) {
+  // The full matrix's exclude applied to quick.axes may rightly match nothing; quick.exclude
+  // entries must match in the quick run.
+  const json j = {{"defaults", base},
+                  {"axes", {{"dt", {1e-3, 2e-3}}}},
+                  {"exclude", json::parse(R"([{"dt": 0.002}])")},
+                  {"quick", {{"axes", {{"dt", {1e-3}}}}}}};
+  EXPECT_EQ(expand(j).cells.size(), 1u);
+  EXPECT_EQ(expand(j, true).cells.size(), 1u);
+  json own = j;
+  own["quick"]["exclude"] = json::parse(R"([{"dt": 0.003}])");
+  try {
+    expand(own, true);
+    ADD_FAILURE() << "quick.exclude matching nothing was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("quick.exclude[0]"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ExperimentConfig, ConfigFilesAreReadStrictly) {
+  // Duplicate keys (JSON keeps the last silently), numbers out of double range and a --quick
+  // run of a config without a quick section are errors naming the file.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mcfbench_config_files";
+  std::filesystem::create_directories(dir);
+  auto file = [&](const std::string& name, const std::string& text) {
+    std::ofstream((dir / name).string()) << text;
+    return (dir / name).string();
+  };
+  auto error_of = [](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string dup = file("dup.json", R"({"defaults": {"mesh": "icosphere:level=1", "dt": 0.001, "dt": 0.01}})");
+  std::string what = error_of([&] { load_experiment_config(dup, false); });
+  EXPECT_NE(what.find("dup.json"), std::string::npos) << what;
+  EXPECT_NE(what.find("\"dt\" appears twice"), std::string::npos) << what;
+  // The same key in two different objects is fine.
+  EXPECT_EQ(read_config_file(file("ok.json", R"({"a": {"x": 1}, "b": {"x": 2}, "x": [{"x": 1}, {"x": 2}]})"))["b"]["x"], 2);
+  const std::string big = file("big.json", R"({"defaults": {"mesh": "icosphere:level=1", "dt": 1e400}})");
+  what = error_of([&] { load_experiment_config(big, false); });
+  EXPECT_NE(what.find("big.json"), std::string::npos) << what;
+  EXPECT_NE(what.find("overflow"), std::string::npos) << what;
+  const std::string plain = file("plain.json", R"({"defaults": {"mesh": "icosphere:level=1"}})");
+  EXPECT_EQ(load_experiment_config(plain, false).cells.size(), 1u);
+  what = error_of([&] { load_experiment_config(plain, true); });
+  EXPECT_NE(what.find("plain.json: --quick"), std::string::npos) << what;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ExperimentConfig, EveryShippedStudyConfigExpandsInBothVariants) {
+  // bench/configs/*.json (not the *.reference.json tables the reports read): the studies the
+  // README documents must load, full and quick, with this build's keys and checks.
+  const auto configs = std::filesystem::path(MCFBENCH_TEST_DATA).parent_path().parent_path() / "bench" / "configs";
+  int n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(configs)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".json" || name.find(".reference.") != std::string::npos) continue;
+    ++n;
+    for (bool quick : {false, true}) {
+      try {
+        EXPECT_FALSE(load_experiment_config(entry.path().string(), quick).cells.empty()) << name;
+      } catch (const std::exception& e) {
+        ADD_FAILURE() << name << (quick ? " --quick" : "") << ": " << e.what();
+      }
+    }
+  }
+  EXPECT_GE(n, 7) << "table1, sphere_error, model_error, depth_cycles, cubature, cmcf, time_order";
 }
 
 TEST(ExperimentConfig, ShardsPartitionTheCells) {

@@ -167,6 +167,34 @@ std::map<std::string, fs::file_time_type> age_files(const fs::path& dir) {
   return times;
 }
 
+TEST(RunnerCli, RerunRetriesErroredAndUnreadableCellsAndCollectCountsErrors) {
+  // An errored cell is not a result: a rerun runs it again (and exits 1 while it still fails),
+  // `collect` reports it; a cell file that does not parse is replaced, not "skipped".
+  const fs::path dir = fresh_dir("retry");
+  write_text(dir / "e.json", R"({"name": "e", "defaults": {"mesh": "icosphere:level=1", "steps": 1, "basis": "octree",
+    "octree": {"depth": 4}, "solver": {"name": "cholmod"}}, "axes": {"octree.cube": ["tight", "unit"]}})");
+  Command c = mcfbench("run e.json --out out", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;  // the unit cube does not hold a radius-1 sphere
+  EXPECT_NE(c.out.find("2 ran, 0 skipped, 1 errors"), std::string::npos) << c.out;
+  c = mcfbench("collect out", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("0 missing, 0 duplicated, 1 errored"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("errored cell indices: [1]"), std::string::npos) << c.out;
+  EXPECT_EQ(read_json(dir / "out" / "index.json")["studies"][0]["errors"], json::array({1}));
+  c = mcfbench("run e.json --out out", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("1 ran (1 retried after an error), 1 skipped, 1 errors"), std::string::npos) << c.out;
+  // Truncate the good cell's file: the next run recomputes it.
+  fs::path good;
+  for (const auto& f : result_files(dir / "out"))
+    if (read_json(f)["status"] == "ok") good = f;
+  ASSERT_FALSE(good.empty());
+  write_text(good, "{\"status\": \"ok\", \"tru");
+  c = mcfbench("run e.json --out out", dir);
+  EXPECT_NE(c.out.find("2 ran (2 retried after an error), 0 skipped, 1 errors"), std::string::npos) << c.out;
+  EXPECT_EQ(read_json(good)["status"], "ok");
+}
+
 TEST(RunnerCli, RerunRedoesExactlyTheMissingCell) {
   const fs::path dir = fresh_dir("resume");
   write_text(dir / "tiny.json", tiny_config);

@@ -103,6 +103,48 @@ TEST(Cli, FlowWritesTheResultContract) {
   for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos);
 }
 
+TEST(Cli, SetUpErrorsInsideTheFlowLeaveNoFolderAndNameTheOption) {
+  // The unit cube is only found wrong once the octree is built, after the folder was made.
+  const fs::path out = temp_dir() / "out_cube";
+  const CommandResult r = mcfbench("flow --mesh icosphere:level=2 --basis octree --depth 4 --cube unit --steps 1 --out " + out.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--cube"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("octree.cube"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // Range checks the defaults used to hide: a negative tolerance is not "the default".
+  const CommandResult tol = mcfbench("flow --mesh icosphere:level=2 --solver pcg --tolerance -0.5 --out " + out.string());
+  EXPECT_NE(tol.status, 0);
+  EXPECT_NE(tol.err.find("solver.tolerance"), std::string::npos) << tol.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, ARerunIntoTheSameFolderLeavesNoStaleFrames) {
+  const fs::path out = temp_dir() / "out_rerun";
+  ASSERT_EQ(mcfbench("flow --mesh icosphere:level=1 --steps 5 --save-every 1 --out " + out.string()).status, 0);
+  EXPECT_TRUE(fs::exists(out / "frame_00005.ply"));
+  ASSERT_EQ(mcfbench("flow --mesh icosphere:level=1 --steps 2 --save-every 1 --out " + out.string()).status, 0);
+  EXPECT_TRUE(fs::exists(out / "frame_00002.ply"));
+  for (const char* stale : {"frame_00003.ply", "frame_00004.ply", "frame_00005.ply"}) EXPECT_FALSE(fs::exists(out / stale)) << stale;
+}
+
+TEST(Cli, EnvironmentRecordsTheThreadsThatRan) {
+  // config.threads is the request; environment.threads what TBB could give (at most the cores).
+  const fs::path out = temp_dir() / "out_threads";
+  ASSERT_EQ(mcfbench("flow --mesh icosphere:level=1 --steps 1 --threads 4096 --out " + out.string()).status, 0);
+  std::ifstream in(out / "result.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["config"]["threads"], 4096);
+  EXPECT_GE(j["environment"]["threads"].get<int>(), 1);
+  EXPECT_LE(j["environment"]["threads"].get<int>(), j["environment"]["cores"].get<int>());
+  const fs::path cfg = write("threads.json", R"({"name": "t", "defaults": {"mesh": "icosphere:level=1", "steps": 1}})");
+  for (const char* bad : {"99999", "-1"}) {
+    const CommandResult r = mcfbench("run " + cfg.string() + " --threads " + bad + " --out " + (temp_dir() / "out_run_threads").string());
+    EXPECT_NE(r.status, 0) << bad;
+    EXPECT_NE(r.err.find("--threads"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(temp_dir() / "out_run_threads"));
+}
+
 TEST(Cli, HelpExplainsEveryOption) {
   const fs::path help = temp_dir() / "help.txt";
   std::system((std::string(MCFBENCH_BINARY) + " flow --help > " + help.string()).c_str());
@@ -113,6 +155,8 @@ TEST(Cli, HelpExplainsEveryOption) {
                           "--cycles", "--smooth", "--integrator", "--dt", "--steps", "--normalize-area", "--threads",
                           "--save-every", "--out"})
     EXPECT_NE(ss.str().find(opt), std::string::npos) << opt;
+  // Every solver name the config accepts is listed.
+  for (const char* solver : {"cholmod", "pcg", "multigrid", "dense"}) EXPECT_NE(ss.str().find(solver), std::string::npos) << solver;
 }
 
 }  // namespace
