@@ -154,7 +154,9 @@ FileCounts scan_obj(const std::string& path) {
   counts.vertices = 0;
   counts.triangles = 0;
   std::string line;
+  long long line_number = 0, max_index = 0, max_index_line = 0;
   while (std::getline(in, line)) {
+    ++line_number;
     line = clean_line(line);
     if (line.size() < 2) continue;
     if (line[0] == 'v' && std::isspace(static_cast<unsigned char>(line[1]))) {
@@ -172,12 +174,28 @@ FileCounts scan_obj(const std::string& path) {
       std::istringstream fs_(line.substr(2));
       std::string tok;
       long long k = 0;
-      while (fs_ >> tok) ++k;
+      while (fs_ >> tok) {
+        ++k;
+        // "v", "v/vt", "v/vt/vn" or "v//vn"; a negative v counts back from the last vertex read.
+        // OpenMesh drops a face with a bad index as "non-manifold", which hides the real cause.
+        char* end = nullptr;
+        const long long v = std::strtoll(tok.c_str(), &end, 10);
+        if (end == tok.c_str() || (*end != '\0' && *end != '/') || v == 0 || (v < 0 && -v > counts.vertices))
+          fail(path, "line " + std::to_string(line_number) + ": face corner '" + tok + "' is not a vertex index (1.." +
+                         std::to_string(counts.vertices) + " or -1..-" + std::to_string(counts.vertices) + " so far)");
+        if (v > max_index) {
+          max_index = v;
+          max_index_line = line_number;
+        }
+      }
       if (k < 3) fail(path, "face with fewer than 3 corners: '" + line + "'");
       counts.triangles += k - 2;
     }
   }
   if (counts.vertices == 0 && counts.triangles == 0) fail(path, "no vertex or face records (not an OBJ file?)");
+  if (max_index > counts.vertices)
+    fail(path, "line " + std::to_string(max_index_line) + ": face refers to vertex " + std::to_string(max_index) +
+                   " but the file has " + std::to_string(counts.vertices) + " vertices");
   return counts;
 }
 

@@ -39,7 +39,7 @@ void add_distance_command(CLI::App& app, std::function<int()>& run) {
   cmd->footer("A and B: mesh files (read as is, never rescaled) or mesh specs:\n" + mesh_spec_help());
   cmd->add_option("A", args->a, "First surface: file or mesh spec")->required();
   cmd->add_option("B", args->b, "Second surface: file or mesh spec")->required();
-  cmd->add_option("--samples", args->samples, "Samples per surface")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--samples", args->samples, "Samples per surface")->check(CLI::Range(1LL, 1000000000LL))->capture_default_str();
   cmd->add_option("--seed", args->seed, "Random seed (same seed, same samples, same answer)")->capture_default_str();
   cmd->callback([args, &run] {
     run = [args]() -> int {

@@ -152,6 +152,29 @@ TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
   EXPECT_NE(c.err.find("\"seconds.totl\""), std::string::npos) << c.err;
 }
 
+TEST(CompareCli, AccuracyIsTheReferenceDistanceWhereThereIsOne) {
+  // Octree-vs-cotangent studies: accuracy is the last distance to the reference flow, which
+  // takes precedence over the radial error (here unchanged, so only the distance can flag it).
+  const fs::path dir = fresh_dir("compare_distance");
+  make_set(dir / "old", "aaaa", 1.0, 0.03, 1.0, 1);
+  for (const char* name : {"near", "far"}) {
+    fs::create_directories(dir / name);
+    for (const auto& f : result_files(dir / "old")) {
+      json r = read_json(f);
+      r["environment"]["commit"] = name;
+      const double d = std::string(name) == "far" ? 2e-3 : 1e-3;
+      r["reference_distance"] = json::array({{{"step", 1}, {"rms", 9.0}}, {{"step", 15}, {"rms", d}}});
+      std::ofstream(dir / name / f.filename()) << r.dump();
+    }
+  }
+  Command c = mcfbench("compare near far --all", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("| 0.001 | 0.002 | 2.000 | **less accurate**"), std::string::npos) << c.out;
+  c = mcfbench("compare far near", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("more accurate"), std::string::npos) << c.out;
+}
+
 TEST(CompareCli, InjectedSlowdownOnARealRun) {
   const fs::path dir = fresh_dir("compare_real");
   write_text(dir / "c.json", R"({"name": "c", "defaults": {"mesh": "icosphere:level=3", "steps": 30, "dt": 1e-4, "threads": 1}})");

@@ -85,7 +85,11 @@ TEST(MeshIo, NanCoordinate) {
 TEST(MeshIo, IndexOutOfRange) {
   TempDir dir;
   expect_error_naming(dir.write("range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"), "vertex 7");
-  expect_error_naming(dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"));
+  expect_error_naming(dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "line 4: face refers to vertex 9");
+  expect_error_naming(dir.write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "line 4: face corner '0'");
+  expect_error_naming(dir.write("back.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n"), "face corner '-4'");
+  // Relative (negative) and textured/normal forms of valid indices still load.
+  EXPECT_EQ(read_mesh(dir.write("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf -3/1/1 2//1 3/1\n")).num_faces(), 1);
   expect_error_naming(dir.write("range.ply",
                                 "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"

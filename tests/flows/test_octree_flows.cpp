@@ -102,7 +102,10 @@ TEST(OctreeFlows, TrackedFollowsTheSemiImplicitRadius) {
     ASSERT_EQ(r.result["status"], "ok");
     const double et = last(t, "radial_error", "rms"), er = last(r, "radial_error", "rms");
     EXPECT_LT(et, 1.5e-3) << solver.dump();  // the level-4 mesh alone is ~7e-4 off the sphere (sagitta)
-    EXPECT_LE(et, er) << solver.dump() << " tracked " << et << " rebuilt " << er;
+    // Not merely no worse: an order of magnitude better (measured 8.6e-4 vs 4.6e-2 with CHOLMOD,
+    // 6.7e-4 vs 1.6e-2 with three W-cycles; the README's "2.2e-4 vs 1.2e-2" is level 5, depth 6).
+    // The rebuilt basis re-integrates the flat-faced mesh every step and drifts inward.
+    EXPECT_LT(et, 0.1 * er) << solver.dump() << " tracked " << et << " rebuilt " << er;
     // The radius moved a lot (r² ≈ 1 - 4t), so this is not a trivially small error.
     double radius = 1;
     for (int n = 0; n < 100; ++n) radius = radius * radius * radius / (radius * radius + 2e-3);
