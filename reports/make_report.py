@@ -79,7 +79,12 @@ def main(argv):
         else:
             common.warn("no report module for study %r; frames only" % study)
         ok &= run_module("frames", results, out_dir, reference, written)
-        sections.append((study, src, written))
+        # A cell whose flow threw has no steps: the figures cannot show it, so the index says so.
+        errored = [r for r in results if r.get("status") == "error"]
+        if errored:
+            common.warn("%s: %d cell(s) errored and are missing from its figures (listed in index.md)"
+                        % (study, len(errored)))
+        sections.append((study, src, written, errored))
     index.make(out_dir, sections)
     return 0 if ok else 1
 

@@ -54,6 +54,12 @@ grep -q "1.4 + 0.22" "$work/out/table1.md" || { echo "FAIL: table1 lacks the pap
 grep -qE "\| ([a-z]+: )?bdf2 \| 2\.00 \|" "$work/out/time_order.md" || { echo "FAIL: bdf2 order not fitted as 2"; fail=1; }
 grep -qE "\| ([a-z]+: )?semi-implicit \| 1\.00 \|" "$work/out/time_order.md" || { echo "FAIL: semi-implicit order not 1"; fail=1; }
 grep -q "singular" "$work/out/cmcf_summary.md" || { echo "FAIL: singular stop not in cmcf summary"; fail=1; }
+# The fake time_order set holds one cell with status "error" (explicit, dt = 1e-3): the figures
+# cannot show it, so the index lists it under its study with the reason.
+grep -q '^\*\*1 cell(s) errored\*\*' "$work/out/index.md" || { echo "FAIL: index.md does not say a cell errored"; fail=1; }
+grep -qF -- '- cell 6 `dt=0.001 integrator=explicit`: diverged' "$work/out/index.md" \
+  || { echo "FAIL: index.md does not list the errored cell"; fail=1; }
+[ "$(grep -c 'cell(s) errored' "$work/out/index.md")" = 1 ] || { echo "FAIL: errored cells reported for a study without any"; fail=1; }
 for f in "$work"/out/*.png "$work"/out/*.md; do
   b=$(basename "$f"); [ "$b" = index.md ] && continue
   grep -q "$b" "$work/out/index.md" || { echo "FAIL: index.md does not link $b"; fail=1; }
