@@ -129,6 +129,7 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
   }
   set.commit = *commits.begin();
   set.study = *studies.begin();
+  bool any_steps = false;
   for (const json& r : results) {
     const json& cell = r["cell"];
     const std::string key = cell.value("config_key", cell.value("key", ""));
@@ -136,6 +137,7 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
     c.label = label_of(cell.value("assignment", json::object()), key);
     ++c.repetitions;
     const std::string status = r.value("status", "error");
+    if (status == "error") ++c.errored;
     if (status != "ok") {
       if (c.failed++ == 0) {
         std::string reason = r.contains("stop") && r["stop"].is_object() ? r["stop"].value("reason", "") : "";
@@ -144,6 +146,7 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
     }
     const int steps = r.contains("steps") && r["steps"].is_array() ? int(r["steps"].size()) : 0;
     c.min_steps = c.min_steps < 0 ? steps : std::min(c.min_steps, steps);
+    any_steps = any_steps || steps > 0;
     if (r.contains("steps"))
       for (const auto& s : r["steps"]) {
         const json* v = json_at_path(s, metric);
@@ -152,9 +155,11 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
     const double err = accuracy_of(r);
     if (std::isfinite(err)) c.errors.push_back(err);
   }
+  // Cells with steps but not one value: the metric's name is wrong. (Cells without any step,
+  // all errored, are compared as failures instead.)
   bool any_value = false;
   for (const auto& [key, c] : set.cells) any_value = any_value || !c.values.empty();
-  if (!any_value)
+  if (any_steps && !any_value)
     throw std::runtime_error(dir_at_commit + ": no step of any cell has the metric \"" + metric +
                              "\" (--metric is a dotted path in steps[], e.g. seconds.total, seconds.solve, radial_error.rms)");
   return set;
@@ -191,7 +196,7 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
     }
     c.old_steps = std::max(old.min_steps, 0);
     c.new_steps = std::max(n.min_steps, 0);
-    c.failed = n.failed > 0 && old.failed == 0;
+    c.failed = (n.failed > 0 && old.failed == 0) || (n.errored > 0 && old.errored == 0);
     c.failure = n.failure;
     c.stopped_earlier = c.new_steps < c.old_steps;
     rep.regression = rep.regression || c.slower || c.less_accurate || c.failed || c.stopped_earlier;

@@ -17,6 +17,7 @@ struct CellSamples {
   std::vector<double> errors;        ///< accuracy per repetition (final reference distance or radial rms)
   int repetitions = 0;
   int failed = 0;                    ///< repetitions whose status is not "ok" (singular or error)
+  int errored = 0;                   ///< of those, the ones with status "error" (the flow threw)
   std::string failure;               ///< the first such repetition's status and stop reason
   int min_steps = -1;                ///< fewest steps any repetition recorded
 };
@@ -30,7 +31,7 @@ struct ResultSet {
 /// those of COMMIT (a prefix) when given. A folder holding several commits without @COMMIT is
 /// an error listing them (timings of different code must not be pooled). `metric` is the
 /// dotted path of the per-step value ("seconds.total", "radial_error.rms", ...).
-/// When no step of any cell has `metric` (a misspelt --metric), the set is an error too.
+/// When cells have steps but none of them has `metric` (a misspelt --metric), that is an error.
 ResultSet load_result_set(const std::string& dir_at_commit, const std::string& metric);
 
 struct CompareOptions {
@@ -46,8 +47,9 @@ struct CellComparison {
   bool has_error = false;
   double old_error = 0, new_error = 0, error_ratio = 1;
   bool slower = false, faster = false, less_accurate = false;
-  /// NEW failed (status not "ok") where OLD never did, or stopped earlier than OLD's fewest
-  /// steps: a regression whatever the timings say (a cell that errors has no timings at all).
+  /// NEW failed (status not "ok") where OLD never did, or errored where OLD at worst stopped as
+  /// singular, or stopped earlier than OLD's fewest steps: a regression whatever the timings say
+  /// (a cell that errors has no timings at all).
   bool failed = false, stopped_earlier = false;
   std::string failure;
   int old_steps = 0, new_steps = 0;

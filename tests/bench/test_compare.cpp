@@ -136,6 +136,26 @@ TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
   // The reverse is not a regression: NEW fixed what OLD got wrong.
   c = mcfbench("compare errored old", dir);
   EXPECT_EQ(c.status, 0) << c.out << c.err;
+  // A cell that stopped as singular in OLD (say a pinch) and errors in NEW is still a failure.
+  variant("errored_where_stopped", [](json& r) {
+    r["status"] = "error";
+    r["stop"] = {{"step", 0}, {"reason", "error: boom"}};
+    r["steps"] = json::array();
+  }, "aaaa21.json");
+  c = mcfbench("compare stopped errored_where_stopped", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("**failed** (error: error: boom)"), std::string::npos) << c.out;
+  // A NEW whose every cell errored (no steps at all) is a regression table, not a metric error.
+  variant("all_errored", [](json&) {}, "");
+  for (const auto& f : result_files(dir / "all_errored")) {
+    json r = read_json(f);
+    r["status"] = "error";
+    r["steps"] = json::array();
+    std::ofstream(f) << r.dump();
+  }
+  c = mcfbench("compare old all_errored", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("3 cells compared, 3 changed"), std::string::npos) << c.out;
   // A cell missing from NEW.
   variant("missing", [](json&) {}, "");
   fs::remove(dir / "missing" / "aaaa20.json");
