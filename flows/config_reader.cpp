@@ -9,16 +9,33 @@ namespace mcf {
 nlohmann::json read_config_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open config file");
-  // Duplicate keys: nlohmann keeps the last one without a word, so track each open object's keys.
-  std::vector<std::set<std::string>> open_objects;
+  // nlohmann keeps the last of two equal keys without a word, and its number-overflow error names
+  // no key: follow the open objects and arrays to name the dotted path ("axes.dt[]") either way.
+  struct Level {
+    bool array = false;
+    std::string key;  // the object's current key
+    std::set<std::string> keys;
+  };
+  std::vector<Level> open;
+  auto dotted = [&open] {
+    std::string p;
+    for (const Level& l : open) {
+      if (l.array) p += "[]";
+      else if (!l.key.empty()) p += (p.empty() ? "" : ".") + l.key;
+    }
+    return p;
+  };
   std::string duplicate;
   const nlohmann::json::parser_callback_t track = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
     using E = nlohmann::json::parse_event_t;
-    if (event == E::object_start) open_objects.emplace_back();
-    else if (event == E::object_end && !open_objects.empty()) open_objects.pop_back();
-    else if (event == E::key && !open_objects.empty() && !open_objects.back().insert(parsed.get<std::string>()).second &&
-             duplicate.empty())
-      duplicate = parsed.get<std::string>();
+    if (event == E::object_start || event == E::array_start) {
+      open.push_back(Level{event == E::array_start, "", {}});
+    } else if (event == E::object_end || event == E::array_end) {
+      if (!open.empty()) open.pop_back();
+    } else if (event == E::key && !open.empty()) {
+      open.back().key = parsed.get<std::string>();
+      if (!open.back().keys.insert(open.back().key).second && duplicate.empty()) duplicate = dotted();
+    }
     return true;
   };
   nlohmann::json j;
@@ -26,10 +43,10 @@ nlohmann::json read_config_file(const std::string& path) {
     j = nlohmann::json::parse(in, track);
   } catch (const nlohmann::json::parse_error& e) {
     throw ConfigError(path + ": JSON parse error: " + e.what());
-  } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range.406: number overflow
-    throw ConfigError(path + ": " + e.what());
+  } catch (const nlohmann::json::exception& e) {  // out_of_range.406: a number beyond double range
+    throw ConfigError(path + ": " + (open.empty() ? std::string() : dotted() + ": ") + e.what());
   }
-  if (!duplicate.empty()) throw ConfigError(path + ": key \"" + duplicate + "\" appears twice in one object");
+  if (!duplicate.empty()) throw ConfigError(path + ": " + duplicate + ": key appears twice in one object (JSON would keep the last)");
   return j;
 }
 
