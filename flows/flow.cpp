@@ -149,6 +149,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
                     {"boundary_loops", rep.boundary_loops},
                     {"genus", rep.genus},
                     {"components", rep.connected_components},
+                    {"unreferenced_vertices", rep.unreferenced_vertices},
                     {"area", rep.area},
                     {"analytic", source.analytic}};
 

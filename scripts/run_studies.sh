@@ -2,7 +2,8 @@
 # Runs studies of bench/configs (all by default) and regenerates their report.
 #   scripts/run_studies.sh [--quick] [--out DIR] [STUDY ...]
 # Results: DIR/results/<study>/ (one JSON per cell; reruns skip finished cells),
-# report: DIR/report/index.md. Default DIR: out/studies (out/studies-quick with --quick).
+# report: DIR/report/index.md, of every study under DIR/results (also those run earlier).
+# Default DIR: out/studies (out/studies-quick with --quick).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${MCFBENCH_BUILD:-$root/build}
@@ -24,8 +25,10 @@ dirs=()
 for s in "${studies[@]}"; do
   echo "== study $s ${quick}" >&2
   "$build/mcfbench" run "$root/bench/configs/$s.json" $quick --out "$out/results/$s" || status=1
-  dirs+=("$out/results/$s")
 done
+# The report covers every study with results under DIR, not only those run now: running one
+# study must not drop the others from DIR/report/index.md.
+for d in "$out"/results/*/; do [ -d "$d" ] && dirs+=("${d%/}"); done
 /usr/bin/python3 "$root/reports/make_report.py" "${dirs[@]}" "$out/report" --references "$root/bench/configs" || status=1
 echo "report: $out/report/index.md" >&2
 exit $status

@@ -49,7 +49,7 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
       json files = json::array();
       std::map<std::string, Group> groups;
       std::set<std::string> seen_hash;
-      json duplicates = json::array();
+      json duplicates = json::array(), unreadable = json::array();
       for (const auto& dir : a->dirs) {
         if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder");
         std::vector<fs::path> paths;
@@ -63,7 +63,11 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
             std::ifstream in(path);
             r = json::parse(in);
           } catch (const json::parse_error& e) {
-            throw std::runtime_error(path.string() + ": JSON parse error: " + e.what());
+            // Not written by the atomic writer (a copy cut short, an editor): list it and go on;
+            // `mcfbench run` replaces such a file on its next pass.
+            unreadable.push_back({{"file", path.string()}, {"error", e.what()}});
+            std::printf("%s: unreadable (%s); rerun `mcfbench run` to redo its cell\n", path.c_str(), e.what());
+            continue;
           }
           if (!r.is_object() || !r.contains("cell")) continue;
           const json& c = r["cell"];
@@ -98,7 +102,7 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         }
       }
       json studies = json::array();
-      bool problems = !duplicates.empty();
+      bool problems = !duplicates.empty() || !unreadable.empty();
       for (auto& [name, g] : groups) {
         json s = {{"study", g.study}, {"quick", g.quick}, {"commit", g.commit}, {"cells_found", g.files_by_index.size()}};
         json missing = json::array(), dup = json::array();
@@ -145,9 +149,10 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         studies.push_back(s);
       }
       const std::string out = !a->out.empty() ? a->out : (fs::path(a->dirs.front()) / "index.json").string();
-      write_file_atomic(out, json{{"schema", 1}, {"dirs", a->dirs}, {"studies", studies}, {"duplicates", duplicates}, {"files", files}}.dump(1) + "\n");
+      write_file_atomic(out, json{{"schema", 1}, {"dirs", a->dirs}, {"studies", studies}, {"duplicates", duplicates},
+                                   {"unreadable", unreadable}, {"files", files}}.dump(1) + "\n");
       std::printf("wrote %s (%zu result files)%s\n", out.c_str(), files.size(),
-                  problems ? "; INCOMPLETE (missing or errored) or DUPLICATED cells" : "");
+                  problems ? "; INCOMPLETE (missing, errored or unreadable) or DUPLICATED cells" : "");
       return problems ? 1 : 0;
     };
   });

@@ -36,7 +36,9 @@ void add_distance_command(CLI::App& app, std::function<int()>& run) {
       "Metro-style distance between two surfaces: uniform area sampling of each, exact point-to-triangle "
       "distance to the other through a BVH. Prints JSON {rms_forward, max_forward, rms_backward, max_backward, "
       "rms, max, samples} (forward: samples of A to B; max = Hausdorff).");
-  cmd->footer("A and B: mesh files (read as is, never rescaled) or mesh specs:\n" + mesh_spec_help());
+  cmd->footer("A and B: an existing mesh file is read as is, NOT scaled into the unit cube (a flow's output is\n"
+              "already in its flow's frame); anything else is a mesh spec, handled as everywhere else:\n" +
+              mesh_spec_help());
   cmd->add_option("A", args->a, "First surface: file or mesh spec")->required();
   cmd->add_option("B", args->b, "Second surface: file or mesh spec")->required();
   cmd->add_option("--samples", args->samples, "Samples per surface")->check(CLI::Range(1LL, 1000000000LL))->capture_default_str();

@@ -190,6 +190,10 @@ TEST(RunnerCli, RerunRetriesErroredAndUnreadableCellsAndCollectCountsErrors) {
     if (read_json(f)["status"] == "ok") good = f;
   ASSERT_FALSE(good.empty());
   write_text(good, "{\"status\": \"ok\", \"tru");
+  c = mcfbench("collect out", dir);  // listed, not a crash
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find(good.filename().string() + ": unreadable"), std::string::npos) << c.out;
+  EXPECT_EQ(read_json(dir / "out" / "index.json")["unreadable"].size(), 1u);
   c = mcfbench("run e.json --out out", dir);
   EXPECT_NE(c.out.find("2 ran (2 retried after an error), 0 skipped, 1 errors"), std::string::npos) << c.out;
   EXPECT_EQ(read_json(good)["status"], "ok");

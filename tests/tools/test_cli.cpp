@@ -93,6 +93,8 @@ TEST(Cli, FlowWritesTheResultContract) {
   for (const char* key : {"schema", "status", "stop", "config", "environment", "mesh", "system", "steps", "peak_memory_bytes"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["steps"].size(), 4u);
+  EXPECT_EQ(j["mesh"]["unreferenced_vertices"], 0);  // the README lists it beside genus and components
+  EXPECT_EQ(j["mesh"]["genus"], 0);
   EXPECT_TRUE(j["steps"][0]["radial_error"].contains("rms_continuous"));
   for (const char* key : {"commit", "cpu", "cores", "threads", "libraries"}) EXPECT_TRUE(j["environment"].contains(key)) << key;
   EXPECT_EQ(j["config"]["solver"]["name"], "cholmod");
