@@ -216,6 +216,7 @@ MeshSource load_mesh_spec(const std::string& spec) {
         fail(spec, e.what());
       }
       if (name == "sphere" || name == "icosphere") src.sphere_radius = values.at("radius");
+      if (name == "open_cylinder") src.cylinder_radius = values.at("radius");
     }
   }
 
@@ -223,6 +224,13 @@ MeshSource load_mesh_spec(const std::string& spec) {
     src.mesh = subdivide_to_faces(src.mesh, target_faces);
     // Midpoints of a sphere lie inside it; put them back so sphere_radius stays exact.
     if (src.sphere_radius) src.mesh.vertices = src.mesh.vertices.rowwise().normalized() * *src.sphere_radius;
+    // Likewise chord midpoints around a cylinder: back onto radius r about the z axis.
+    if (src.cylinder_radius)
+      for (Eigen::Index v = 0; v < src.mesh.vertices.rows(); ++v) {
+        const double rho = std::hypot(src.mesh.vertices(v, 0), src.mesh.vertices(v, 1));
+        src.mesh.vertices(v, 0) *= *src.cylinder_radius / rho;
+        src.mesh.vertices(v, 1) *= *src.cylinder_radius / rho;
+      }
   }
   src.report = validate_mesh(src.mesh, validate_name);
   return src;

@@ -22,6 +22,7 @@ struct MeshSource {
   std::string kind;           ///< "sphere", "icosphere", "cgal", "file", ...
   bool analytic = false;      ///< generated shape (keeps its size); real models are unit-cube scaled
   std::optional<double> sphere_radius;  ///< set for sphere and icosphere (centre at the origin)
+  std::optional<double> cylinder_radius;  ///< set for open_cylinder (axis z through the origin)
   MeshReport report;          ///< validation report (validate_mesh has passed)
 };
 

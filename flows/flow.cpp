@@ -6,6 +6,7 @@
 #include "flows/integrator.h"
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
+#include "flows/cylinder_reference.h"
 #include "flows/sphere_reference.h"
 #include "solvers/symmetric_multiply.h"
 
@@ -176,6 +177,8 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
   double previous_area = area0;
   std::optional<SphereReference> sphere;
   if (source.sphere_radius && !config.normalize_area) sphere.emplace(*source.sphere_radius, config.flow == "heat");
+  std::optional<CylinderReference> cylinder;
+  if (source.cylinder_radius && !config.normalize_area) cylinder.emplace(*source.cylinder_radius, config.flow, V);
 
   if (observer.on_step) observer.on_step(0, 0.0, V);
   nlohmann::json steps = nlohmann::json::array();
@@ -256,6 +259,13 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
 
     record["area"] = area;
     record["step_difference"] = step_difference;
+    if (cylinder) {
+      cylinder->advance(config.dt);
+      record["cylinder"] = {{"ring_radius", cylinder->ring_radius(V_new)},
+                            {"radius_semi_implicit", cylinder->discrete},
+                            {"radius_continuous", cylinder->continuous(t)},
+                            {"ring_vertices", cylinder->ring.size()}};
+    }
     if (sphere) {
       sphere->advance(config.dt);
       const RadialError d = radial_error(V_new, sphere->discrete);

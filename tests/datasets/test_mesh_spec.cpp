@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <string>
 
 namespace mcf {
@@ -50,6 +52,17 @@ TEST(MeshSpec, Sphere) {
   EXPECT_EQ(s.report.vertices, s.mesh.num_vertices());
   EXPECT_TRUE(s.report.closed());
   EXPECT_EQ(s.report.genus, 0);
+}
+
+TEST(MeshSpec, OpenCylinderKeepsItsRadiusUnderSubdivision) {
+  // cylinder_radius feeds the cylinder reference radii; @faces puts chord midpoints back on it.
+  const MeshSource s = load_mesh_spec("open_cylinder:radius=0.7,n_around=12,n_along=4@faces=2000");
+  ASSERT_TRUE(s.cylinder_radius.has_value());
+  EXPECT_DOUBLE_EQ(*s.cylinder_radius, 0.7);
+  EXPECT_GE(s.mesh.num_faces(), 2000);
+  for (Eigen::Index v = 0; v < s.mesh.num_vertices(); ++v)
+    EXPECT_NEAR(std::hypot(s.mesh.vertices(v, 0), s.mesh.vertices(v, 1)), 0.7, 1e-14) << v;
+  EXPECT_FALSE(load_mesh_spec("icosphere:level=1").cylinder_radius.has_value());
 }
 
 TEST(MeshSpec, IcosphereWithFacesStaysOnTheSphere) {

@@ -218,7 +218,32 @@ double middle_radius(const std::string& flow) {
       ++count;
     }
   EXPECT_GT(count, 0);
+  // The flow reports the same ring (the input's vertices nearest half height) and the cylinder's
+  // semi-implicit recursion and continuous radius (flows/cylinder_reference.h), checked here
+  // against this test's own formulas.
+  const auto& c = o.result["steps"].back()["cylinder"];
+  EXPECT_EQ(c["ring_vertices"], count) << flow;
+  EXPECT_NEAR(c["ring_radius"].get<double>(), sum / count, 1e-12) << flow;
+  double r = 1;
+  for (int n = 0; n < 100; ++n)
+    r = flow == "mcf" ? r * r * r / (r * r + 1e-3) : flow == "cmcf" ? r * r / (r + 1e-3) : r / (1 + 1e-3);
+  EXPECT_NEAR(c["radius_semi_implicit"].get<double>(), r, 1e-14) << flow;
+  const double t = 0.1, continuous = flow == "mcf" ? std::sqrt(1 - 2 * t) : flow == "cmcf" ? 1 - t : std::exp(-t);
+  EXPECT_NEAR(c["radius_continuous"].get<double>(), continuous, 1e-14) << flow;
   return sum / count;
+}
+
+TEST(CylinderFlows, RecordedOnlyForUnnormalizedOpenCylinders) {
+  const auto normalized = testing::run(nlohmann::json{{"mesh", "open_cylinder:n_around=16,n_along=8"}, {"steps", 1},
+                                                      {"normalize_area", true}});
+  EXPECT_FALSE(normalized.result["steps"][0].contains("cylinder"));
+  const auto sphere = testing::run(nlohmann::json{{"mesh", "icosphere:level=1"}, {"steps", 1}});
+  EXPECT_FALSE(sphere.result["steps"][0].contains("cylinder"));
+  // Radius 0.5: the recursion uses r0 (cMCF: r_n² / (r_n + δ/r0)).
+  const auto half = testing::run(nlohmann::json{{"mesh", "open_cylinder:radius=0.5,n_around=16,n_along=8"}, {"flow", "cmcf"},
+                                                {"steps", 1}, {"dt", 1e-2}});
+  EXPECT_NEAR(half.result["steps"][0]["cylinder"]["radius_semi_implicit"].get<double>(), 0.25 / (0.5 + 1e-2 / 0.5), 1e-15);
+  EXPECT_NEAR(half.result["steps"][0]["cylinder"]["radius_continuous"].get<double>(), 0.5 - 1e-2 / 0.5, 1e-15);
 }
 
 TEST(CylinderFlows, RadiiFollowTheCmcfPapersTable) {
