@@ -146,6 +146,12 @@ def main(root):
               result(s, i, {"flow": flow}, config(mesh="dumbbell", flow=flow),
                      [step(n, 1e-3, extra=metrics) for n in range(1, steps + 1)], status=status,
                      reason="pinched" if status != "ok" else "completed"))
+    # An unnormalised open cylinder (cMCF: the middle ring against r0 - t/r0) for the analytic table.
+    ring = lambda n: {"cylinder": {"ring_radius": 1 - n * 1e-3 - 5e-4, "radius_semi_implicit": 1 - n * 1e-3 + 1e-5,  # noqa: E731
+                                   "radius_continuous": 1 - n * 1e-3, "ring_vertices": 32}}
+    write(os.path.join(root, s), "cell_003",
+          result(s, 3, {"flow": "cmcf", "mesh": "open_cylinder"}, config(mesh="open_cylinder", flow="cmcf"),
+                 [step(n, 1e-3, extra=ring) for n in range(1, 11)]))
     frames(os.path.join(root, s), "cell_002", 8, 60, 120)  # 14k faces × ... decimation exercised below
     frames(os.path.join(root, s), "cell_001", 3, 110, 220)  # ~48k faces: decimated
     # time_order: two integrators × dts (error ∝ dt and dt²), one unstable explicit run.

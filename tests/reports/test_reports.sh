@@ -54,6 +54,11 @@ grep -q "1.4 + 0.22" "$work/out/table1.md" || { echo "FAIL: table1 lacks the pap
 grep -qE "\| ([a-z]+: )?bdf2 \| 2\.00 \|" "$work/out/time_order.md" || { echo "FAIL: bdf2 order not fitted as 2"; fail=1; }
 grep -qE "\| ([a-z]+: )?semi-implicit \| 1\.00 \|" "$work/out/time_order.md" || { echo "FAIL: semi-implicit order not 1"; fail=1; }
 grep -q "singular" "$work/out/cmcf_summary.md" || { echo "FAIL: singular stop not in cmcf summary"; fail=1; }
+# The analytic table: the open cylinder's ring (0.98950 at t = 0.01) beside its references (the
+# fake dumbbell runs have no mean radius, so they stay out of it).
+grep -qF "| open_cylinder | cmcf | 0.001 | 0.01 | 0.98950 | 0.99001 | 0.99000 | 5.10e-04 | 5.00e-04 |" "$work/out/cmcf_summary.md" \
+  || { echo "FAIL: cmcf summary lacks the cylinder's analytic row"; fail=1; }
+[ "$(grep -c '^| dumbbell' "$work/out/cmcf_summary.md")" = 3 ] || { echo "FAIL: dumbbell rows in the analytic table"; fail=1; }
 # The fake time_order set holds one cell with status "error" (explicit, dt = 1e-3): the figures
 # cannot show it, so the index lists it under its study with the reason.
 grep -q '^\*\*1 cell(s) errored\*\*' "$work/out/index.md" || { echo "FAIL: index.md does not say a cell errored"; fail=1; }
