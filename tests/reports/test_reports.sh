@@ -77,6 +77,13 @@ done
 import sys
 sys.path.insert(0, sys.argv[1])
 import common, cmcf, time_order
+# The stability edge is drawn but not fitted: explicit Euler on MCF, level 4 (the full study).
+pts = [(3.9e-5, 1.29e-5), (7.8e-5, 2.58e-5), (1.56e-4, 5.17e-5), (3.1e-4, 1.03e-4), (6.25e-4, 5.11e-2)]
+fit = time_order.fitted_points(pts, [1.25e-3, 2.5e-3])
+assert fit == pts[:4], fit
+assert abs(time_order.fit_slope(fit) - 1.0) < 0.01, time_order.fit_slope(fit)
+assert time_order.fitted_points(pts[:1] + pts[4:], [1.25e-3]) == pts[:1] + pts[4:]  # two points: too few to drop one
+assert time_order.fitted_points(pts, []) == pts  # nothing unstable: no edge
 flows = ("mcf", "heat")
 keys = [(f, g, frozen) for f in flows for g in time_order.INTEGRATORS + ("rk4",) for frozen in (False, True)]
 style = time_order.styles(keys)
