@@ -45,7 +45,7 @@ nlohmann::json environment_json(int threads) {
           {"cores", cores},
           // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the
           // config asked for (that request is in "config.threads").
-          {"threads", std::min(threads > 0 ? threads : tbb::info::default_concurrency(), tbb::info::default_concurrency())},
+          {"threads", threads > 0 ? std::min(threads, tbb::info::default_concurrency()) : tbb::info::default_concurrency()},
           {"hostname", hostname()},
           {"build", {{"type", MCFBENCH_BUILD_TYPE}, {"compiler", MCFBENCH_CXX_COMPILER}}},
           {"libraries",

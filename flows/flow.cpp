@@ -3,10 +3,10 @@
 #include "datasets/validate.h"
 
 #include <Eigen/Geometry>
+#include "flows/cylinder_reference.h"
 #include "flows/integrator.h"
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
-#include "flows/cylinder_reference.h"
 #include "flows/sphere_reference.h"
 #include "solvers/symmetric_multiply.h"
 

@@ -147,9 +147,10 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       // Frames of an earlier run into the same folder would sit beside this run's result as if
       // they were its own: once the new result is in place, they go.
       for (const auto& entry : fs::directory_iterator(out)) {
-        const std::string name = entry.path().filename().string();
-        if (name.size() == 15 && name.rfind("frame_", 0) == 0 && entry.path().extension() == ".ply" && !frames.count(name))
-          fs::remove(entry.path());
+        const std::string stem = entry.path().stem().string(), name = entry.path().filename().string();
+        const bool frame = entry.path().extension() == ".ply" && stem.rfind("frame_", 0) == 0 && stem.size() > 6 &&
+                           stem.find_first_not_of("0123456789", 6) == std::string::npos;
+        if (frame && !frames.count(name)) fs::remove(entry.path());
       }
       const auto& stop = outcome.result["stop"];
       std::fprintf(stderr, "mcfbench flow: %s after %d steps (%s); wrote %s\n",
