@@ -66,6 +66,7 @@ class FlowStepContext final : public StepContext {
     ++solves_;
     iterations_ += r.iterations;
     last_ = r;
+    residuals_per_solve_.push_back(r.residuals);
     if (severity(r.status) >= severity(worst_.status)) worst_ = r;
     return Y;
   }
@@ -76,6 +77,7 @@ class FlowStepContext final : public StepContext {
     x_prev_ = prev;
     update_seconds_ = solve_seconds_ = 0;
     solves_ = iterations_ = 0;
+    residuals_per_solve_.clear();
     worst_ = SolveReport{};
     last_ = SolveReport{};
   }
@@ -89,6 +91,8 @@ class FlowStepContext final : public StepContext {
   double update_seconds_ = 0, solve_seconds_ = 0;
   int solves_ = 0, iterations_ = 0;
   SolveReport worst_, last_;
+  // Two-solve integrators (Taylor-2, Neumann-2): every solve's residuals, in order.
+  std::vector<std::vector<double>> residuals_per_solve_;
   std::size_t fixed() const { return system_->num_fixed(); }
 
  private:
@@ -212,6 +216,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
                         {"residuals", ctx.last_.residuals},
                         {"relative_residual", worst.relative_residual},
                         {"status", to_string(worst.status)}};
+    if (ctx.solves_ > 1) record["solver"]["residuals_per_solve"] = ctx.residuals_per_solve_;
     if (ctx.fixed()) record["fixed_functions"] = ctx.fixed();
     if (basis->rebuilds_every_step()) {
       record["dimension"] = basis->dimension();

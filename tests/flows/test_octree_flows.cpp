@@ -69,6 +69,34 @@ TEST(OctreeFlows, MultigridCyclesReduceTheResidual) {
   EXPECT_LT(r.back().get<double>(), 1e-4);
 }
 
+TEST(OctreeFlows, TwoSolveIntegratorsRecordEverySolvesResiduals) {
+  // Taylor-2 solves twice a step: `residuals` is the last solve's, `residuals_per_solve` has
+  // both, in order, each falling cycle by cycle; one-solve integrators do not write it.
+  for (const char* integrator : {"taylor2", "semi-implicit"}) {
+    json j = octree("icosphere:level=3", "tracked", 5, {{"name", "multigrid"}, {"cycles", 3}});
+    j["integrator"] = integrator;
+    j["steps"] = 2;
+    const auto o = run(j);
+    for (const auto& step : o.result["steps"]) {
+      const auto& s = step["solver"];
+      if (std::string(integrator) == "semi-implicit") {
+        EXPECT_EQ(s["solves"], 1);
+        EXPECT_FALSE(s.contains("residuals_per_solve"));
+        continue;
+      }
+      ASSERT_EQ(s["solves"], 2);
+      const auto& per = s["residuals_per_solve"];
+      ASSERT_EQ(per.size(), 2u);
+      EXPECT_EQ(per[1], s["residuals"]);
+      EXPECT_NE(per[0], per[1]);  // two different right-hand sides
+      for (const auto& r : per) {
+        ASSERT_EQ(r.size(), 3u);
+        EXPECT_LT(r[2].get<double>(), r[0].get<double>());
+      }
+    }
+  }
+}
+
 TEST(OctreeFlows, OneWCycleReducesTheResidualTenfoldAtDepth7) {
   const TriangleMesh sphere = make_icosphere(5);
   OctreeOptions o;
