@@ -111,15 +111,15 @@ MARKERS = "osD^vP*Xhp<>"
 
 
 def styles(keys):
-    """{variant() key: (colour, marker, linestyle, marker face)}: colour and marker by integrator
-    (the known ones first, in INTEGRATORS order, then others sorted), dashed with open markers
-    when the operators were frozen. Distinct within a flow for up to 10 integrators."""
-    integrators = sorted({integ for _, integ, _ in keys},
-                         key=lambda g: (INTEGRATORS.index(g) if g in INTEGRATORS else len(INTEGRATORS), g))
+    """{variant() key: (colour, marker, linestyle, marker face)}: colour and marker by integrator,
+    dashed with open markers when the operators were frozen. A known integrator has its place in
+    INTEGRATORS, so it looks the same in every report whichever others ran; others follow it,
+    sorted. Distinct within a flow for up to 10 integrators."""
+    others = sorted({integ for _, integ, _ in keys} - set(INTEGRATORS))
     out = {}
     for key in keys:
         _, integ, frozen = key
-        i = integrators.index(integ)
+        i = INTEGRATORS.index(integ) if integ in INTEGRATORS else len(INTEGRATORS) + others.index(integ)
         color = "C%d" % (i % 10)
         out[key] = (color, MARKERS[i % len(MARKERS)], "--" if frozen else "-", "none" if frozen else color)
     return out

@@ -99,6 +99,9 @@ for f in flows:
     mine = [style[k][:3] for k in keys if k[0] == f]
     assert len(set(mine)) == len(mine), "time_order: two variants of %s share a style" % f
 assert style[("mcf", "bdf2", False)][:2] == style[("heat", "bdf2", False)][:2], "time_order: bdf2 changes colour between panels"
+alone = time_order.styles([("mcf", "bdf2", False), ("mcf", "rk4", False)])
+assert alone[("mcf", "bdf2", False)] == style[("mcf", "bdf2", False)], "time_order: bdf2 changes style between reports"
+assert alone[("mcf", "rk4", False)] == style[("mcf", "rk4", False)], "time_order: an unknown integrator's style"
 r = {"_stem": "x", "config": {"basis": "octree", "solver": {"name": "multigrid"},
                               "octree": {"refine_input": True, "tracking": "rebuilt"}}}
 shown = ["basis", "octree.refine_input", "octree.tracking", "solver.name"]
