@@ -3,7 +3,8 @@
 tables of the README: rebuilt phases per mesh, and the per-step ratios (tracked vs rebuilt,
 tracked vs hat + CHOLMOD, 2 vs 1 threads, W-cycle / SpMV, bytes per cubature point) with their
 targets and the paper's values, and each multigrid level's visits and own time per V- and
-W-cycle. Ratios only compare benchmarks of the same JSON file (same run).
+W-cycle. Ratios only compare benchmarks of the same JSON file (same run); with
+--benchmark_repetitions each benchmark counts as the median of its repetitions.
 
 Usage: bench/summarize_micro.py micro_octree.json [> table.md]
 """
@@ -11,15 +12,39 @@ import json
 import sys
 
 
+def median(xs):
+    xs = sorted(xs)
+    n = len(xs)
+    return xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
+
+
 def load(path):
+    """(context, {name: benchmark}). With --benchmark_repetitions=N each benchmark has N
+    iteration runs (interleaved with the others under --benchmark_enable_random_interleaving):
+    its real time and every numeric counter are then their medians over the repetitions, so one
+    slow repetition does not set a ratio; "repetitions" says how many there were."""
     data = json.load(open(path))
-    out = {}
+    runs = {}
     for b in data.get("benchmarks", []):
         if b.get("run_type", "iteration") != "iteration":
             continue
         name = b.get("run_name", b["name"])
         # "BM_X/threads:2/iterations:5/real_time" -> "BM_X/threads:2"
         name = "/".join(p for p in name.split("/") if p != "real_time" and not p.startswith("iterations:"))
+        runs.setdefault(name, []).append(b)
+    out = {}
+    for name, rs in runs.items():
+        b = dict(rs[-1])
+        if len(rs) > 1:
+            scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+            unit = b.get("time_unit", "ns")
+            # Repetitions share their unit; convert anyway so a mixed file cannot skew the median.
+            b["real_time"] = median([r["real_time"] * scale[r.get("time_unit", "ns")] for r in rs]) / scale[unit]
+            for k, v in b.items():
+                if k != "real_time" and isinstance(v, (int, float)) and not isinstance(v, bool) and \
+                        all(isinstance(r.get(k), (int, float)) for r in rs):
+                    b[k] = median([r[k] for r in rs])
+        b["repetitions"] = len(rs)
         out[name] = b
     return data.get("context", {}), out
 
@@ -48,6 +73,10 @@ def main():
     lines = []
     lines.append(f"Machine: {ctx.get('host_name', '?')}, {ctx.get('num_cpus', '?')} CPUs "
                  f"@ {ctx.get('mhz_per_cpu', '?')} MHz, run {ctx.get('date', '?')}\n")
+    reps = sorted({x["repetitions"] for x in b.values()})
+    if reps and reps != [1]:
+        n = str(reps[0]) if len(reps) == 1 else f"{reps[0]}–{reps[-1]}"
+        lines.append(f"Times and counters: medians of {n} repetitions per benchmark.\n")
 
     # Rebuilt phases, one column per mesh.
     meshes = [(0, "armadillo"), (1, "sphere")]

@@ -7,7 +7,8 @@ root=$(cd "$here/../.." && pwd)
 py=/usr/bin/python3
 # bench/summarize_micro.py (no matplotlib needed) on a fabricated Google Benchmark file: the step
 # ratios, and each multigrid level's share of a W-cycle (100 of 400 ms = 25%; the 40 ms left are
-# the copies and the final residual, 10%).
+# the copies and the final residual, 10%); a benchmark repeated three times (one slow repetition)
+# counts as its median.
 [ -x "$py" ] || py=python3
 sw=$(mktemp -d)
 cat >"$sw/micro.json" <<'JSON'
@@ -20,11 +21,19 @@ cat >"$sw/micro.json" <<'JSON'
   {"name": "BM_Step_Tracked/threads:2/iterations:5/real_time", "run_type": "iteration", "time_unit": "ms",
    "real_time": 1000, "update_ms": 1, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
   {"name": "BM_Step_Rebuilt/threads:2/iterations:2/real_time", "run_type": "iteration", "time_unit": "ms",
-   "real_time": 4000, "rebuild_ms": 1, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1}]}
+   "real_time": 4000, "rebuild_ms": 1, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1},
+  {"name": "BM_Step_Tracked/threads:1/iterations:5/real_time", "run_type": "iteration", "time_unit": "ms",
+   "real_time": 1800, "update_ms": 700, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
+  {"name": "BM_Step_Tracked/threads:1/iterations:5/real_time", "run_type": "iteration", "time_unit": "ms",
+   "real_time": 2000, "update_ms": 800, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
+  {"name": "BM_Step_Tracked/threads:1/iterations:5/real_time", "run_type": "iteration", "time_unit": "ms",
+   "real_time": 9000, "update_ms": 900, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
+  {"name": "BM_Step_Tracked/threads:1_mean", "run_type": "aggregate", "time_unit": "ms", "real_time": 4267}]}
 JSON
 "$py" "$root/bench/summarize_micro.py" "$sw/micro.json" >"$sw/out.md" 2>&1 || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py"; exit 1; }
 for want in '| 1 | 2 | 100 | 25% |' '| outside the cycle (copies, final residual) |  | 40 | 10% |' \
-            '| rebuilt / tracked per step | 4× |'; do
+            '| rebuilt / tracked per step | 4× |' '| tracked, 1 thread | 2000 | update 800,' \
+            '| tracked 1 thread / 2 threads | 2× |' 'medians of 1–3 repetitions'; do
   grep -qF "$want" "$sw/out.md" || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py lacks: $want"; exit 1; }
 done
 rm -rf "$sw"
