@@ -154,6 +154,12 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
       }
     const double err = accuracy_of(r);
     if (std::isfinite(err)) c.errors.push_back(err);
+    const json* run = json_at_path(r, "run_seconds");
+    const json* steal = json_at_path(r, "steal_seconds");
+    if (run && steal && run->is_number() && steal->is_number()) {
+      set.run_seconds += run->get<double>();
+      set.steal_seconds += steal->get<double>();
+    }
   }
   // Cells with steps but not one value: the metric's name is wrong. (Cells without any step,
   // all errored, are compared as failures instead.)
@@ -217,6 +223,15 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, c
   md << "Metric `" << o.metric << "` per step (median over steps and repetitions); Mann–Whitney U, "
      << "slower/faster when the ratio passes 1±" << o.threshold << " with p < " << o.alpha
      << "; accuracy = final reference distance or radial error (RMS).\n\n";
+  if (old_set.run_seconds > 0 || new_set.run_seconds > 0) {
+    // Stolen time is CPU time of all vCPUs, run time is wall time: on a 2-vCPU guest the share
+    // can reach 200%. A slower NEW with a much larger share may be the machine, not the code.
+    const auto share = [](const ResultSet& s) {
+      return s.run_seconds > 0 ? fmt(100 * s.steal_seconds / s.run_seconds, "%.1f") + "%" : std::string("–");
+    };
+    md << "Hypervisor steal (CPU time the host gave other guests, all vCPUs) per cell run time: OLD "
+       << share(old_set) << ", NEW " << share(new_set) << ".\n\n";
+  }
   int changed = 0;
   std::ostringstream table;
   table << "| cell | old | new | new/old | p | old error | new error | error ratio | verdict |\n"

@@ -25,6 +25,9 @@ struct CellSamples {
 struct ResultSet {
   std::string dir, commit, study;
   std::map<std::string, CellSamples> cells;  ///< by config key
+  /// Sums over the cells that record both (`run_seconds`, `steal_seconds`): the share of their
+  /// run time that the hypervisor gave to other guests, to tell a noisy machine from slower code.
+  double run_seconds = 0, steal_seconds = 0;
 };
 
 /// Reads DIR[@COMMIT]: every cell result (*.json with a "cell" object) in DIR, keeping only

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <sys/resource.h>
 #include <thread>
@@ -62,6 +63,25 @@ long long peak_memory_bytes() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return static_cast<long long>(u.ru_maxrss) * 1024;
+}
+
+double steal_seconds_from_proc_stat(const std::string& text, long ticks_per_second) {
+  std::istringstream in(text);
+  std::string label;
+  in >> label;
+  if (label != "cpu" || ticks_per_second <= 0) return -1;
+  // user nice system idle iowait irq softirq steal (proc(5))
+  unsigned long long value = 0;
+  for (int field = 1; field <= 8; ++field)
+    if (!(in >> value)) return -1;
+  return double(value) / double(ticks_per_second);
+}
+
+double cpu_steal_seconds() {
+  std::ifstream in("/proc/stat");
+  std::string line;
+  if (!std::getline(in, line)) return -1;
+  return steal_seconds_from_proc_stat(line, ::sysconf(_SC_CLK_TCK));
 }
 
 }  // namespace mcf

@@ -1,7 +1,10 @@
 #pragma once
-// Where a result came from: git commit, CPU, cores, threads, library versions, peak memory.
+// Where a result came from: git commit, CPU, cores, threads, library versions, peak memory, and
+// the CPU time the hypervisor took away while it ran.
 
 #include <nlohmann/json.hpp>
+
+#include <string>
 
 namespace mcf {
 
@@ -10,5 +13,14 @@ namespace mcf {
 nlohmann::json environment_json(int threads);
 /// Peak resident set size of this process (getrusage), in bytes.
 long long peak_memory_bytes();
+
+/// CPU time the hypervisor gave to other guests while this one wanted to run ("steal", the
+/// eighth value of /proc/stat's aggregate `cpu` line), summed over all CPUs, in seconds since
+/// boot; -1 where the kernel does not report it. On shared 2-vCPU guests a slow benchmark
+/// repetition is often stolen time: the difference over a run tells noise from a regression.
+double cpu_steal_seconds();
+/// The steal field of /proc/stat's first line `text` at `ticks_per_second` (USER_HZ), in seconds;
+/// -1 if the line is not an aggregate `cpu` line with at least eight values.
+double steal_seconds_from_proc_stat(const std::string& text, long ticks_per_second);
 
 }  // namespace mcf

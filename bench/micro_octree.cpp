@@ -27,6 +27,7 @@
 #include "bases/octree_basis.h"
 #include "bases/octree_system.h"
 #include "bases/tracked_octree_basis.h"
+#include "bench/environment.h"
 #include "datasets/mesh_spec.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"
@@ -340,6 +341,18 @@ TrackedFixture& tracked_fixture() {
   });
 }
 
+/// Runs the timed iterations and records `steal_ms`: CPU time per iteration that the hypervisor
+/// gave to other guests (all vCPUs, /proc/stat's steal; -1 where unknown). A repetition much
+/// slower than its siblings with a large steal_ms was the machine, not the code.
+template <class Step>
+void timed_steps(benchmark::State& state, Step&& step) {
+  const double steal0 = cpu_steal_seconds();
+  for (auto _ : state) step(true);
+  const double steal1 = cpu_steal_seconds();
+  state.counters["steal_ms"] =
+      steal0 >= 0 && steal1 >= 0 ? 1e3 * (steal1 - steal0) / double(state.iterations()) : -1.0;
+}
+
 void step_counters(benchmark::State& state, const Case& c, const MeshSource& m, const BasisStats& s) {
   state.counters["dimension"] = double(s.dimension);
   state.counters["split_triangles"] = double(s.split_triangles);
@@ -385,7 +398,7 @@ void BM_Step_Tracked(benchmark::State& state) {
     t_eval += std::chrono::duration<double>(t4 - t3).count();
   };
   step(false);  // warm-up (see "Warm-up" at the top)
-  for (auto _ : state) step(true);
+  timed_steps(state, step);
   const double n = double(state.iterations());
   state.counters["update_ms"] = 1e3 * t_update / n;
   state.counters["set_matrix_ms"] = 1e3 * t_set / n;
@@ -464,7 +477,7 @@ void BM_Step_Rebuilt(benchmark::State& state) {
     t_eval += std::chrono::duration<double>(t4 - t3).count();
   };
   step(false);  // warm-up (see "Warm-up" at the top)
-  for (auto _ : state) step(true);
+  timed_steps(state, step);
   const double n = double(state.iterations());
   state.counters["rebuild_ms"] = 1e3 * t_rebuild / n;
   state.counters["set_matrix_ms"] = 1e3 * t_set / n;
@@ -515,7 +528,7 @@ void BM_Step_HatCholmod(benchmark::State& state) {
     t_solve += std::chrono::duration<double>(t3 - t2).count();
   };
   step(false);  // warm-up (see "Warm-up" at the top)
-  for (auto _ : state) step(true);
+  timed_steps(state, step);
   const double n = double(state.iterations());
   state.counters["update_ms"] = 1e3 * t_update / n;
   state.counters["factorize_ms"] = 1e3 * t_factor / n;

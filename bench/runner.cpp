@@ -90,6 +90,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   const bool per_step = m.quasi_conformal || m.sphericity;
   const MetricHooks& hooks = metric_hooks();
   const bool peak_per_cell = reset_peak_memory();
+  const double steal_before = cpu_steal_seconds();
 
   json result;
   try {
@@ -135,6 +136,8 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   result["study_config"] = e.study_config;
   if (!written.empty()) result["frames"] = {{"dir", "frames/" + p.hash}, {"steps", written}};
   result["run_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (const double steal_after = cpu_steal_seconds(); steal_before >= 0 && steal_after >= 0)
+    result["steal_seconds"] = steal_after - steal_before;
   return result;
 }
 

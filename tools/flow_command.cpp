@@ -122,6 +122,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       fs::create_directories(out);
       std::set<std::string> frames;
       FlowOutcome outcome;
+      const double steal_before = cpu_steal_seconds();
       try {
         Progress progress("step", config.steps);
         FlowObserver observer;
@@ -142,6 +143,8 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       }
       outcome.result["environment"] = environment_json(config.threads);
       outcome.result["peak_memory_bytes"] = peak_memory_bytes();
+      if (const double steal_after = cpu_steal_seconds(); steal_before >= 0 && steal_after >= 0)
+        outcome.result["steal_seconds"] = steal_after - steal_before;
       write_mesh((out / "final.ply").string(), outcome.final_mesh);
       write_file_atomic((out / "result.json").string(), outcome.result.dump(1) + "\n");
       // Frames of an earlier run into the same folder would sit beside this run's result as if

@@ -33,7 +33,9 @@ TEST(Compare, MannWhitney) {
 
 /// A synthetic result set: 3 cells, 2 repetitions, 15 steps each; per-step seconds scaled by
 /// `slow` with multiplicative noise of +-noise; final radial error scaled by `error`.
-void make_set(const fs::path& dir, const std::string& commit, double slow, double noise, double error, unsigned seed) {
+/// With `steal` >= 0 each cell also records run_seconds 1 and steal_seconds `steal`.
+void make_set(const fs::path& dir, const std::string& commit, double slow, double noise, double error, unsigned seed,
+              double steal = -1) {
   fs::create_directories(dir);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(1 - noise, 1 + noise);
@@ -45,14 +47,34 @@ void make_set(const fs::path& dir, const std::string& commit, double slow, doubl
                          {"seconds", {{"total", 0.01 * (cell + 1) * (1 + 0.2 * std::sin(s)) * slow * jitter(rng)}}},
                          {"radial_error", {{"rms", 1e-3 * (cell + 1) * s * error}}}});
       const std::string key = "cellkey" + std::to_string(cell);
-      const json r = {{"status", "ok"},
+      json r = {{"status", "ok"},
                       {"environment", {{"commit", commit}}},
                       {"cell", {{"key", key + "r" + std::to_string(rep)}, {"config_key", key}, {"index", cell * 2 + rep},
                                 {"repetition", rep}, {"study", "synthetic"},
                                 {"assignment", {{"solver.name", "solver" + std::to_string(cell)}}}}},
                       {"steps", steps}};
+      if (steal >= 0) {
+        r["run_seconds"] = 1.0;
+        r["steal_seconds"] = steal;
+      }
       std::ofstream(dir / (commit + std::to_string(cell) + std::to_string(rep) + ".json")) << r.dump();
     }
+}
+
+TEST(CompareCli, ReportsTheHypervisorsStolenShareOfEachSet) {
+  // A slower NEW whose cells lost a quarter of their run time to other guests says so; sets
+  // without the record show "–", and without it on either side the line is left out.
+  const fs::path dir = fresh_dir("compare_steal");
+  make_set(dir / "old", "aaaa", 1.0, 0.03, 1.0, 1);
+  make_set(dir / "stolen", "bbbb", 2.0, 0.03, 1.0, 2, 0.25);
+  make_set(dir / "quiet", "cccc", 1.0, 0.03, 1.0, 3, 0.0);
+  Command c = mcfbench("compare old stolen", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;  // still a regression: the verdict is the timings'
+  EXPECT_NE(c.out.find("per cell run time: OLD –, NEW 25.0%."), std::string::npos) << c.out;
+  c = mcfbench("compare quiet stolen", dir);
+  EXPECT_NE(c.out.find("OLD 0.0%, NEW 25.0%"), std::string::npos) << c.out;
+  c = mcfbench("compare old old", dir);
+  EXPECT_EQ(c.out.find("Hypervisor steal"), std::string::npos) << c.out;
 }
 
 TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {

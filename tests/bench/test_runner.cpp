@@ -2,6 +2,7 @@
 // and end to end through the binary (resume after a deleted file, after SIGKILL, shards +
 // collect, config errors that write nothing).
 
+#include "bench/environment.h"
 #include "bench/metric_hooks.h"
 #include "bench/runner.h"
 #include "flows/config_reader.h"
@@ -77,6 +78,8 @@ TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
     EXPECT_EQ((*r)["study_config"], j);
     EXPECT_TRUE((*r).contains("environment"));
     EXPECT_GT((*r)["peak_memory_bytes"].get<long long>(), 0);
+    // The hypervisor's stolen CPU time while the cell ran (Linux reports it; never negative).
+    if (cpu_steal_seconds() >= 0) EXPECT_GE((*r)["steal_seconds"].get<double>(), 0.0);
   }
   EXPECT_FALSE(ref.contains("reference_distance"));  // the reference itself
   ASSERT_TRUE(other.contains("reference_distance"));
