@@ -16,8 +16,9 @@ long long peak_memory_bytes();
 
 /// CPU time the hypervisor gave to other guests while this one wanted to run ("steal", the
 /// eighth value of /proc/stat's aggregate `cpu` line), summed over all CPUs, in seconds since
-/// boot; -1 where the kernel does not report it. On shared 2-vCPU guests a slow benchmark
-/// repetition is often stolen time: the difference over a run tells noise from a regression.
+/// boot; -1 where the kernel does not report it. The difference over a run says how much of a
+/// slow run the host took as CPU time; noise from shared caches and memory bandwidth does not
+/// show here.
 double cpu_steal_seconds();
 /// The steal field of /proc/stat's first line `text` at `ticks_per_second` (USER_HZ), in seconds;
 /// -1 if the line is not an aggregate `cpu` line with at least eight values.

@@ -343,7 +343,8 @@ TrackedFixture& tracked_fixture() {
 
 /// Runs the timed iterations and records `steal_ms`: CPU time per iteration that the hypervisor
 /// gave to other guests (all vCPUs, /proc/stat's steal; -1 where unknown). A repetition much
-/// slower than its siblings with a large steal_ms was the machine, not the code.
+/// slower than its siblings with a large steal_ms was the machine, not the code (a small one
+/// rules out only stolen CPU time, not contention for caches and memory bandwidth).
 template <class Step>
 void timed_steps(benchmark::State& state, Step&& step) {
   const double steal0 = cpu_steal_seconds();
