@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
+#include <iterator>
 #include <stdexcept>
 
 namespace mcf {
@@ -31,31 +33,29 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   const bool shared = shares_pattern(M, K);
   if (!shared) sum_ = general_sum(a, M, b, K);
 
-  // Fixed set: the basis's locked functions plus rows that received no contribution (every
-  // entry of a M + b K zero).
-  std::vector<int> fixed = base_fixed_;
+  // Rows that received no contribution this step (every entry of a M + b K zero; by symmetry
+  // their columns are zero too), apart from the basis's locked functions.
+  std::vector<int> empty;
   {
     const auto* outer = (shared ? M : sum_).outerIndexPtr();
     const double* m = shared ? M.valuePtr() : nullptr;
     const double* k = shared ? K.valuePtr() : nullptr;
     const double* v = shared ? nullptr : sum_.valuePtr();
     for (Eigen::Index c = 0; c < n; ++c) {
-      bool empty = true;
-      for (int p = outer[c]; p < outer[c + 1] && empty; ++p)
-        empty = (shared ? sum_entry(a, m[p], b, k[p]) : v[p]) == 0.0;
-      if (empty) fixed.push_back(int(c));
+      bool is_empty = true;
+      for (int p = outer[c]; p < outer[c + 1] && is_empty; ++p)
+        is_empty = (shared ? sum_entry(a, m[p], b, k[p]) : v[p]) == 0.0;
+      if (is_empty && !std::binary_search(base_fixed_.begin(), base_fixed_.end(), int(c))) empty.push_back(int(c));
     }
-    std::sort(fixed.begin(), fixed.end());
-    fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   }
+  fixed_.clear();
+  std::set_union(base_fixed_.begin(), base_fixed_.end(), empty.begin(), empty.end(), std::back_inserter(fixed_));
 
   // The basis's pattern is fixed while this object lives (a rebuilt basis gets a new
   // ReducedSystem), so a pattern key lets the solver skip comparing it each step. No key when M
   // and K have different patterns: then sum_'s pattern depends on whether b is 0.
   HierarchyView view{basis_.prolongations(), basis_.colours(), shared ? full_key_ : 0};
-  if (fixed.empty()) {
-    fixed_.clear();
-    reduction_valid_ = false;
+  if (fixed_.empty()) {
     if (shared) {
       sum_ = SparseMatrix();  // held functions may have needed it; now it is the solver's
       report_ = solver_.set_matrix_sum(a, M, b, K, view);
@@ -71,9 +71,76 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     sum_on_pattern(a, M, b, K, sum_);
   }
 
-  // Only a change of the fixed set needs a new reduction (and a new key, rebuild_reduction).
-  if (!reduction_valid_ || fixed != fixed_) {
-    fixed_ = std::move(fixed);
+  // An empty row is held in place (the paper's anchoring, Section 5.3: the coefficient keeps
+  // its value): its diagonal becomes d and its right-hand side d times the held value. Its
+  // column is zero, so no other unknown sees it and the solution of the others is the one of
+  // the system without it, while the pattern, and so the solver's symbolic work (Galerkin
+  // pattern, CHOLMOD's analysis), stays that of every other step. Eliminating the row instead
+  // changes the pattern whenever the set of empty rows does, which through a pinch or with
+  // the 1-point rule is nearly every step (a 4x slower solve, measured). d is the mean
+  // diagonal of the other rows, so the coarse operators the row feeds stay of the usual scale.
+  std::vector<int> diagonal(empty.size(), -1);
+  {
+    const int* outer = sum_.outerIndexPtr();
+    const int* inner = sum_.innerIndexPtr();
+    for (std::size_t e = 0; e < empty.size(); ++e) {
+      const int c = empty[e];
+      const int* at = std::lower_bound(inner + outer[c], inner + outer[c + 1], c);
+      if (at != inner + outer[c + 1] && *at == c) diagonal[e] = int(at - inner);
+    }
+  }
+  // Rows without a stored diagonal cannot be held in place: they are eliminated.
+  std::vector<int> eliminated = base_fixed_;
+  std::vector<int> anchored, anchored_diagonal;
+  for (std::size_t e = 0; e < empty.size(); ++e) {
+    if (diagonal[e] < 0) {
+      eliminated.push_back(empty[e]);
+    } else {
+      anchored.push_back(empty[e]);
+      anchored_diagonal.push_back(diagonal[e]);
+    }
+  }
+  std::sort(eliminated.begin(), eliminated.end());
+  double d = 1.0;
+  if (!anchored.empty()) {
+    const int* outer = sum_.outerIndexPtr();
+    const int* inner = sum_.innerIndexPtr();
+    const double* v = sum_.valuePtr();
+    double total = 0;
+    Eigen::Index count = 0;
+    for (Eigen::Index c = 0; c < n; ++c) {
+      const int* at = std::lower_bound(inner + outer[c], inner + outer[c + 1], int(c));
+      if (at != inner + outer[c + 1] && *at == c && v[at - inner] > 0) {
+        total += v[at - inner];
+        ++count;
+      }
+    }
+    if (count > 0 && std::isfinite(total / double(count))) d = total / double(count);
+    for (int p : anchored_diagonal) sum_.valuePtr()[p] = d;
+  }
+  Coefficients R_held = R, warm_held = warm;
+  for (int i : anchored) {
+    R_held.row(i) = d * fixed_values.row(i);
+    warm_held.row(i) = fixed_values.row(i);
+  }
+  // The held coefficients exactly (the solve returns them to rounding).
+  const auto hold = [&](Coefficients& Y) {
+    for (int i : anchored) Y.row(i) = fixed_values.row(i);
+  };
+
+  if (eliminated.empty()) {
+    reduction_valid_ = false;
+    report_ = solver_.set_matrix(sum_, view);
+    Coefficients X = std::move(warm_held);
+    if (report_.ok()) report_ = solver_.solve(R_held, X);
+    hold(X);
+    return X;
+  }
+
+  // Only a change of the eliminated set (the basis's locked functions, fixed for the basis's
+  // life) needs a new reduction (and a new key, rebuild_reduction).
+  if (!reduction_valid_ || eliminated != eliminated_) {
+    eliminated_ = std::move(eliminated);
     rebuild_reduction(sum_);
   }
 
@@ -88,13 +155,13 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   }
   // Right-hand side: R_f - S_fl Y_l.
   Coefficients Yfixed = Coefficients::Zero(n, 3);
-  for (int i : fixed_) Yfixed.row(i) = fixed_values.row(i);
+  for (int i : eliminated_) Yfixed.row(i) = fixed_values.row(i);
   const Coefficients coupling = symmetric_multiply(sum_, Yfixed);  // S is symmetric
   const Eigen::Index nf = Eigen::Index(free_.size());
   Eigen::MatrixXd Rf(nf, 3), Xf(nf, 3);
   for (Eigen::Index i = 0; i < nf; ++i) {
-    Rf.row(i) = R.row(free_[i]) - coupling.row(free_[i]);
-    Xf.row(i) = warm.row(free_[i]);
+    Rf.row(i) = R_held.row(free_[i]) - coupling.row(free_[i]);
+    Xf.row(i) = warm_held.row(free_[i]);
   }
   HierarchyView reduced_view;
   if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
@@ -103,13 +170,14 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   if (report_.ok()) report_ = solver_.solve(Rf, Xf);
   Coefficients Y = Yfixed;
   for (Eigen::Index i = 0; i < nf; ++i) Y.row(free_[i]) = Xf.row(i);
+  hold(Y);
   return Y;
 }
 
 void ReducedSystem::rebuild_reduction(const SparseMatrix& S) {
   const Eigen::Index n = S.rows();
   reduced_of_.assign(n, 0);
-  for (int i : fixed_) reduced_of_[i] = -1;
+  for (int i : eliminated_) reduced_of_[i] = -1;
   free_.clear();
   for (Eigen::Index i = 0; i < n; ++i)
     if (reduced_of_[i] == 0) {

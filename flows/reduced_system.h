@@ -1,11 +1,12 @@
 #pragma once
-// Solving (a M + b K) Y = R with some functions held fixed. Fixed rows are eliminated, so the
-// system the solver sees stays symmetric positive definite (open boundaries, DESIGN.md), and
-// functions whose row is empty this step (no cubature point contributes: the paper's
-// "anchoring" through a pinch) are held too instead of making the matrix singular.
+// Solving (a M + b K) Y = R with some functions held fixed. The basis's locked functions (open
+// boundaries, DESIGN.md) are eliminated, so the system the solver sees stays symmetric positive
+// definite. Functions whose row is empty this step (no cubature point contributes: the paper's
+// "anchoring" through a pinch) are held too instead of making the matrix singular: in place,
+// by a diagonal entry and a matching right-hand side, so the pattern does not change with them.
 // With no function held (a closed surface) M and K go to the solver as they are
 // (LinearSolver::set_matrix_sum), so the sum is not stored here as well.
-// The reduced pattern and the restricted hierarchy are rebuilt only when the fixed set changes;
+// The reduced pattern and the restricted hierarchy are rebuilt only when the eliminated set changes;
 // the basis's own pattern must stay fixed while a ReducedSystem lives (make a new one after a
 // rebuild).
 
@@ -35,7 +36,8 @@ class ReducedSystem {
   const Basis& basis_;
   LinearSolver& solver_;
   std::vector<int> base_fixed_;        // from the basis (boundary)
-  std::vector<int> fixed_;             // sorted; last solve's
+  std::vector<int> fixed_;             // sorted; last solve's held functions (locked + empty rows)
+  std::vector<int> eliminated_;        // sorted; those the current reduction leaves out
   std::vector<int> free_;              // reduced index -> full index
   std::vector<int> reduced_of_;        // full index -> reduced index or -1
   std::vector<int> source_nz_;         // reduced nonzero -> nonzero of the full matrix

@@ -79,7 +79,9 @@ TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
     EXPECT_TRUE((*r).contains("environment"));
     EXPECT_GT((*r)["peak_memory_bytes"].get<long long>(), 0);
     // The hypervisor's stolen CPU time while the cell ran (Linux reports it; never negative).
-    if (cpu_steal_seconds() >= 0) EXPECT_GE((*r)["steal_seconds"].get<double>(), 0.0);
+    if (cpu_steal_seconds() >= 0) {
+      EXPECT_GE((*r)["steal_seconds"].get<double>(), 0.0);
+    }
   }
   EXPECT_FALSE(ref.contains("reference_distance"));  // the reference itself
   ASSERT_TRUE(other.contains("reference_distance"));

@@ -138,7 +138,9 @@ TEST(Cli, EnvironmentRecordsTheThreadsThatRan) {
   EXPECT_EQ(j["config"]["threads"], 4096);
   EXPECT_GE(j["environment"]["threads"].get<int>(), 1);
   EXPECT_LE(j["environment"]["threads"].get<int>(), j["environment"]["cores"].get<int>());
-  if (std::ifstream("/proc/stat")) EXPECT_GE(j["steal_seconds"].get<double>(), 0.0);  // the hypervisor's share
+  if (std::ifstream("/proc/stat")) {
+    EXPECT_GE(j["steal_seconds"].get<double>(), 0.0);  // the hypervisor's share
+  }
   const fs::path cfg = write("threads.json", R"({"name": "t", "defaults": {"mesh": "icosphere:level=1", "steps": 1}})");
   for (const char* bad : {"99999", "-1"}) {
     const CommandResult r = mcfbench("run " + cfg.string() + " --threads " + bad + " --out " + (temp_dir() / "out_run_threads").string());
