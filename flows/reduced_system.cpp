@@ -79,50 +79,52 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   // changes the pattern whenever the set of empty rows does, which through a pinch or with
   // the 1-point rule is nearly every step (a 4x slower solve, measured). d is the mean
   // diagonal of the other rows, so the coarse operators the row feeds stay of the usual scale.
-  std::vector<int> diagonal(empty.size(), -1);
-  {
-    const int* outer = sum_.outerIndexPtr();
-    const int* inner = sum_.innerIndexPtr();
-    for (std::size_t e = 0; e < empty.size(); ++e) {
-      const int c = empty[e];
-      const int* at = std::lower_bound(inner + outer[c], inner + outer[c + 1], c);
-      if (at != inner + outer[c + 1] && *at == c) diagonal[e] = int(at - inner);
-    }
-  }
-  // Rows without a stored diagonal cannot be held in place: they are eliminated.
+  // One pass over the columns: each empty row's diagonal position, and the mean of the others'
+  // positive diagonal entries. Rows without a stored diagonal cannot be held in place: they are
+  // eliminated.
   std::vector<int> eliminated = base_fixed_;
   std::vector<int> anchored, anchored_diagonal;
-  for (std::size_t e = 0; e < empty.size(); ++e) {
-    if (diagonal[e] < 0) {
-      eliminated.push_back(empty[e]);
-    } else {
-      anchored.push_back(empty[e]);
-      anchored_diagonal.push_back(diagonal[e]);
-    }
-  }
-  std::sort(eliminated.begin(), eliminated.end());
   double d = 1.0;
-  if (!anchored.empty()) {
+  if (!empty.empty()) {
     const int* outer = sum_.outerIndexPtr();
     const int* inner = sum_.innerIndexPtr();
     const double* v = sum_.valuePtr();
     double total = 0;
     Eigen::Index count = 0;
+    std::size_t e = 0;  // empty is sorted
     for (Eigen::Index c = 0; c < n; ++c) {
       const int* at = std::lower_bound(inner + outer[c], inner + outer[c + 1], int(c));
-      if (at != inner + outer[c + 1] && *at == c && v[at - inner] > 0) {
-        total += v[at - inner];
+      const int diagonal = at != inner + outer[c + 1] && *at == c ? int(at - inner) : -1;
+      if (e < empty.size() && empty[e] == c) {
+        if (diagonal < 0) {
+          eliminated.push_back(int(c));
+        } else {
+          anchored.push_back(int(c));
+          anchored_diagonal.push_back(diagonal);
+        }
+        ++e;
+      } else if (diagonal >= 0 && v[diagonal] > 0) {
+        total += v[diagonal];
         ++count;
       }
     }
     if (count > 0 && std::isfinite(total / double(count))) d = total / double(count);
     for (int p : anchored_diagonal) sum_.valuePtr()[p] = d;
   }
-  Coefficients R_held = R, warm_held = warm;
-  for (int i : anchored) {
-    R_held.row(i) = d * fixed_values.row(i);
-    warm_held.row(i) = fixed_values.row(i);
+  std::sort(eliminated.begin(), eliminated.end());
+  // Copies of R and the warm start only when rows are held in place (an open surface's steps
+  // without a pinch read the caller's).
+  Coefficients R_held, warm_held;
+  if (!anchored.empty()) {
+    R_held = R;
+    warm_held = warm;
+    for (int i : anchored) {
+      R_held.row(i) = d * fixed_values.row(i);
+      warm_held.row(i) = fixed_values.row(i);
+    }
   }
+  const Coefficients& R_in = anchored.empty() ? R : R_held;
+  const Coefficients& warm_in = anchored.empty() ? warm : warm_held;
   // The held coefficients exactly (the solve returns them to rounding).
   const auto hold = [&](Coefficients& Y) {
     for (int i : anchored) Y.row(i) = fixed_values.row(i);
@@ -131,8 +133,8 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   if (eliminated.empty()) {
     reduction_valid_ = false;
     report_ = solver_.set_matrix(sum_, view);
-    Coefficients X = std::move(warm_held);
-    if (report_.ok()) report_ = solver_.solve(R_held, X);
+    Coefficients X = std::move(warm_held);  // anchored is not empty here: fixed_ is
+    if (report_.ok()) report_ = solver_.solve(R_in, X);
     hold(X);
     return X;
   }
@@ -160,8 +162,8 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   const Eigen::Index nf = Eigen::Index(free_.size());
   Eigen::MatrixXd Rf(nf, 3), Xf(nf, 3);
   for (Eigen::Index i = 0; i < nf; ++i) {
-    Rf.row(i) = R_held.row(free_[i]) - coupling.row(free_[i]);
-    Xf.row(i) = warm_held.row(free_[i]);
+    Rf.row(i) = R_in.row(free_[i]) - coupling.row(free_[i]);
+    Xf.row(i) = warm_in.row(free_[i]);
   }
   HierarchyView reduced_view;
   if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
