@@ -84,4 +84,9 @@ double cpu_steal_seconds() {
   return steal_seconds_from_proc_stat(line, ::sysconf(_SC_CLK_TCK));
 }
 
+double cpu_steal_seconds_since(double before) {
+  const double now = cpu_steal_seconds();
+  return before >= 0 && now >= 0 ? now - before : -1;
+}
+
 }  // namespace mcf

@@ -20,6 +20,8 @@ long long peak_memory_bytes();
 /// slow run the host took as CPU time; noise from shared caches and memory bandwidth does not
 /// show here.
 double cpu_steal_seconds();
+/// cpu_steal_seconds() now minus `before` (an earlier reading); -1 where either is unknown.
+double cpu_steal_seconds_since(double before);
 /// The steal field of /proc/stat's first line `text` at `ticks_per_second` (USER_HZ), in seconds;
 /// -1 if the line is not an aggregate `cpu` line with at least eight values.
 double steal_seconds_from_proc_stat(const std::string& text, long ticks_per_second);

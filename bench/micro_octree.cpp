@@ -347,11 +347,10 @@ TrackedFixture& tracked_fixture() {
 /// rules out only stolen CPU time, not contention for caches and memory bandwidth).
 template <class Step>
 void timed_steps(benchmark::State& state, Step&& step) {
-  const double steal0 = cpu_steal_seconds();
+  const double before = cpu_steal_seconds();
   for (auto _ : state) step(true);
-  const double steal1 = cpu_steal_seconds();
-  state.counters["steal_ms"] =
-      steal0 >= 0 && steal1 >= 0 ? 1e3 * (steal1 - steal0) / double(state.iterations()) : -1.0;
+  const double steal = cpu_steal_seconds_since(before);
+  state.counters["steal_ms"] = steal >= 0 ? 1e3 * steal / double(state.iterations()) : -1.0;
 }
 
 void step_counters(benchmark::State& state, const Case& c, const MeshSource& m, const BasisStats& s) {

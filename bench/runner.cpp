@@ -136,8 +136,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   result["study_config"] = e.study_config;
   if (!written.empty()) result["frames"] = {{"dir", "frames/" + p.hash}, {"steps", written}};
   result["run_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (const double steal_after = cpu_steal_seconds(); steal_before >= 0 && steal_after >= 0)
-    result["steal_seconds"] = steal_after - steal_before;
+  if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0) result["steal_seconds"] = steal;
   return result;
 }
 

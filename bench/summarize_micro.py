@@ -12,6 +12,10 @@ import json
 import sys
 
 
+# Google Benchmark's time units in milliseconds.
+UNIT_MS = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+
+
 def median(xs):
     xs = sorted(xs)
     n = len(xs)
@@ -36,10 +40,8 @@ def load(path):
     for name, rs in runs.items():
         b = dict(rs[-1])
         if len(rs) > 1:
-            scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
-            unit = b.get("time_unit", "ns")
             # Repetitions share their unit; convert anyway so a mixed file cannot skew the median.
-            b["real_time"] = median([r["real_time"] * scale[r.get("time_unit", "ns")] for r in rs]) / scale[unit]
+            b["real_time"] = median([ms(r) for r in rs]) / UNIT_MS[b.get("time_unit", "ns")]
             for k, v in b.items():
                 if k != "real_time" and isinstance(v, (int, float)) and not isinstance(v, bool) and \
                         all(isinstance(r.get(k), (int, float)) for r in rs):
@@ -50,8 +52,7 @@ def load(path):
 
 
 def ms(b):
-    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b.get("time_unit", "ns")]
-    return b["real_time"] * scale
+    return b["real_time"] * UNIT_MS[b.get("time_unit", "ns")]
 
 
 def fmt(x, digits=3):

@@ -143,8 +143,8 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       }
       outcome.result["environment"] = environment_json(config.threads);
       outcome.result["peak_memory_bytes"] = peak_memory_bytes();
-      if (const double steal_after = cpu_steal_seconds(); steal_before >= 0 && steal_after >= 0)
-        outcome.result["steal_seconds"] = steal_after - steal_before;
+      if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
+        outcome.result["steal_seconds"] = steal;
       write_mesh((out / "final.ply").string(), outcome.final_mesh);
       write_file_atomic((out / "result.json").string(), outcome.result.dump(1) + "\n");
       // Frames of an earlier run into the same folder would sit beside this run's result as if
