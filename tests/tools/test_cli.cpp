@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 
 namespace {
@@ -43,12 +44,19 @@ fs::path write(const std::string& name, const std::string& content) {
   return p;
 }
 
+/// `mcfbench flow ARGS --out OUT` fails, names every one of `must_mention` on stderr and leaves
+/// no OUT behind.
+void expect_flow_rejected(const std::string& args, std::initializer_list<std::string> must_mention,
+                          const fs::path& out) {
+  const CommandResult r = mcfbench("flow " + args + " --out " + out.string());
+  EXPECT_NE(r.status, 0) << args;
+  for (const std::string& m : must_mention) EXPECT_NE(r.err.find(m), std::string::npos) << m << " in stderr: " << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "wrote output for bad input " << args;
+}
+
 void expect_rejected(const std::string& mesh_arg, const std::string& must_mention) {
-  const fs::path out = temp_dir() / ("out_" + std::to_string(std::hash<std::string>{}(mesh_arg)));
-  const CommandResult r = mcfbench("flow --mesh " + mesh_arg + " --steps 1 --out " + out.string());
-  EXPECT_NE(r.status, 0) << mesh_arg;
-  EXPECT_NE(r.err.find(must_mention), std::string::npos) << "stderr: " << r.err;
-  EXPECT_FALSE(fs::exists(out)) << "wrote output for bad input " << mesh_arg;
+  expect_flow_rejected("--mesh " + mesh_arg + " --steps 1", {must_mention},
+                       temp_dir() / ("out_" + std::to_string(std::hash<std::string>{}(mesh_arg))));
 }
 
 TEST(Cli, BadMeshesAreRejectedNamingTheFile) {
@@ -70,18 +78,9 @@ TEST(Cli, BadMeshesAreRejectedNamingTheFile) {
 TEST(Cli, BadConfigKeysAreNamed) {
   const fs::path cfg = write("bad.json", R"({"mesh": "icosphere:level=2", "solver": {"cycels": 3}})");
   const fs::path out = temp_dir() / "out_badcfg";
-  const CommandResult r = mcfbench("flow --config " + cfg.string() + " --out " + out.string());
-  EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.err.find("bad.json"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("solver.cycels"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(out));
-  const CommandResult bad_json = mcfbench("flow --config " + write("broken.json", "{\"mesh\": ").string() + " --out " + out.string());
-  EXPECT_NE(bad_json.status, 0);
-  EXPECT_NE(bad_json.err.find("broken.json"), std::string::npos) << bad_json.err;
-  const CommandResult bad_flag = mcfbench("flow --mesh icosphere:level=2 --integrator rk4 --out " + out.string());
-  EXPECT_NE(bad_flag.status, 0);
-  EXPECT_NE(bad_flag.err.find("integrator"), std::string::npos) << bad_flag.err;
-  EXPECT_FALSE(fs::exists(out));
+  expect_flow_rejected("--config " + cfg.string(), {"bad.json", "solver.cycels"}, out);
+  expect_flow_rejected("--config " + write("broken.json", "{\"mesh\": ").string(), {"broken.json"}, out);
+  expect_flow_rejected("--mesh icosphere:level=2 --integrator rk4", {"integrator"}, out);
 }
 
 TEST(Cli, FlowWritesTheResultContract) {
@@ -108,16 +107,10 @@ TEST(Cli, FlowWritesTheResultContract) {
 TEST(Cli, SetUpErrorsInsideTheFlowLeaveNoFolderAndNameTheOption) {
   // The unit cube is only found wrong once the octree is built, after the folder was made.
   const fs::path out = temp_dir() / "out_cube";
-  const CommandResult r = mcfbench("flow --mesh icosphere:level=2 --basis octree --depth 4 --cube unit --steps 1 --out " + out.string());
-  EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.err.find("--cube"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("octree.cube"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(out));
+  expect_flow_rejected("--mesh icosphere:level=2 --basis octree --depth 4 --cube unit --steps 1",
+                       {"--cube", "octree.cube"}, out);
   // Range checks the defaults used to hide: a negative tolerance is not "the default".
-  const CommandResult tol = mcfbench("flow --mesh icosphere:level=2 --solver pcg --tolerance -0.5 --out " + out.string());
-  EXPECT_NE(tol.status, 0);
-  EXPECT_NE(tol.err.find("solver.tolerance"), std::string::npos) << tol.err;
-  EXPECT_FALSE(fs::exists(out));
+  expect_flow_rejected("--mesh icosphere:level=2 --solver pcg --tolerance -0.5", {"solver.tolerance"}, out);
 }
 
 TEST(Cli, ARerunIntoTheSameFolderLeavesNoStaleFrames) {
