@@ -79,7 +79,8 @@ json cell_json(const ExperimentConfig& e, const CellPlan& p) {
           {"mesh_fingerprint", p.mesh_fingerprint}};
 }
 
-json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, const fs::path& out) {
+json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, const fs::path& out,
+              const std::function<void(int step)>& on_step) {
   const auto start = std::chrono::steady_clock::now();
   const MetricsConfig& m = e.metrics;
   const FlowConfig& config = p.cell.flow;
@@ -112,6 +113,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
         if (m.sphericity) mj["sphericity"] = hooks.sphericity(V, source.mesh.faces);
         step_metrics[step] = std::move(mj);
       }
+      if (on_step) on_step(step);  // after the step's frames and metrics: they are part of its time
     };
     FlowOutcome outcome = run_flow(config, source, observer);
     result = std::move(outcome.result);
@@ -277,7 +279,9 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
     } else {
       if (!o.force && fs::exists(p.file)) ++s.retried;
       const auto t0 = std::chrono::steady_clock::now();
-      const json result = run_cell(e, p, meshes, out);
+      const json result = run_cell(e, p, meshes, out, [&](int step) {
+        if (o.on_step) o.on_step(StepReport{done + 1, s.in_shard, &p, step, p.cell.flow.steps});
+      });
       write_file_atomic(p.file, result.dump(1) + "\n");
       ++s.ran;
       ran_now.insert(p.hash);

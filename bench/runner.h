@@ -43,12 +43,20 @@ struct CellReport {
   double seconds = 0;
 };
 
+/// A cell's flow has finished step `step` of `steps` (0 = the input, before the first step).
+struct StepReport {
+  int cell_number = 0, total = 0;  ///< this cell's place among the shard's cells (1-based) / their number
+  const CellPlan* plan = nullptr;
+  int step = 0, steps = 0;
+};
+
 struct RunOptions {
   std::string out_dir;
   int shard_index = 0, shard_count = 1;
   bool force = false;
   int threads = -1;  ///< >= 0 overrides every cell's "threads" (part of the config, so of the key)
   std::function<void(const CellReport&)> on_cell;  ///< progress (stderr in the CLI)
+  std::function<void(const StepReport&)> on_step;  ///< inside a cell that runs (not for skipped ones)
 };
 
 struct RunSummary {

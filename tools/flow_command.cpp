@@ -113,6 +113,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
 
       const FlowConfig config = flow_config_from_json(j, source);
       const MeshSource mesh = load_mesh_spec(config.mesh);  // throws naming the file: nothing written yet
+      const double line_seconds = progress_line_seconds();  // a bad MCFBENCH_PROGRESS_SECONDS too
 
       namespace fs = std::filesystem;
       const fs::path out(args->out);
@@ -124,7 +125,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       FlowOutcome outcome;
       const double steal_before = cpu_steal_seconds();
       try {
-        Progress progress("step", config.steps);
+        Progress progress("step", config.steps, Progress::Mode::automatic, stderr, line_seconds);
         FlowObserver observer;
         observer.on_step = [&](int step, double, const Positions& V) {
           progress.update(step);

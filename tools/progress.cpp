@@ -1,31 +1,64 @@
 #include "tools/progress.h"
 
-#include <cstdio>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
 #include <unistd.h>
 
 namespace mcf {
 
-Progress::Progress(std::string what, long long total)
-    : what_(std::move(what)), total_(total), enabled_(::isatty(2) != 0),
-      start_(std::chrono::steady_clock::now()), last_(start_) {}
+double progress_line_seconds() {
+  const char* text = std::getenv("MCFBENCH_PROGRESS_SECONDS");
+  if (text == nullptr || *text == '\0') return 60.0;
+  char* end = nullptr;
+  const double seconds = std::strtod(text, &end);
+  if (*end != '\0' || !std::isfinite(seconds) || seconds < 0)
+    throw std::invalid_argument(std::string("MCFBENCH_PROGRESS_SECONDS: expected seconds >= 0, got '") + text + "'");
+  return seconds;
+}
+
+Progress::Progress(std::string what, long long total, Mode mode, std::FILE* out, double line_seconds)
+    : what_(std::move(what)),
+      total_(total),
+      terminal_(mode == Mode::terminal || (mode == Mode::automatic && ::isatty(::fileno(out)) != 0)),
+      out_(out),
+      line_seconds_(line_seconds),
+      start_(std::chrono::steady_clock::now()) {}
 
 Progress::~Progress() { finish(); }
 
 void Progress::update(long long done, const std::string& extra) {
-  if (!enabled_) return;
-  const auto now = std::chrono::steady_clock::now();
-  if (done < total_ && now - last_ < std::chrono::milliseconds(200)) return;
-  last_ = now;
-  const double elapsed = std::chrono::duration<double>(now - start_).count();
-  const double left = done > 0 ? elapsed * double(total_ - done) / double(done) : 0.0;
-  std::fprintf(stderr, "\r%s %lld/%lld  %.1f s  left %.1f s  %s\033[K", what_.c_str(), done, total_, elapsed, left,
-               extra.c_str());
-  std::fflush(stderr);
+  update_at(std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(), done, extra);
+}
+
+void Progress::update_at(double seconds, long long done, const std::string& extra) {
+  if (terminal_) {
+    // The last update always shows, so the line ends on "total/total".
+    if (done < total_ && open_ && seconds - last_ < 0.2) return;
+  } else if (done >= total_ || seconds - last_ < line_seconds_) {
+    return;  // the caller reports completion itself; a line only when line_seconds have passed
+  }
+  last_ = seconds;
+  print(seconds, done, extra);
+}
+
+void Progress::print(double seconds, long long done, const std::string& extra) {
+  const double left = done > 0 ? seconds * double(total_ - done) / double(done) : 0.0;
+  std::fprintf(out_, "%s%s %lld/%lld  %.1f s  left %.1f s%s%s%s", terminal_ ? "\r" : "", what_.c_str(), done, total_,
+               seconds, left, extra.empty() ? "" : "  ", extra.c_str(), terminal_ ? "\033[K" : "\n");
+  std::fflush(out_);
+  open_ = terminal_;
 }
 
 void Progress::finish() {
-  if (enabled_ && !finished_) std::fputc('\n', stderr);
-  finished_ = true;
+  if (open_) std::fputc('\n', out_);
+  open_ = false;
+}
+
+void Progress::clear() {
+  if (open_) std::fputs("\r\033[K", out_);
+  std::fflush(out_);
+  open_ = false;
 }
 
 }  // namespace mcf

@@ -5,6 +5,7 @@
 #include "bench/experiment_config.h"
 #include "bench/runner.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 
 #include <chrono>
 #include <cstdio>
@@ -42,6 +43,7 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
   cmd->callback([a, &run] {
     run = [a]() -> int {
       const ExperimentConfig e = load_experiment_config(a->config, a->quick);
+      const double line_seconds = progress_line_seconds();  // a bad MCFBENCH_PROGRESS_SECONDS: nothing written
       RunOptions o;
       parse_shard(a->shard, o.shard_index, o.shard_count);
       o.out_dir = !a->out.empty() ? a->out : "results/" + e.name + (a->quick ? "-quick" : "");
@@ -51,7 +53,22 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
       const auto start = std::chrono::steady_clock::now();
       double run_seconds = 0;
       int ran = 0;
+      // Inside a running cell: its steps (a terminal's line is erased by the cell's own line).
+      std::unique_ptr<Progress> steps;
+      const CellPlan* steps_of = nullptr;
+      o.on_step = [&](const StepReport& r) {
+        if (steps_of != r.plan) {
+          steps_of = r.plan;
+          steps = std::make_unique<Progress>("[" + std::to_string(r.cell_number) + "/" + std::to_string(r.total) +
+                                                 "] cell " + std::to_string(r.plan->cell.index) + " step",
+                                             r.steps, Progress::Mode::automatic, stderr, line_seconds);
+        }
+        steps->update(r.step);
+      };
       o.on_cell = [&](const CellReport& r) {
+        if (steps) steps->clear();
+        steps.reset();
+        steps_of = nullptr;
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!r.skipped) {
           run_seconds += r.seconds;

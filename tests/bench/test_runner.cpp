@@ -14,6 +14,8 @@
 #include <map>
 #include <set>
 #include <thread>
+#include <tuple>
+#include <vector>
 
 namespace mcf {
 namespace {
@@ -144,6 +146,31 @@ TEST(Runner, ACellErrorIsRecordedAndTheRunGoesOn) {
   EXPECT_EQ(good["status"], "ok");
 }
 
+TEST(Runner, OnStepReportsEveryStepOfTheCellsThatRunAndNoneOfTheSkippedOnes) {
+  const fs::path out = fresh_dir("on_step");
+  const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 3}}}, {"axes", {{"dt", {1e-3, 2e-3}}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "s.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  std::vector<std::tuple<int, int, int, int, int>> seen;  // cell number, total, cell index, step, steps
+  o.on_step = [&](const StepReport& r) {
+    seen.emplace_back(r.cell_number, r.total, r.plan->cell.index, r.step, r.steps);
+  };
+  ASSERT_EQ(run_experiment(e, o).ran, 2);
+  std::vector<std::tuple<int, int, int, int, int>> expected;
+  for (int cell = 0; cell < 2; ++cell)
+    for (int step = 0; step <= 3; ++step) expected.emplace_back(cell + 1, 2, cell, step, 3);
+  EXPECT_EQ(seen, expected);
+  // Rerun with the second cell's file gone: only it runs, as cell 2 of 2.
+  MeshCache meshes;
+  fs::remove(plan_cells(e, out.string(), meshes)[1].file);
+  seen.clear();
+  ASSERT_EQ(run_experiment(e, o).ran, 1);
+  expected.clear();
+  for (int step = 0; step <= 3; ++step) expected.emplace_back(2, 2, 1, step, 3);
+  EXPECT_EQ(seen, expected);
+}
+
 TEST(Runner, MissingMetricImplementationIsAConfigErrorBeforeAnything) {
   HookGuard guard(MetricHooks{});
   const fs::path out = fresh_dir("nohooks") / "out";
@@ -202,6 +229,37 @@ TEST(RunnerCli, RerunRetriesErroredAndUnreadableCellsAndCollectCountsErrors) {
   c = mcfbench("run e.json --out out", dir);
   EXPECT_NE(c.out.find("2 ran (2 retried after an error), 0 skipped, 1 errors"), std::string::npos) << c.out;
   EXPECT_EQ(read_json(good)["status"], "ok");
+}
+
+TEST(RunnerCli, LogsShowStepProgressEveryProgressSecondsAndABadValueWritesNothing) {
+  // stderr is a file here, as under nohup or Slurm: plain lines, at most every
+  // MCFBENCH_PROGRESS_SECONDS (0: every step but a cell's last, which its own line reports).
+  const fs::path dir = fresh_dir("progress");
+  write_text(dir / "tiny.json", tiny_config);
+  ::setenv("MCFBENCH_PROGRESS_SECONDS", "0", 1);
+  Command c = mcfbench("run tiny.json --out out", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  for (const char* line : {"[1/3] cell 0 step 0/2  ", "[1/3] cell 0 step 1/2  ", "[3/3] cell 2 step 1/2  "})
+    EXPECT_NE(c.err.find(line), std::string::npos) << line << " in " << c.err;
+  EXPECT_EQ(c.err.find("step 2/2"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find('\r'), std::string::npos) << "a terminal's line in a log";
+  EXPECT_LT(c.err.find("[1/3] cell 0 step 1/2"), c.err.find(" ok ")) << c.err;  // before the cell's own line
+  c = mcfbench("flow --mesh icosphere:level=1 --steps 3 --out flow", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_NE(c.err.find("step 2/3  "), std::string::npos) << c.err;
+  // The default (60 s) prints nothing for runs this short.
+  ::unsetenv("MCFBENCH_PROGRESS_SECONDS");
+  c = mcfbench("run tiny.json --out again", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(c.err.find(" step "), std::string::npos) << c.err;
+  ::setenv("MCFBENCH_PROGRESS_SECONDS", "often", 1);
+  for (const char* args : {"run tiny.json --out bad", "flow --mesh icosphere:level=1 --steps 3 --out bad"}) {
+    c = mcfbench(args, dir);
+    EXPECT_NE(c.status, 0) << args;
+    EXPECT_NE(c.err.find("MCFBENCH_PROGRESS_SECONDS"), std::string::npos) << args << ": " << c.err;
+    EXPECT_FALSE(fs::exists(dir / "bad")) << args;
+  }
+  ::unsetenv("MCFBENCH_PROGRESS_SECONDS");
 }
 
 TEST(RunnerCli, RerunRedoesExactlyTheMissingCell) {
