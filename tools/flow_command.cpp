@@ -125,7 +125,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       FlowOutcome outcome;
       const double steal_before = cpu_steal_seconds();
       try {
-        Progress progress("step", config.steps, Progress::Mode::automatic, stderr, line_seconds);
+        Progress progress("step", config.steps, line_seconds);
         FlowObserver observer;
         observer.on_step = [&](int step, double, const Positions& V) {
           progress.update(step);

@@ -17,7 +17,7 @@ double progress_line_seconds() {
   return seconds;
 }
 
-Progress::Progress(std::string what, long long total, Mode mode, std::FILE* out, double line_seconds)
+Progress::Progress(std::string what, long long total, double line_seconds, Mode mode, std::FILE* out)
     : what_(std::move(what)),
       total_(total),
       terminal_(mode == Mode::terminal || (mode == Mode::automatic && ::isatty(::fileno(out)) != 0)),
@@ -56,8 +56,10 @@ void Progress::finish() {
 }
 
 void Progress::clear() {
-  if (open_) std::fputs("\r\033[K", out_);
-  std::fflush(out_);
+  if (open_) {
+    std::fputs("\r\033[K", out_);
+    std::fflush(out_);
+  }
   open_ = false;
 }
 

@@ -24,8 +24,9 @@ class Progress {
     lines,      ///< a plain line at most every line_seconds
   };
 
-  Progress(std::string what, long long total, Mode mode = Mode::automatic, std::FILE* out = stderr,
-           double line_seconds = progress_line_seconds());
+  /// line_seconds: from progress_line_seconds(), read by the caller before it writes anything.
+  Progress(std::string what, long long total, double line_seconds, Mode mode = Mode::automatic,
+           std::FILE* out = stderr);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;

@@ -53,22 +53,19 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
       const auto start = std::chrono::steady_clock::now();
       double run_seconds = 0;
       int ran = 0;
-      // Inside a running cell: its steps (a terminal's line is erased by the cell's own line).
+      // Inside a running cell: its steps. on_cell ends the line (on a terminal the cell's own line
+      // replaces it), so the next cell's first step starts a new one.
       std::unique_ptr<Progress> steps;
-      const CellPlan* steps_of = nullptr;
       o.on_step = [&](const StepReport& r) {
-        if (steps_of != r.plan) {
-          steps_of = r.plan;
+        if (!steps)
           steps = std::make_unique<Progress>("[" + std::to_string(r.cell_number) + "/" + std::to_string(r.total) +
                                                  "] cell " + std::to_string(r.plan->cell.index) + " step",
-                                             r.steps, Progress::Mode::automatic, stderr, line_seconds);
-        }
+                                             r.steps, line_seconds);
         steps->update(r.step);
       };
       o.on_cell = [&](const CellReport& r) {
         if (steps) steps->clear();
         steps.reset();
-        steps_of = nullptr;
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!r.skipped) {
           run_seconds += r.seconds;

@@ -31,7 +31,7 @@ struct Captured {
 TEST(Progress, LinesModePrintsAHeartbeatOnlyEveryLineSecondsAndNotAtTheEnd) {
   Captured out;
   {
-    Progress p("step", 100, Progress::Mode::lines, out.file, 60.0);
+    Progress p("step", 100, 60.0, Progress::Mode::lines, out.file);
     p.update_at(1.0, 1);
     p.update_at(59.9, 10);
     EXPECT_EQ(out.text(), "");  // a short run prints nothing
@@ -47,7 +47,7 @@ TEST(Progress, LinesModePrintsAHeartbeatOnlyEveryLineSecondsAndNotAtTheEnd) {
 
 TEST(Progress, LinesModeWithZeroSecondsPrintsEveryUpdateButTheLast) {
   Captured out;
-  Progress p("cell 3 step", 3, Progress::Mode::lines, out.file, 0.0);
+  Progress p("cell 3 step", 3, 0.0, Progress::Mode::lines, out.file);
   for (int step = 0; step <= 3; ++step) p.update_at(step * 2.0, step);
   EXPECT_EQ(out.text(),
             "cell 3 step 0/3  0.0 s  left 0.0 s\n"
@@ -58,7 +58,7 @@ TEST(Progress, LinesModeWithZeroSecondsPrintsEveryUpdateButTheLast) {
 TEST(Progress, TerminalModeRewritesOneLineThrottledAndEndsOrErasesIt) {
   Captured out;
   {
-    Progress p("step", 10, Progress::Mode::terminal, out.file, 60.0);
+    Progress p("step", 10, 60.0, Progress::Mode::terminal, out.file);
     p.update_at(0.0, 1);
     p.update_at(0.1, 2);  // within 0.2 s of the last: skipped
     p.update_at(0.5, 5);
@@ -71,7 +71,7 @@ TEST(Progress, TerminalModeRewritesOneLineThrottledAndEndsOrErasesIt) {
             "\rstep 10/10  0.6 s  left 0.0 s\033[K\n");
   Captured erased;
   {
-    Progress p("step", 10, Progress::Mode::terminal, erased.file, 60.0);
+    Progress p("step", 10, 60.0, Progress::Mode::terminal, erased.file);
     p.update_at(0.0, 1);
     p.clear();  // the caller's summary line takes its place; the destructor adds nothing
   }
