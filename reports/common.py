@@ -130,12 +130,25 @@ def key_name(key):
     return parts[-2] if parts[-1] == "name" and len(parts) > 1 else parts[-1]
 
 
+# Config sections that belong to one basis: their keys mean nothing in a cell of another basis.
+BASIS_SECTIONS = ("octree",)
+
+
+def applies(result, key):
+    """False for a key of a basis the cell does not use: a hat-basis cell of a zip beside octree
+    cells carries "octree.tracking" too, but it changes nothing in that run."""
+    section = key.split(".")[0]
+    basis = get(result, "config.basis", assignment(result).get("basis"))
+    return not (section in BASIS_SECTIONS and isinstance(basis, str) and basis != section)
+
+
 def label(result, keys):
     """Legend label: the values of `keys` in the result's assignment, "key=value" joined; a true
     flag is its key alone and a false one is left out ("tracking=rebuilt, refine_input" beside
-    "tracking=rebuilt"), unless false flags are all there is to tell the variants apart."""
+    "tracking=rebuilt"), unless false flags are all there is to tell the variants apart. Keys of
+    another basis are left out ("basis=hat, solver=pcg", not "tracking=tracked")."""
     a = assignment(result)
-    present = [k for k in keys if k in a]
+    present = [k for k in keys if k in a and applies(result, k)]
     parts = [key_name(k) if a[k] is True else "%s=%s" % (key_name(k), short_value(a[k]))
              for k in present if a[k] is not False]
     if not parts:

@@ -118,6 +118,11 @@ assert common.label(r, shown) == "basis=octree, refine_input, tracking=rebuilt, 
 r["config"]["octree"]["refine_input"] = False
 assert common.label(r, shown) == "basis=octree, tracking=rebuilt, solver=multigrid", common.label(r, shown)
 assert common.label(r, ["octree.refine_input"]) == "refine_input=False", common.label(r, ["octree.refine_input"])
+# A hat-basis cell beside octree cells (sphere_error's zip) carries the octree defaults: not named.
+h = {"_stem": "h", "config": {"basis": "hat", "solver": {"name": "pcg"}, "octree": {"refine_input": False, "tracking": "tracked"}}}
+assert common.label(h, shown) == "basis=hat, solver=pcg", common.label(h, shown)
+h = {"_stem": "h", "cell": {"assignment": {"basis": "hat", "octree.tracking": "tracked", "solver.name": "pcg"}}}
+assert common.label(h, shown) == "basis=hat, solver=pcg", common.label(h, shown)
 figures = []
 common.save_figure = lambda fig, *args: figures.append(fig)
 cells = [{"_stem": f, "_path": f + ".json", "config": {"flow": f, "mesh": "m"}, "status": "ok",
