@@ -134,11 +134,10 @@ def key_name(key):
 BASIS_SECTIONS = ("octree",)
 
 
-def applies(result, key):
+def applies(key, basis):
     """False for a key of a basis the cell does not use: a hat-basis cell of a zip beside octree
     cells carries "octree.tracking" too, but it changes nothing in that run."""
     section = key.split(".")[0]
-    basis = get(result, "config.basis", assignment(result).get("basis"))
     return not (section in BASIS_SECTIONS and isinstance(basis, str) and basis != section)
 
 
@@ -148,7 +147,8 @@ def label(result, keys):
     "tracking=rebuilt"), unless false flags are all there is to tell the variants apart. Keys of
     another basis are left out ("basis=hat, solver=pcg", not "tracking=tracked")."""
     a = assignment(result)
-    present = [k for k in keys if k in a and applies(result, k)]
+    basis = get(result, "config.basis", a.get("basis"))
+    present = [k for k in keys if k in a and applies(k, basis)]
     parts = [key_name(k) if a[k] is True else "%s=%s" % (key_name(k), short_value(a[k]))
              for k in present if a[k] is not False]
     if not parts:
