@@ -3,6 +3,8 @@
 
 #include "datasets/mesh_io.h"
 
+#include "datasets/ply_format.h"
+
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
@@ -199,25 +201,13 @@ FileCounts scan_obj(const std::string& path) {
   return counts;
 }
 
-// PLY: the header names the vertex and face element counts (ASCII and binary alike). Polygon
-// sizes would need the body, so a polygonal PLY only gets the lower bound "one face each".
-FileCounts scan_ply(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file");
-  std::string line;
-  if (!std::getline(in, line) || clean_line(line) != "ply") fail(path, "not a PLY file (no 'ply' magic)");
+// PLY: a full walk of header and body (ply_format.cpp), which also gives exact doubles.
+FileCounts scan_ply_counts(const std::string& path) {
+  PlyContents ply = scan_ply(path);
   FileCounts counts;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string w1, w2;
-    long long n = -1;
-    ls >> w1;
-    if (w1 == "end_header") break;
-    if (w1 == "element" && (ls >> w2 >> n)) {
-      if (w2 == "vertex") counts.vertices = n;
-      if (w2 == "face") counts.triangles = n;
-    }
-  }
+  counts.vertices = ply.vertices;
+  counts.triangles = ply.triangles;
+  counts.coords = std::move(ply.coords);
   return counts;
 }
 
@@ -277,7 +267,7 @@ TriangleMesh read_mesh(const std::string& path) {
   FileCounts expected;
   if (ext == ".off") expected = scan_off(path);
   else if (ext == ".obj") expected = scan_obj(path);
-  else if (ext == ".ply") expected = scan_ply(path);
+  else if (ext == ".ply") expected = scan_ply_counts(path);
   else if (ext == ".stl") expected = scan_stl(path);
   else fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
 
@@ -327,8 +317,8 @@ TriangleMesh read_mesh(const std::string& path) {
 
 namespace {
 
-// OFF and OBJ are written here rather than by OpenMesh, whose writers round coordinates to
-// float: with 17 significant digits an ASCII file reproduces every double exactly.
+// OFF and OBJ (and PLY, ply_format.cpp) are written here rather than by OpenMesh, whose writers
+// round coordinates to float: with 17 significant digits an ASCII file reproduces every double.
 bool write_ascii_exact(const fs::path& file, const TriangleMesh& mesh, bool obj) {
   std::FILE* out = std::fopen(file.c_str(), "wb");
   if (!out) return false;
@@ -385,13 +375,13 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) 
   fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
                         std::to_string(counter++) + target.extension().string());
-  const bool written = (ext == ".off" || ext == ".obj")
-                           ? write_ascii_exact(tmp, mesh, ext == ".obj")
-                           : OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17);
+  const bool written = ext == ".off" || ext == ".obj" ? write_ascii_exact(tmp, mesh, ext == ".obj")
+                       : ext == ".ply"                 ? write_ply(tmp, mesh, binary)
+                                                       : OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17);
   if (!written) {
     std::error_code ec;
     fs::remove(tmp, ec);
-    fail(path, "OpenMesh could not write the file (folder missing or not writable?)");
+    fail(path, "could not write the file (folder missing or not writable?)");
   }
   std::error_code ec;
   fs::rename(tmp, target, ec);

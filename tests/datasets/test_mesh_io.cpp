@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
@@ -153,10 +156,107 @@ TEST(MeshIo, AsciiKeepsDoublesExactly) {
   TempDir dir;
   TriangleMesh m = make_icosphere(1);
   m.vertices *= 1.0 / 3.0;  // not representable in float
-  for (const char* name : {"x.off", "x.obj"}) {
-    write_mesh(dir.file(name), m);
-    EXPECT_EQ(read_mesh(dir.file(name)).vertices, m.vertices) << name;
+  for (const char* name : {"x.off", "x.obj", "x.ply"}) {
+    for (bool binary : {false, true}) {
+      write_mesh(dir.file(name), m, binary);
+      EXPECT_EQ(read_mesh(dir.file(name)).vertices, m.vertices) << name << (binary ? " binary" : " ascii");
+    }
   }
+}
+
+// --- PLY: every record is walked (ply_format.cpp), so errors name the line (ASCII) or byte. ---
+
+const std::string kTetraPlyHeader =
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+    "element face 4\nproperty list uchar int vertex_indices\nend_header\n";  // lines 1-9
+const std::string kTetraVertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";           // lines 10-13
+const std::string kTetraFaces = "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";     // lines 14-17
+
+TEST(MeshIoPly, AsciiErrorsNameTheLine) {
+  TempDir dir;
+  EXPECT_EQ(read_mesh(dir.write("ok.ply", kTetraPlyHeader + kTetraVertices + kTetraFaces)).num_faces(), 4);
+  struct Case {
+    const char* file;
+    std::string vertices, faces;  // the body, lines 10-13 and 14-17
+    const char* error;
+  };
+  const Case cases[] = {
+      {"nan.ply", "0 0 0\n1 0 0\n0 nan 0\n0 0 1\n", kTetraFaces, "line 12: vertex 2 has a non-finite coordinate y"},
+      {"range.ply", kTetraVertices, "3 0 2 1\n3 0 1 3\n3 1 2 9\n3 0 3 2\n",
+       "line 16: face 2 references vertex 9 but the mesh has 4 vertices"},
+      {"short.ply", kTetraVertices, "3 0 2 1\n3 0 1 3\n", "the file ends at line 16 before face 2 of 4 is complete"},
+      // A value missing or one too many: the error is on that line, not a misread of the rest.
+      {"missing.ply", "0 0 0\n1 0\n0 1 0\n0 0 1\n", kTetraFaces, "line 11: vertex 1 of 4 ends after 2 values"},
+      {"extra.ply", "0 0 0\n1 0 0 7\n0 1 0\n0 0 1\n", kTetraFaces, "line 11: vertex 1 of 4 has more values than its 3"},
+      {"two.ply", kTetraVertices, "3 0 2 1\n3 0 1\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 of 4 ends after 3 values"},
+      {"word.ply", kTetraVertices, "3 0 2 1\n3 0 1 x\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 corner 2: 'x' is not an integer"},
+      {"corners.ply", kTetraVertices, "3 0 2 1\n2 0 1\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 has 2 corners"},
+  };
+  for (const Case& c : cases) expect_error_naming(dir.write(c.file, kTetraPlyHeader + c.vertices + c.faces), c.error);
+  // Blank lines between records and trailing blanks are fine.
+  EXPECT_EQ(read_mesh(dir.write("blank.ply", kTetraPlyHeader + "0 0 0\n\n1 0 0  \n0 1 0\n0 0 1\n" + kTetraFaces + "\n")).num_faces(), 4);
+}
+
+TEST(MeshIoPly, HeaderErrorsNameTheLine) {
+  TempDir dir;
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string h = kTetraPlyHeader;
+    h.replace(h.find(from), from.size(), to);
+    return h + kTetraVertices + kTetraFaces;
+  };
+  expect_error_naming(dir.write("format.ply", with("format ascii", "format utf8")), "line 2: unknown format 'utf8'");
+  expect_error_naming(dir.write("type.ply", with("property double y", "property real y")), "line 5: unknown property type 'real'");
+  expect_error_naming(dir.write("noz.ply", with("property double z", "property double w")), "no scalar property 'z'");
+  expect_error_naming(dir.write("nolist.ply", with("vertex_indices", "corners")), "no list property 'vertex_indices'");
+  expect_error_naming(dir.write("noend.ply", kTetraPlyHeader.substr(0, kTetraPlyHeader.find("end_header"))), "no end_header");
+}
+
+// Little- or big-endian bytes of a value, to write binary test files by hand.
+template <typename T>
+std::string bytes(T value, bool big_endian) {
+  std::string b(sizeof(T), '\0');
+  std::memcpy(b.data(), &value, sizeof(T));
+  if (big_endian == (std::endian::native == std::endian::little)) std::reverse(b.begin(), b.end());
+  return b;
+}
+
+// A binary tetrahedron with float coordinates, an extra per-vertex property and an extra element
+// after the faces: what scanners and laser-scan exports write.
+std::string binary_tetra(bool big_endian, int bad_index = 2, int faces_written = 4) {
+  std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                  " 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                  "property uchar red\nelement face 4\nproperty list uchar int vertex_indices\n"
+                  "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n";
+  const float v[4][3] = {{0, 0, 0}, {0.1f, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (const auto& p : v) {
+    for (float c : p) s += bytes(c, big_endian);
+    s += bytes(std::uint8_t{200}, big_endian);
+  }
+  const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, bad_index, 3}, {0, 3, 2}};
+  for (int i = 0; i < faces_written; ++i) {
+    s += bytes(std::uint8_t{3}, big_endian);
+    for (int c : f[i]) s += bytes(std::int32_t{c}, big_endian);
+  }
+  if (faces_written == 4) s += bytes(std::int32_t{0}, big_endian) + bytes(std::int32_t{1}, big_endian);
+  return s;
+}
+
+TEST(MeshIoPly, BinaryBothByteOrders) {
+  TempDir dir;
+  for (bool big : {false, true}) {
+    const TriangleMesh m = read_mesh(dir.write(big ? "big.ply" : "little.ply", binary_tetra(big)));
+    ASSERT_EQ(m.num_vertices(), 4);
+    ASSERT_EQ(m.num_faces(), 4);
+    EXPECT_EQ(m.vertices(1, 0), double(0.1f)) << "float widened exactly, big endian " << big;
+    EXPECT_TRUE(test::same_face(m.faces.row(2), Eigen::RowVector3i(1, 2, 3)));
+    EXPECT_GT(test::signed_volume(m), 0);
+  }
+  // Vertex records take 13 bytes, face records 13 (count, then three indices).
+  auto header_bytes = [](bool big) { return binary_tetra(big).find("end_header\n") + 11; };
+  expect_error_naming(dir.write("range_bin.ply", binary_tetra(false, 6)),
+                      "byte " + std::to_string(header_bytes(false) + 4 * 13 + 2 * 13 + 5) + ": face 2 references vertex 6");
+  expect_error_naming(dir.write("short_bin.ply", binary_tetra(true, 2, 3)),
+                      "the file ends at byte " + std::to_string(header_bytes(true) + 4 * 13 + 3 * 13) + " before face 3 of 4");
 }
 
 // Round trip of a torus (irrational coordinates) through every format.
@@ -193,8 +293,8 @@ void expect_round_trip(const std::string& name, bool binary, double tol, bool ke
 }
 
 TEST(MeshIo, RoundTripOff) { expect_round_trip("t.off", false, 1e-15); }
-TEST(MeshIo, RoundTripPlyAscii) { expect_round_trip("t.ply", false, 1e-6); }  // OpenMesh: float
-TEST(MeshIo, RoundTripPlyBinary) { expect_round_trip("t.ply", true, 1e-6); }
+TEST(MeshIo, RoundTripPlyAscii) { expect_round_trip("t.ply", false, 0.0); }  // property double
+TEST(MeshIo, RoundTripPlyBinary) { expect_round_trip("t.ply", true, 0.0); }
 TEST(MeshIo, RoundTripObj) { expect_round_trip("t.obj", false, 1e-15); }
 TEST(MeshIo, RoundTripStlAscii) { expect_round_trip("t.stl", false, 1e-6, false); }
 TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false); }

@@ -1,0 +1,345 @@
+// PLY read and written in double precision (ply_format.h). The format: Paul Bourke's description
+// of Greg Turk's PLY ("PLY - Polygon File Format"): a text header of `element NAME COUNT` lines,
+// each followed by its `property TYPE NAME` / `property list COUNT_TYPE ITEM_TYPE NAME` lines,
+// then the records of every element in header order, as whitespace-separated text (ascii) or
+// packed values (binary_little_endian, binary_big_endian).
+
+#include "datasets/ply_format.h"
+
+#include "datasets/mesh_error.h"
+
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace mcf {
+namespace {
+
+enum class Encoding { Ascii, LittleEndian, BigEndian };
+
+// A scalar type's size in bytes, 0 for an unknown name. Both spellings of the format: the
+// original (char, uchar, ...) and the sized one (int8, uint8, ...).
+int type_size(const std::string& t) {
+  if (t == "char" || t == "int8" || t == "uchar" || t == "uint8") return 1;
+  if (t == "short" || t == "int16" || t == "ushort" || t == "uint16") return 2;
+  if (t == "int" || t == "int32" || t == "uint" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+struct Property {
+  std::string name;
+  std::string type;        // the item type of a list
+  std::string count_type;  // empty: a scalar property
+  bool is_list() const { return !count_type.empty(); }
+};
+
+struct Element {
+  std::string name;
+  long long count = 0;
+  std::vector<Property> properties;
+};
+
+struct Header {
+  Encoding encoding = Encoding::Ascii;
+  std::vector<Element> elements;
+  std::size_t body_offset = 0;  // first byte after the end_header line
+  long long body_line = 1;      // line number of the body's first line (ASCII)
+};
+
+std::string trim(std::string s) {
+  while (!s.empty() && (s.back() == '\r' || s.back() == ' ' || s.back() == '\t')) s.pop_back();
+  std::size_t start = 0;
+  while (start < s.size() && (s[start] == ' ' || s[start] == '\t')) ++start;
+  return s.substr(start);
+}
+
+Header parse_header(const std::string& path, const std::string& data) {
+  auto fail = [&](long long line, const std::string& problem) -> void {
+    throw MeshError(path + ": line " + std::to_string(line) + ": " + problem);
+  };
+  Header h;
+  bool have_format = false;
+  std::size_t pos = 0;
+  long long line_number = 0;
+  while (true) {
+    if (pos >= data.size()) fail(line_number, "the header has no end_header line");
+    const std::size_t eol = data.find('\n', pos);
+    const std::string line = trim(data.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos));
+    pos = eol == std::string::npos ? data.size() : eol + 1;
+    ++line_number;
+    std::istringstream ls(line);
+    std::string word;
+    ls >> word;
+    if (line_number == 1) {
+      if (word != "ply") throw MeshError(path + ": not a PLY file (no 'ply' magic)");
+      continue;
+    }
+    if (word.empty() || word == "comment" || word == "obj_info") continue;
+    if (word == "end_header") {
+      if (!have_format) fail(line_number, "the header has no format line");
+      h.body_offset = pos;
+      h.body_line = line_number + 1;
+      return h;
+    }
+    if (word == "format") {
+      std::string encoding, version;
+      ls >> encoding >> version;
+      if (encoding == "ascii") h.encoding = Encoding::Ascii;
+      else if (encoding == "binary_little_endian") h.encoding = Encoding::LittleEndian;
+      else if (encoding == "binary_big_endian") h.encoding = Encoding::BigEndian;
+      else fail(line_number, "unknown format '" + encoding + "' (ascii, binary_little_endian, binary_big_endian)");
+      have_format = true;
+    } else if (word == "element") {
+      Element e;
+      if (!(ls >> e.name >> e.count) || e.count < 0) fail(line_number, "bad element line '" + line + "'");
+      h.elements.push_back(e);
+    } else if (word == "property") {
+      if (h.elements.empty()) fail(line_number, "property before any element");
+      Property p;
+      std::string first;
+      ls >> first;
+      if (first == "list") ls >> p.count_type >> p.type >> p.name;
+      else {
+        p.type = first;
+        ls >> p.name;
+      }
+      if (p.name.empty()) fail(line_number, "bad property line '" + line + "'");
+      for (const std::string* t : {&p.type, &p.count_type})
+        if ((t == &p.type || p.is_list()) && type_size(*t) == 0)
+          fail(line_number, "unknown property type '" + *t + "'");
+      h.elements.back().properties.push_back(p);
+    } else {
+      fail(line_number, "unknown header keyword '" + word + "'");
+    }
+  }
+}
+
+// Reads the body value by value, in either encoding, knowing where it is for error messages.
+class BodyReader {
+ public:
+  BodyReader(const std::string& path, const std::string& data, const Header& h)
+      : path_(path), data_(data), encoding_(h.encoding), pos_(h.body_offset), line_(h.body_line) {}
+
+  /// The next value, converted to double (exact for every PLY type).
+  double next(const std::string& type, const std::string& what) {
+    if (encoding_ == Encoding::Ascii) return next_text(what, /*integer=*/false);
+    return next_binary(type);
+  }
+  /// The next value, which must be an integer (list counts, vertex indices).
+  long long next_integer(const std::string& type, const std::string& what) {
+    const double v = encoding_ == Encoding::Ascii ? next_text(what, /*integer=*/true) : next_binary(type);
+    if (encoding_ != Encoding::Ascii && v != std::floor(v))
+      fail(what + " is not an integer (" + std::to_string(v) + ")");
+    return static_cast<long long>(v);
+  }
+  /// ASCII records are one line each (every writer does so); checking it turns a missing or extra
+  /// value into an error on its own line rather than a misread of every record after it.
+  void start_record(const std::string& what) {
+    record_ = what;
+    record_values_ = 0;
+  }
+  void end_record() {
+    if (encoding_ != Encoding::Ascii || record_values_ == 0) return;
+    std::size_t p = pos_;
+    while (p < data_.size() && data_[p] != '\n' && std::isspace(static_cast<unsigned char>(data_[p]))) ++p;
+    if (p < data_.size() && data_[p] != '\n')
+      throw MeshError(path_ + ": line " + std::to_string(line_) + ": " + record_ + " has more values than its " +
+                      std::to_string(record_values_) + " declared in the header");
+  }
+  /// "line 12" (ASCII) or "byte 4711" (binary): where the last value read began.
+  std::string where() const {
+    return encoding_ == Encoding::Ascii ? "line " + std::to_string(token_line_) : "byte " + std::to_string(token_pos_);
+  }
+  [[noreturn]] void fail(const std::string& problem) const { throw MeshError(path_ + ": " + where() + ": " + problem); }
+  [[noreturn]] void fail_at_end() const {
+    throw MeshError(path_ + ": the file ends at " +
+                    (encoding_ == Encoding::Ascii ? "line " + std::to_string(line_) : "byte " + std::to_string(data_.size())) +
+                    " before " + record_ + " is complete");
+  }
+
+ private:
+  double next_text(const std::string& what, bool integer) {
+    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) {
+      if (data_[pos_] == '\n') ++line_;
+      ++pos_;
+    }
+    if (pos_ >= data_.size()) fail_at_end();
+    if (record_values_ > 0 && line_ != token_line_)
+      throw MeshError(path_ + ": line " + std::to_string(token_line_) + ": " + record_ + " ends after " +
+                      std::to_string(record_values_) + " values (the header declares more)");
+    ++record_values_;
+    token_line_ = line_;
+    token_pos_ = pos_;
+    std::size_t stop = pos_;
+    while (stop < data_.size() && !std::isspace(static_cast<unsigned char>(data_[stop]))) ++stop;
+    const std::string token = data_.substr(pos_, stop - pos_);
+    pos_ = stop;
+    char* end = nullptr;
+    if (integer) {
+      const long long v = std::strtoll(token.c_str(), &end, 10);
+      if (end != token.c_str() + token.size()) fail(what + ": '" + token + "' is not an integer");
+      return static_cast<double>(v);
+    }
+    const double v = std::strtod(token.c_str(), &end);
+    if (end != token.c_str() + token.size()) fail(what + ": cannot parse '" + token + "' as a number");
+    return v;
+  }
+
+  double next_binary(const std::string& type) {
+    const int size = type_size(type);
+    if (pos_ + size > data_.size()) fail_at_end();
+    token_pos_ = pos_;
+    unsigned char b[8];
+    std::memcpy(b, data_.data() + pos_, size);
+    pos_ += size;
+    const bool swap = (encoding_ == Encoding::LittleEndian) != (std::endian::native == std::endian::little);
+    if (swap)
+      for (int i = 0; i < size / 2; ++i) std::swap(b[i], b[size - 1 - i]);
+    auto as = [&b]<typename T>(T) {
+      T v;
+      std::memcpy(&v, b, sizeof v);
+      return static_cast<double>(v);
+    };
+    if (type == "char" || type == "int8") return as(std::int8_t{});
+    if (type == "uchar" || type == "uint8") return as(std::uint8_t{});
+    if (type == "short" || type == "int16") return as(std::int16_t{});
+    if (type == "ushort" || type == "uint16") return as(std::uint16_t{});
+    if (type == "int" || type == "int32") return as(std::int32_t{});
+    if (type == "uint" || type == "uint32") return as(std::uint32_t{});
+    if (type == "float" || type == "float32") return as(float{});
+    return as(double{});
+  }
+
+  const std::string& path_;
+  const std::string& data_;
+  Encoding encoding_;
+  std::size_t pos_;
+  long long line_;
+  long long token_line_ = 0;
+  std::string record_;
+  int record_values_ = 0;
+  std::size_t token_pos_ = 0;
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw MeshError(path + ": cannot open file");
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+PlyContents scan_ply(const std::string& path) {
+  const std::string data = read_file(path);
+  const Header header = parse_header(path, data);
+  const Element* vertex = nullptr;
+  for (const Element& e : header.elements)
+    if (e.name == "vertex") vertex = &e;
+  if (!vertex) throw MeshError(path + ": the header declares no vertex element");
+  int axis_of[3] = {-1, -1, -1};  // property index of x, y, z
+  for (std::size_t i = 0; i < vertex->properties.size(); ++i) {
+    const Property& p = vertex->properties[i];
+    for (int c = 0; c < 3; ++c)
+      if (p.name == std::string(1, char('x' + c)) && !p.is_list()) axis_of[c] = static_cast<int>(i);
+  }
+  for (int c = 0; c < 3; ++c)
+    if (axis_of[c] < 0) throw MeshError(path + ": the vertex element has no scalar property '" + std::string(1, char('x' + c)) + "'");
+
+  PlyContents out;
+  out.vertices = vertex->count;
+  out.coords.resize(3 * static_cast<std::size_t>(vertex->count));
+  BodyReader body(path, data, header);
+  for (const Element& e : header.elements) {
+    const bool is_vertex = &e == vertex;
+    const bool is_face = e.name == "face";
+    bool face_has_indices = false;
+    for (const Property& p : e.properties)
+      face_has_indices |= p.is_list() && (p.name == "vertex_indices" || p.name == "vertex_index");
+    if (is_face && !face_has_indices && e.count > 0)
+      throw MeshError(path + ": the face element has no list property 'vertex_indices'");
+    for (long long r = 0; r < e.count; ++r) {
+      const std::string record = e.name + " " + std::to_string(r) + " of " + std::to_string(e.count);
+      body.start_record(record);
+      for (std::size_t i = 0; i < e.properties.size(); ++i) {
+        const Property& p = e.properties[i];
+        if (!p.is_list()) {
+          const double v = body.next(p.type, record);
+          if (is_vertex)
+            for (int c = 0; c < 3; ++c)
+              if (axis_of[c] == static_cast<int>(i)) {
+                if (!std::isfinite(v))
+                  body.fail("vertex " + std::to_string(r) + " has a non-finite coordinate " + p.name);
+                out.coords[3 * r + c] = v;
+              }
+          continue;
+        }
+        const long long k = body.next_integer(p.count_type, record + " (list length)");
+        if (k < 0) body.fail(record + ": negative list length " + std::to_string(k));
+        const bool corners = is_face && (p.name == "vertex_indices" || p.name == "vertex_index");
+        if (corners && k < 3) body.fail("face " + std::to_string(r) + " has " + std::to_string(k) + " corners (at least 3)");
+        for (long long j = 0; j < k; ++j) {
+          if (!corners) {
+            body.next(p.type, record);
+            continue;
+          }
+          const long long index = body.next_integer(p.type, "face " + std::to_string(r) + " corner " + std::to_string(j));
+          if (index < 0 || index >= vertex->count)
+            body.fail("face " + std::to_string(r) + " references vertex " + std::to_string(index) + " but the mesh has " +
+                      std::to_string(vertex->count) + " vertices");
+        }
+        if (corners) out.triangles += k - 2;
+      }
+      body.end_record();
+    }
+  }
+  return out;
+}
+
+bool write_ply(const std::filesystem::path& file, const TriangleMesh& mesh, bool binary) {
+  std::FILE* out = std::fopen(file.c_str(), "wb");
+  if (!out) return false;
+  std::vector<char> buffer(1 << 20);
+  std::setvbuf(out, buffer.data(), _IOFBF, buffer.size());
+  std::fprintf(out,
+               "ply\nformat %s 1.0\ncomment mcfbench: double-precision coordinates\nelement vertex %lld\n"
+               "property double x\nproperty double y\nproperty double z\nelement face %lld\n"
+               "property list uchar int vertex_indices\nend_header\n",
+               binary ? "binary_little_endian" : "ascii", static_cast<long long>(mesh.num_vertices()),
+               static_cast<long long>(mesh.num_faces()));
+  // Little-endian bytes of a value whatever the host's order.
+  auto put = [out]<typename T>(T value) {
+    unsigned char b[sizeof(T)];
+    std::memcpy(b, &value, sizeof(T));
+    if constexpr (std::endian::native == std::endian::big)
+      for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+    std::fwrite(b, 1, sizeof(T), out);
+  };
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (binary)
+      for (int c = 0; c < 3; ++c) put(mesh.vertices(v, c));
+    else
+      std::fprintf(out, "%.17g %.17g %.17g\n", mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
+  }
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
+    if (binary) {
+      put(std::uint8_t{3});
+      for (int c = 0; c < 3; ++c) put(std::int32_t{mesh.faces(f, c)});
+    } else {
+      std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
+    }
+  }
+  const bool ok = std::ferror(out) == 0;
+  return std::fclose(out) == 0 && ok;
+}
+
+}  // namespace mcf

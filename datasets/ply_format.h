@@ -1,0 +1,37 @@
+#pragma once
+// The PLY format (ASCII, binary little- and big-endian) read and written in double precision.
+//
+// Why not only OpenMesh: its PLY reader goes through floats and, on a truncated file, an
+// out-of-range index or a NaN, drops faces or duplicates vertices without an error, which
+// read_mesh could then only blame on non-manifold input; its writer stores float coordinates, so
+// a flow's final.ply and frames lost the last 29 bits of every coordinate. mesh_io still reads
+// every file through OpenMesh (its half-edge insertion is what finds non-manifold faces) and
+// compares what OpenMesh added with what this walk found.
+
+#include "datasets/mesh.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace mcf {
+
+/// What a PLY file holds, from one walk of its header and body.
+struct PlyContents {
+  long long vertices = 0;
+  long long triangles = 0;       ///< after fan triangulation of every face (k corners: k - 2)
+  std::vector<double> coords;    ///< x, y, z of every vertex, as stored (float widened exactly)
+};
+
+/// Walks the whole file: header, every element's records, each face's corner indices. Throws
+/// MeshError naming the file and the line (ASCII, header) or byte offset (binary body) on an
+/// unknown format or type, a missing x/y/z or vertex_indices property, a non-finite coordinate, a
+/// face with fewer than 3 corners, an index outside 0..vertices-1, or a file that ends early.
+PlyContents scan_ply(const std::string& path);
+
+/// Writes the mesh as PLY with `property double x, y, z` (ASCII with 17 significant digits, or
+/// binary little-endian), so every coordinate reads back exactly; faces as `list uchar int
+/// vertex_indices`. Returns false when the file cannot be written (the caller names it).
+bool write_ply(const std::filesystem::path& file, const TriangleMesh& mesh, bool binary);
+
+}  // namespace mcf
