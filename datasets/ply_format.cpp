@@ -255,6 +255,11 @@ PlyContents scan_ply(const std::string& path) {
   for (int c = 0; c < 3; ++c)
     if (axis_of[c] < 0) throw MeshError(path + ": the vertex element has no scalar property '" + std::string(1, char('x' + c)) + "'");
 
+  // Every value takes at least one byte (a digit, or a binary char), so a count beyond that is a
+  // broken header; checked before the coordinates are allocated.
+  if (static_cast<double>(vertex->count) * vertex->properties.size() > static_cast<double>(data.size() - header.body_offset))
+    throw MeshError(path + ": the header declares " + std::to_string(vertex->count) +
+                    " vertices, more than the file's body can hold");
   PlyContents out;
   out.vertices = vertex->count;
   out.coords.resize(3 * static_cast<std::size_t>(vertex->count));

@@ -208,6 +208,8 @@ TEST(MeshIoPly, HeaderErrorsNameTheLine) {
   expect_error_naming(dir.write("type.ply", with("property double y", "property real y")), "line 5: unknown property type 'real'");
   expect_error_naming(dir.write("noz.ply", with("property double z", "property double w")), "no scalar property 'z'");
   expect_error_naming(dir.write("nolist.ply", with("vertex_indices", "corners")), "no list property 'vertex_indices'");
+  expect_error_naming(dir.write("huge.ply", with("element vertex 4", "element vertex 4000000000000")),
+                      "declares 4000000000000 vertices, more than the file's body can hold");
   expect_error_naming(dir.write("noend.ply", kTetraPlyHeader.substr(0, kTetraPlyHeader.find("end_header"))), "no end_header");
 }
 
