@@ -150,6 +150,12 @@ TEST(MeshIo, QuadsAreFanTriangulated) {
   const TriangleMesh o = read_mesh(obj);
   EXPECT_EQ(o.num_faces(), 3);
   EXPECT_EQ(o.num_vertices(), 5);
+  // A closed pyramid with a quad base: the PLY walk counts k - 2 triangles per face, as OpenMesh adds.
+  const auto ply = dir.write("pyramid.ply",
+                             "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n"
+                             "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n");
+  EXPECT_EQ(read_mesh(ply).num_faces(), 6);
 }
 
 TEST(MeshIo, AsciiKeepsDoublesExactly) {
