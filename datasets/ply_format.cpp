@@ -56,13 +56,6 @@ struct Header {
   long long body_line = 1;      // line number of the body's first line (ASCII)
 };
 
-std::string trim(std::string s) {
-  while (!s.empty() && (s.back() == '\r' || s.back() == ' ' || s.back() == '\t')) s.pop_back();
-  std::size_t start = 0;
-  while (start < s.size() && (s[start] == ' ' || s[start] == '\t')) ++start;
-  return s.substr(start);
-}
-
 Header parse_header(const std::string& path, const std::string& data) {
   auto fail = [&](long long line, const std::string& problem) -> void {
     throw MeshError(path + ": line " + std::to_string(line) + ": " + problem);
@@ -74,7 +67,8 @@ Header parse_header(const std::string& path, const std::string& data) {
   while (true) {
     if (pos >= data.size()) fail(line_number, "the header has no end_header line");
     const std::size_t eol = data.find('\n', pos);
-    const std::string line = trim(data.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos));
+    // Words are read with >>, which skips blanks and the '\r' of a CRLF file.
+    const std::string line = data.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos);
     pos = eol == std::string::npos ? data.size() : eol + 1;
     ++line_number;
     std::istringstream ls(line);
@@ -130,30 +124,40 @@ class BodyReader {
   BodyReader(const std::string& path, const std::string& data, const Header& h)
       : path_(path), data_(data), encoding_(h.encoding), pos_(h.body_offset), line_(h.body_line) {}
 
+  /// What the next values are, for error messages only (composed by what(), on failure).
+  enum class Part { value, list_length, corner };
+
   /// The next value, converted to double (exact for every PLY type).
-  double next(const std::string& type, const std::string& what) {
-    if (encoding_ == Encoding::Ascii) return next_text(what, /*integer=*/false);
+  double next(const std::string& type) {
+    if (encoding_ == Encoding::Ascii) return next_text(/*integer=*/false);
     return next_binary(type);
   }
   /// The next value, which must be an integer (list counts, vertex indices).
-  long long next_integer(const std::string& type, const std::string& what) {
-    const double v = encoding_ == Encoding::Ascii ? next_text(what, /*integer=*/true) : next_binary(type);
-    if (encoding_ != Encoding::Ascii && v != std::floor(v))
-      fail(what + " is not an integer (" + std::to_string(v) + ")");
+  long long next_integer(const std::string& type, Part part, long long corner = -1) {
+    part_ = part;
+    corner_ = corner;
+    const double v = encoding_ == Encoding::Ascii ? next_text(/*integer=*/true) : next_binary(type);
+    if (encoding_ != Encoding::Ascii && v != std::floor(v)) fail(what() + " is not an integer (" + std::to_string(v) + ")");
+    part_ = Part::value;
     return static_cast<long long>(v);
   }
   /// ASCII records are one line each (every writer does so); checking it turns a missing or extra
   /// value into an error on its own line rather than a misread of every record after it.
-  void start_record(const std::string& what) {
-    record_ = what;
+  void start_record(const Element& element, long long index) {
+    element_ = &element;
+    index_ = index;
     record_values_ = 0;
+  }
+  /// "face 2 of 4", the record being read.
+  std::string record() const {
+    return element_->name + " " + std::to_string(index_) + " of " + std::to_string(element_->count);
   }
   void end_record() {
     if (encoding_ != Encoding::Ascii || record_values_ == 0) return;
     std::size_t p = pos_;
     while (p < data_.size() && data_[p] != '\n' && std::isspace(static_cast<unsigned char>(data_[p]))) ++p;
     if (p < data_.size() && data_[p] != '\n')
-      throw MeshError(path_ + ": line " + std::to_string(line_) + ": " + record_ + " has more values than its " +
+      throw MeshError(path_ + ": line " + std::to_string(line_) + ": " + record() + " has more values than its " +
                       std::to_string(record_values_) + " declared in the header");
   }
   /// "line 12" (ASCII) or "byte 4711" (binary): where the last value read began.
@@ -164,34 +168,39 @@ class BodyReader {
   [[noreturn]] void fail_at_end() const {
     throw MeshError(path_ + ": the file ends at " +
                     (encoding_ == Encoding::Ascii ? "line " + std::to_string(line_) : "byte " + std::to_string(data_.size())) +
-                    " before " + record_ + " is complete");
+                    " before " + record() + " is complete");
   }
 
  private:
-  double next_text(const std::string& what, bool integer) {
+  // "face 1 corner 2", "face 1 of 4 (list length)" or "face 1 of 4".
+  std::string what() const {
+    if (part_ == Part::corner) return element_->name + " " + std::to_string(index_) + " corner " + std::to_string(corner_);
+    return record() + (part_ == Part::list_length ? " (list length)" : "");
+  }
+
+  double next_text(bool integer) {
     while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) {
       if (data_[pos_] == '\n') ++line_;
       ++pos_;
     }
     if (pos_ >= data_.size()) fail_at_end();
     if (record_values_ > 0 && line_ != token_line_)
-      throw MeshError(path_ + ": line " + std::to_string(token_line_) + ": " + record_ + " ends after " +
+      throw MeshError(path_ + ": line " + std::to_string(token_line_) + ": " + record() + " ends after " +
                       std::to_string(record_values_) + " values (the header declares more)");
     ++record_values_;
     token_line_ = line_;
     token_pos_ = pos_;
     std::size_t stop = pos_;
     while (stop < data_.size() && !std::isspace(static_cast<unsigned char>(data_[stop]))) ++stop;
-    const std::string token = data_.substr(pos_, stop - pos_);
+    // Parsed in place: data_ is a std::string, so the text ends in '\0' and the parse stops at the
+    // blank after the token at the latest; the token is copied only for an error message.
+    const char* first = data_.c_str() + pos_;
+    const char* last = data_.c_str() + stop;
     pos_ = stop;
     char* end = nullptr;
-    if (integer) {
-      const long long v = std::strtoll(token.c_str(), &end, 10);
-      if (end != token.c_str() + token.size()) fail(what + ": '" + token + "' is not an integer");
-      return static_cast<double>(v);
-    }
-    const double v = std::strtod(token.c_str(), &end);
-    if (end != token.c_str() + token.size()) fail(what + ": cannot parse '" + token + "' as a number");
+    const double v = integer ? static_cast<double>(std::strtoll(first, &end, 10)) : std::strtod(first, &end);
+    if (end != last)
+      fail(what() + ": '" + std::string(first, last) + (integer ? "' is not an integer" : "' cannot be parsed as a number"));
     return v;
   }
 
@@ -226,7 +235,10 @@ class BodyReader {
   std::size_t pos_;
   long long line_;
   long long token_line_ = 0;
-  std::string record_;
+  const Element* element_ = nullptr;
+  long long index_ = 0;
+  Part part_ = Part::value;
+  long long corner_ = -1;
   int record_values_ = 0;
   std::size_t token_pos_ = 0;
 };
@@ -273,12 +285,11 @@ PlyContents scan_ply(const std::string& path) {
     if (is_face && !face_has_indices && e.count > 0)
       throw MeshError(path + ": the face element has no list property 'vertex_indices'");
     for (long long r = 0; r < e.count; ++r) {
-      const std::string record = e.name + " " + std::to_string(r) + " of " + std::to_string(e.count);
-      body.start_record(record);
+      body.start_record(e, r);
       for (std::size_t i = 0; i < e.properties.size(); ++i) {
         const Property& p = e.properties[i];
         if (!p.is_list()) {
-          const double v = body.next(p.type, record);
+          const double v = body.next(p.type);
           if (is_vertex)
             for (int c = 0; c < 3; ++c)
               if (axis_of[c] == static_cast<int>(i)) {
@@ -288,16 +299,16 @@ PlyContents scan_ply(const std::string& path) {
               }
           continue;
         }
-        const long long k = body.next_integer(p.count_type, record + " (list length)");
-        if (k < 0) body.fail(record + ": negative list length " + std::to_string(k));
+        const long long k = body.next_integer(p.count_type, BodyReader::Part::list_length);
+        if (k < 0) body.fail(body.record() + ": negative list length " + std::to_string(k));
         const bool corners = is_face && (p.name == "vertex_indices" || p.name == "vertex_index");
         if (corners && k < 3) body.fail("face " + std::to_string(r) + " has " + std::to_string(k) + " corners (at least 3)");
         for (long long j = 0; j < k; ++j) {
           if (!corners) {
-            body.next(p.type, record);
+            body.next(p.type);
             continue;
           }
-          const long long index = body.next_integer(p.type, "face " + std::to_string(r) + " corner " + std::to_string(j));
+          const long long index = body.next_integer(p.type, BodyReader::Part::corner, j);
           if (index < 0 || index >= vertex->count)
             body.fail("face " + std::to_string(r) + " references vertex " + std::to_string(index) + " but the mesh has " +
                       std::to_string(vertex->count) + " vertices");

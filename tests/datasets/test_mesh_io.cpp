@@ -197,8 +197,13 @@ TEST(MeshIoPly, AsciiErrorsNameTheLine) {
       {"two.ply", kTetraVertices, "3 0 2 1\n3 0 1\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 of 4 ends after 3 values"},
       {"word.ply", kTetraVertices, "3 0 2 1\n3 0 1 x\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 corner 2: 'x' is not an integer"},
       {"corners.ply", kTetraVertices, "3 0 2 1\n2 0 1\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 has 2 corners"},
+      {"letters.ply", "0 0 0\n1 0 zz\n0 1 0\n0 0 1\n", kTetraFaces, "line 11: vertex 1 of 4: 'zz' cannot be parsed as a number"},
   };
   for (const Case& c : cases) expect_error_naming(dir.write(c.file, kTetraPlyHeader + c.vertices + c.faces), c.error);
+  // A CRLF file reads as its LF twin.
+  std::string crlf;
+  for (char c : kTetraPlyHeader + kTetraVertices + kTetraFaces) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  EXPECT_EQ(read_mesh(dir.write("crlf.ply", crlf)).vertices, read_mesh(dir.file("ok.ply")).vertices);
   // Blank lines between records and trailing blanks are fine.
   EXPECT_EQ(read_mesh(dir.write("blank.ply", kTetraPlyHeader + "0 0 0\n\n1 0 0  \n0 1 0\n0 0 1\n" + kTetraFaces + "\n")).num_faces(), 4);
 }
