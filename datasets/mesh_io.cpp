@@ -317,23 +317,29 @@ TriangleMesh read_mesh(const std::string& path) {
 
 namespace {
 
-// OFF and OBJ (and PLY, ply_format.cpp) are written here rather than by OpenMesh, whose writers
-// round coordinates to float: with 17 significant digits an ASCII file reproduces every double.
-bool write_ascii_exact(const fs::path& file, const TriangleMesh& mesh, bool obj) {
+// OFF, OBJ and PLY are written here rather than by OpenMesh, whose writers round coordinates to
+// float: with 17 significant digits a text file reproduces every double, and binary PLY stores
+// doubles. An ASCII PLY body is line for line an OFF body; only their headers differ.
+bool write_exact(const fs::path& file, const TriangleMesh& mesh, const std::string& ext, bool binary) {
   std::FILE* out = std::fopen(file.c_str(), "wb");
   if (!out) return false;
   std::vector<char> buffer(1 << 20);
   std::setvbuf(out, buffer.data(), _IOFBF, buffer.size());
-  if (obj) std::fprintf(out, "# %lld vertices, %lld faces\n", static_cast<long long>(mesh.num_vertices()),
-                        static_cast<long long>(mesh.num_faces()));
-  else std::fprintf(out, "OFF\n%lld %lld 0\n", static_cast<long long>(mesh.num_vertices()),
-                    static_cast<long long>(mesh.num_faces()));
-  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v)
-    std::fprintf(out, obj ? "v %.17g %.17g %.17g\n" : "%.17g %.17g %.17g\n", mesh.vertices(v, 0), mesh.vertices(v, 1),
-                 mesh.vertices(v, 2));
-  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
-    if (obj) std::fprintf(out, "f %d %d %d\n", mesh.faces(f, 0) + 1, mesh.faces(f, 1) + 1, mesh.faces(f, 2) + 1);
-    else std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
+  const bool obj = ext == ".obj";
+  const long long nv = mesh.num_vertices(), nf = mesh.num_faces();
+  if (ext == ".ply") std::fputs(ply_header(mesh, binary).c_str(), out);
+  else if (obj) std::fprintf(out, "# %lld vertices, %lld faces\n", nv, nf);
+  else std::fprintf(out, "OFF\n%lld %lld 0\n", nv, nf);
+  if (ext == ".ply" && binary) {
+    write_ply_binary_body(out, mesh);
+  } else {
+    for (Eigen::Index v = 0; v < nv; ++v)
+      std::fprintf(out, obj ? "v %.17g %.17g %.17g\n" : "%.17g %.17g %.17g\n", mesh.vertices(v, 0), mesh.vertices(v, 1),
+                   mesh.vertices(v, 2));
+    for (Eigen::Index f = 0; f < nf; ++f) {
+      if (obj) std::fprintf(out, "f %d %d %d\n", mesh.faces(f, 0) + 1, mesh.faces(f, 1) + 1, mesh.faces(f, 2) + 1);
+      else std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
+    }
   }
   const bool ok = std::ferror(out) == 0;
   return std::fclose(out) == 0 && ok;
@@ -364,9 +370,10 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) 
       fail(path, "cannot write: face " + std::to_string(f) + " makes the mesh non-manifold");
   }
 
-  // OFF has a binary variant, but few readers besides OpenMesh accept it: OFF stays ASCII.
+  // OpenMesh writes STL only (write_exact the rest). OFF has a binary variant, but few readers
+  // besides OpenMesh accept it: OFF stays ASCII.
   OpenMesh::IO::Options opt;
-  if (binary && ext != ".off" && ext != ".obj") opt += OpenMesh::IO::Options::Binary;
+  if (binary) opt += OpenMesh::IO::Options::Binary;
 
   // Temporary name in the same folder (rename is atomic only within a file system), keeping the
   // extension because OpenMesh chooses the writer from it.
@@ -375,9 +382,8 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) 
   fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
                         std::to_string(counter++) + target.extension().string());
-  const bool written = ext == ".off" || ext == ".obj" ? write_ascii_exact(tmp, mesh, ext == ".obj")
-                       : ext == ".ply"                 ? write_ply(tmp, mesh, binary)
-                                                       : OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17);
+  const bool written = ext == ".stl" ? OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17)
+                                     : write_exact(tmp, mesh, ext, binary);
   if (!written) {
     std::error_code ec;
     fs::remove(tmp, ec);

@@ -321,17 +321,14 @@ PlyContents scan_ply(const std::string& path) {
   return out;
 }
 
-bool write_ply(const std::filesystem::path& file, const TriangleMesh& mesh, bool binary) {
-  std::FILE* out = std::fopen(file.c_str(), "wb");
-  if (!out) return false;
-  std::vector<char> buffer(1 << 20);
-  std::setvbuf(out, buffer.data(), _IOFBF, buffer.size());
-  std::fprintf(out,
-               "ply\nformat %s 1.0\ncomment mcfbench: double-precision coordinates\nelement vertex %lld\n"
-               "property double x\nproperty double y\nproperty double z\nelement face %lld\n"
-               "property list uchar int vertex_indices\nend_header\n",
-               binary ? "binary_little_endian" : "ascii", static_cast<long long>(mesh.num_vertices()),
-               static_cast<long long>(mesh.num_faces()));
+std::string ply_header(const TriangleMesh& mesh, bool binary) {
+  return std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+         " 1.0\ncomment mcfbench: double-precision coordinates\nelement vertex " +
+         std::to_string(mesh.num_vertices()) + "\nproperty double x\nproperty double y\nproperty double z\nelement face " +
+         std::to_string(mesh.num_faces()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
+void write_ply_binary_body(std::FILE* out, const TriangleMesh& mesh) {
   // Little-endian bytes of a value whatever the host's order.
   auto put = [out]<typename T>(T value) {
     unsigned char b[sizeof(T)];
@@ -340,22 +337,12 @@ bool write_ply(const std::filesystem::path& file, const TriangleMesh& mesh, bool
       for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
     std::fwrite(b, 1, sizeof(T), out);
   };
-  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
-    if (binary)
-      for (int c = 0; c < 3; ++c) put(mesh.vertices(v, c));
-    else
-      std::fprintf(out, "%.17g %.17g %.17g\n", mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
-  }
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v)
+    for (int c = 0; c < 3; ++c) put(mesh.vertices(v, c));
   for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
-    if (binary) {
-      put(std::uint8_t{3});
-      for (int c = 0; c < 3; ++c) put(std::int32_t{mesh.faces(f, c)});
-    } else {
-      std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
-    }
+    put(std::uint8_t{3});
+    for (int c = 0; c < 3; ++c) put(std::int32_t{mesh.faces(f, c)});
   }
-  const bool ok = std::ferror(out) == 0;
-  return std::fclose(out) == 0 && ok;
 }
 
 }  // namespace mcf

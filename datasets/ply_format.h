@@ -10,7 +10,7 @@
 
 #include "datasets/mesh.h"
 
-#include <filesystem>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -29,9 +29,13 @@ struct PlyContents {
 /// face with fewer than 3 corners, an index outside 0..vertices-1, or a file that ends early.
 PlyContents scan_ply(const std::string& path);
 
-/// Writes the mesh as PLY with `property double x, y, z` (ASCII with 17 significant digits, or
-/// binary little-endian), so every coordinate reads back exactly; faces as `list uchar int
-/// vertex_indices`. Returns false when the file cannot be written (the caller names it).
-bool write_ply(const std::filesystem::path& file, const TriangleMesh& mesh, bool binary);
+/// The header of a PLY file of this mesh with `property double x, y, z` and faces as `list uchar
+/// int vertex_indices`; ASCII bodies (17 significant digits, one record a line) are written by
+/// mesh_io beside OFF's, whose lines are the same, binary ones by write_ply_binary_body.
+std::string ply_header(const TriangleMesh& mesh, bool binary);
+
+/// The body of a binary little-endian PLY file under ply_header(mesh, true): every coordinate
+/// reads back exactly.
+void write_ply_binary_body(std::FILE* out, const TriangleMesh& mesh);
 
 }  // namespace mcf
