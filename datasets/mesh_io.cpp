@@ -1,5 +1,7 @@
-// Mesh file I/O through OpenMesh. OpenMesh only moves data between files and our Eigen arrays;
-// the extra work here is making its silent failure modes loud (DESIGN.md, practical notes).
+// Mesh file I/O. OFF, OBJ and PLY are walked here (and in ply_format.cpp) once, in exact doubles,
+// with errors that name the line; OpenMesh's half-edge insertion then checks the topology, which
+// its own readers would instead repair silently by dropping faces or duplicating vertices
+// (DESIGN.md, practical notes). STL and binary OFF are read by OpenMesh and checked by counts.
 
 #include "datasets/mesh_io.h"
 
@@ -19,6 +21,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -59,14 +63,15 @@ std::string lower_extension(const std::string& path) {
   throw MeshError(path + ": " + problem);
 }
 
-// What the file itself says it contains, counted independently of OpenMesh so that faces it
-// dropped without an error (non-manifold "complex edges", repeated indices) are noticed.
-struct FileCounts {
-  long long vertices = -1;   // -1: unknown for this format
-  long long triangles = -1;  // after fan triangulation; -1: unknown
-  // Coordinates parsed in double precision (ASCII OFF/OBJ): OpenMesh's readers go through
-  // floats, which would round every coordinate of an exactly written file.
-  std::vector<double> coords;
+// What our own walk of an OFF, OBJ or PLY file found, in file order: the coordinates as exact
+// doubles (OpenMesh's readers go through floats) and every face fan-triangulated from its first
+// corner, as OpenMesh's TriMesh would. Where each triangle came from, for error messages.
+struct WalkedMesh {
+  std::vector<double> coords;      // x, y, z per vertex
+  std::vector<int> triangles;      // 3 vertex indices (0-based) per triangle
+  std::vector<long long> source;   // per triangle: the file's face number, or its line (OBJ)
+  bool source_is_line = false;
+  int index_base = 0;              // how the file numbers its vertices (OBJ: from 1)
 };
 
 // Strips '#' comments and surrounding blanks.
@@ -78,9 +83,22 @@ std::string clean_line(std::string line) {
   return line.substr(start);
 }
 
-// ASCII OFF: header counts, finite coordinates, index range and the triangle count after fan
-// triangulation. OpenMesh's reader is lenient about all of these.
-FileCounts scan_off(const std::string& path) {
+// Appends the fan of one face (corners c0 c1 ... ck-1: triangles c0 ci ci+1).
+void add_fan(WalkedMesh& walk, const std::vector<int>& corner, long long source) {
+  for (std::size_t j = 1; j + 1 < corner.size(); ++j) {
+    walk.triangles.insert(walk.triangles.end(), {corner[0], corner[j], corner[j + 1]});
+    walk.source.push_back(source);
+  }
+}
+
+void check_int_range(const std::string& path, long long count, const char* what) {
+  if (count > std::numeric_limits<int>::max())
+    fail(path, std::to_string(count) + " " + what + ": more than a mesh's int indices can address");
+}
+
+// ASCII OFF: header counts, finite coordinates, index range; OpenMesh's reader is lenient about
+// all of these. Returns false for binary OFF, which is left to OpenMesh.
+bool walk_off(const std::string& path, WalkedMesh& walk) {
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
   std::string line;
@@ -97,10 +115,7 @@ FileCounts scan_off(const std::string& path) {
     fail(path, "not an OFF file (header '" + magic + "')");
   std::string rest;
   std::getline(hs, rest);
-  if (rest.find("BINARY") != std::string::npos) {
-    // Binary OFF: we cannot cheaply re-parse; OpenMesh's own counts are all we have.
-    return {};
-  }
+  if (rest.find("BINARY") != std::string::npos) return false;
   rest = clean_line(rest);
   while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
   long long nv = -1, nf = -1;
@@ -108,8 +123,7 @@ FileCounts scan_off(const std::string& path) {
     std::istringstream cs(rest);
     if (!(cs >> nv >> nf) || nv < 0 || nf < 0) fail(path, "bad OFF counts line '" + rest + "'");
   }
-  FileCounts counts;
-  counts.vertices = nv;
+  check_int_range(path, nv, "vertices");
   long long v = 0;
   while (v < nv && std::getline(in, line)) {
     line = clean_line(line);
@@ -120,43 +134,50 @@ FileCounts scan_off(const std::string& path) {
       double x = std::strtod(p, &end);
       if (end == p) fail(path, "vertex " + std::to_string(v) + ": cannot parse coordinates '" + line + "'");
       if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate ('" + line + "')");
-      counts.coords.push_back(x);
+      walk.coords.push_back(x);
       p = end;
     }
     ++v;
   }
   if (v < nv) fail(path, "file ends after " + std::to_string(v) + " of " + std::to_string(nv) + " vertices");
-  long long f = 0, triangles = 0;
+  long long f = 0;
+  std::vector<int> corner;
   while (f < nf && std::getline(in, line)) {
     line = clean_line(line);
     if (line.empty()) continue;
-    std::istringstream fs_(line);
-    long long k = 0;
-    if (!(fs_ >> k) || k < 3) fail(path, "face " + std::to_string(f) + ": bad vertex count in '" + line + "'");
+    const char* p = line.c_str();
+    char* end = nullptr;
+    const long long k = std::strtoll(p, &end, 10);
+    if (end == p || k < 3) fail(path, "face " + std::to_string(f) + ": bad vertex count in '" + line + "'");
+    corner.clear();
     for (long long i = 0; i < k; ++i) {
-      long long idx;
-      if (!(fs_ >> idx)) fail(path, "face " + std::to_string(f) + ": expected " + std::to_string(k) + " indices in '" + line + "'");
+      p = end;
+      const long long idx = std::strtoll(p, &end, 10);
+      if (end == p)
+        fail(path, "face " + std::to_string(f) + ": expected " + std::to_string(k) + " indices in '" + line + "'");
       if (idx < 0 || idx >= nv)
         fail(path, "face " + std::to_string(f) + " references vertex " + std::to_string(idx) +
                        " but the mesh has " + std::to_string(nv) + " vertices");
+      corner.push_back(static_cast<int>(idx));
     }
-    triangles += k - 2;
+    add_fan(walk, corner, f);
     ++f;
   }
   if (f < nf) fail(path, "file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
-  counts.triangles = triangles;
-  return counts;
+  return true;
 }
 
-// OBJ: count 'v' and 'f' records; a face with k corners becomes k-2 triangles.
-FileCounts scan_obj(const std::string& path) {
+// OBJ: 'v' and 'f' records; a face corner is "v", "v/vt", "v/vt/vn" or "v//vn", and a negative
+// v counts back from the last vertex read. Errors name the line.
+void walk_obj(const std::string& path, WalkedMesh& walk) {
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
-  FileCounts counts;
-  counts.vertices = 0;
-  counts.triangles = 0;
+  walk.source_is_line = true;
+  walk.index_base = 1;
+  long long vertices = 0;
   std::string line;
   long long line_number = 0, max_index = 0, max_index_line = 0;
+  std::vector<int> corner;
   while (std::getline(in, line)) {
     ++line_number;
     line = clean_line(line);
@@ -166,58 +187,55 @@ FileCounts scan_obj(const std::string& path) {
       for (int c = 0; c < 3; ++c) {
         char* end = nullptr;
         double x = std::strtod(p, &end);
-        if (end == p) fail(path, "vertex " + std::to_string(counts.vertices) + ": cannot parse '" + line + "'");
-        if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(counts.vertices) + " has a non-finite coordinate ('" + line + "')");
-        counts.coords.push_back(x);
+        if (end == p) fail(path, "vertex " + std::to_string(vertices) + ": cannot parse '" + line + "'");
+        if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(vertices) + " has a non-finite coordinate ('" + line + "')");
+        walk.coords.push_back(x);
         p = end;
       }
-      ++counts.vertices;
+      ++vertices;
+      check_int_range(path, vertices, "vertices");
     } else if (line[0] == 'f' && std::isspace(static_cast<unsigned char>(line[1]))) {
       std::istringstream fs_(line.substr(2));
       std::string tok;
-      long long k = 0;
+      corner.clear();
       while (fs_ >> tok) {
-        ++k;
-        // "v", "v/vt", "v/vt/vn" or "v//vn"; a negative v counts back from the last vertex read.
         // OpenMesh drops a face with a bad index as "non-manifold", which hides the real cause.
         char* end = nullptr;
         const long long v = std::strtoll(tok.c_str(), &end, 10);
-        if (end == tok.c_str() || (*end != '\0' && *end != '/') || v == 0 || (v < 0 && -v > counts.vertices))
+        if (end == tok.c_str() || (*end != '\0' && *end != '/') || v == 0 || (v < 0 && -v > vertices))
           fail(path, "line " + std::to_string(line_number) + ": face corner '" + tok + "' is not a vertex index (1.." +
-                         std::to_string(counts.vertices) + " or -1..-" + std::to_string(counts.vertices) + " so far)");
+                         std::to_string(vertices) + " or -1..-" + std::to_string(vertices) + " so far)");
         if (v > max_index) {
           max_index = v;
           max_index_line = line_number;
         }
+        // Forward references (v beyond the vertices read so far) are checked once the file ends.
+        corner.push_back(static_cast<int>(std::min<long long>(v > 0 ? v - 1 : vertices + v, std::numeric_limits<int>::max())));
       }
-      if (k < 3) fail(path, "face with fewer than 3 corners: '" + line + "'");
-      counts.triangles += k - 2;
+      if (corner.size() < 3) fail(path, "line " + std::to_string(line_number) + ": face with fewer than 3 corners: '" + line + "'");
+      add_fan(walk, corner, line_number);
     }
   }
-  if (counts.vertices == 0 && counts.triangles == 0) fail(path, "no vertex or face records (not an OBJ file?)");
-  if (max_index > counts.vertices)
+  if (vertices == 0 && walk.triangles.empty()) fail(path, "no vertex or face records (not an OBJ file?)");
+  if (max_index > vertices)
     fail(path, "line " + std::to_string(max_index_line) + ": face refers to vertex " + std::to_string(max_index) +
-                   " but the file has " + std::to_string(counts.vertices) + " vertices");
-  return counts;
+                   " but the file has " + std::to_string(vertices) + " vertices");
 }
 
-// PLY: a full walk of header and body (ply_format.cpp), which also gives exact doubles.
-FileCounts scan_ply_counts(const std::string& path) {
+// PLY: a full walk of header and body (ply_format.cpp).
+void walk_ply(const std::string& path, WalkedMesh& walk) {
   PlyContents ply = scan_ply(path);
-  FileCounts counts;
-  counts.vertices = ply.vertices;
-  counts.triangles = ply.triangles;
-  counts.coords = std::move(ply.coords);
-  return counts;
+  walk.coords = std::move(ply.coords);
+  walk.triangles = std::move(ply.triangles);
+  walk.source.assign(ply.triangle_face.begin(), ply.triangle_face.end());
 }
 
 // STL: ASCII counts 'facet' records, binary stores the triangle count at byte 80. Vertices are
 // merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance.
-FileCounts scan_stl(const std::string& path) {
+long long count_stl_triangles(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file");
   std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  FileCounts counts;
   auto start = data.find_first_not_of(" \t\r\n");
   bool ascii = start != std::string::npos && data.compare(start, 5, "solid") == 0 &&
                data.find("facet", start) != std::string::npos;
@@ -228,30 +246,99 @@ FileCounts scan_stl(const std::string& path) {
       if (pos >= 3 && data.compare(pos - 3, 3, "end") == 0) continue;
       ++n;
     }
-    counts.triangles = n;
-  } else {
-    if (data.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
-    std::uint32_t n = 0;
-    std::memcpy(&n, data.data() + 80, 4);
-    if (data.size() < 84 + 50ull * n) fail(path, "binary STL truncated (" + std::to_string(n) + " triangles announced)");
-    counts.triangles = n;
+    return n;
   }
-  return counts;
+  if (data.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
+  std::uint32_t n = 0;
+  std::memcpy(&n, data.data() + 80, 4);
+  if (data.size() < 84 + 50ull * n) fail(path, "binary STL truncated (" + std::to_string(n) + " triangles announced)");
+  return n;
 }
 
-// STL has no vertex list to count against; OpenMesh merges equal corners, so two loaded vertices
-// at exactly the same position mean it split a vertex to add a non-manifold face.
-void check_no_split_vertices(const std::string& path, const IoMesh& om) {
-  std::vector<std::array<double, 3>> points;
-  points.reserve(om.n_vertices());
+// Adds the faces to an OpenMesh half-edge mesh in order, as its readers do. A face it cannot add
+// means a non-manifold ("complex") edge or vertex, or inconsistently oriented faces: the error
+// names the first such face (name_face(f)) and why, after prefix. The half-edge mesh is returned for writers.
+IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const TriangleMesh& mesh,
+                      const std::function<std::string(Eigen::Index)>& name_face,
+                      const std::function<std::string(int)>& name_vertex) {
+  const Eigen::Index nv = mesh.num_vertices(), nf = mesh.num_faces();
+  IoMesh om;
+  om.reserve(nv, nf + nv + 2, nf);  // edges: nf + nv - χ for a closed mesh
+  std::vector<IoMesh::VertexHandle> vh(nv);
+  for (Eigen::Index i = 0; i < nv; ++i)
+    vh[i] = om.add_vertex(IoMesh::Point(mesh.vertices(i, 0), mesh.vertices(i, 1), mesh.vertices(i, 2)));
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const int a = mesh.faces(f, 0), b = mesh.faces(f, 1), c = mesh.faces(f, 2);
+    for (int v : {a, b, c})
+      if (v < 0 || v >= nv)
+        fail(path, prefix + name_face(f) + " references vertex " + std::to_string(v) + " but the mesh has " +
+                       std::to_string(nv) + " vertices");
+    // OpenMesh's add_face does not expect a repeated corner (its readers skip such faces).
+    if (a == b || b == c || c == a)
+      fail(path, prefix + name_face(f) + " repeats vertex " + name_vertex(a == b || a == c ? a : b) + " (a degenerate face)");
+    if (om.add_face(vh[a], vh[b], vh[c]).is_valid()) continue;
+    // Why OpenMesh refused it, from the half-edge structure as it stood (a failed add_face
+    // changes nothing).
+    std::string why;
+    const int corner[3] = {a, b, c};
+    for (int j = 0; j < 3 && why.empty(); ++j) {
+      const auto h = om.find_halfedge(vh[corner[j]], vh[corner[(j + 1) % 3]]);
+      if (h.is_valid() && !om.is_boundary(h))
+        why = "its edge (" + name_vertex(corner[j]) + ", " + name_vertex(corner[(j + 1) % 3]) +
+              ") already has a face on the same side: the edge is in more than two faces, or the faces "
+              "around it are inconsistently oriented";
+    }
+    for (int j = 0; j < 3 && why.empty(); ++j)
+      if (!om.is_boundary(vh[corner[j]]))
+        why = "its vertex " + name_vertex(corner[j]) + " is already surrounded by a closed fan of faces";
+    if (why.empty()) why = "its faces around a vertex cannot be ordered into one fan (a non-manifold vertex)";
+    fail(path, prefix + "non-manifold mesh: " + name_face(f) + " (vertices " + name_vertex(a) + ", " + name_vertex(b) + ", " +
+                   name_vertex(c) + ") cannot be added: " + why);
+  }
+  return om;
+}
+
+// Binary OFF and STL: OpenMesh reads them; what it dropped or duplicated is detected by counts.
+// stl: OpenMesh merged the file's corners into vertices.
+TriangleMesh read_through_openmesh(const std::string& path, long long file_triangles, bool stl) {
+  IoMesh om;
+  OpenMesh::IO::Options opt;
+  if (!OpenMesh::IO::read_mesh(om, path, opt)) fail(path, "OpenMesh could not parse the file");
+  const long long nv = static_cast<long long>(om.n_vertices());
+  const long long nf = static_cast<long long>(om.n_faces());
+  if (stl) {
+    // STL has no vertex list to count against; OpenMesh merges equal corners, so two loaded
+    // vertices at exactly the same position mean it split a vertex to add a non-manifold face.
+    std::vector<std::array<double, 3>> points;
+    points.reserve(nv);
+    for (auto vh : om.vertices()) {
+      const auto& p = om.point(vh);
+      points.push_back({p[0], p[1], p[2]});
+    }
+    std::sort(points.begin(), points.end());
+    if (std::adjacent_find(points.begin(), points.end()) != points.end())
+      fail(path, "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
+                 "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
+  }
+  if (file_triangles >= 0 && nf < file_triangles)
+    fail(path, "only " + std::to_string(nf) + " of the file's " + std::to_string(file_triangles) +
+                   " triangles could be added: the mesh has non-manifold (complex) edges, repeated "
+                   "vertex indices in a face, or inconsistently oriented faces");
+  TriangleMesh mesh;
+  mesh.vertices.resize(nv, 3);
   for (auto vh : om.vertices()) {
     const auto& p = om.point(vh);
-    points.push_back({p[0], p[1], p[2]});
+    mesh.vertices.row(vh.idx()) << p[0], p[1], p[2];
   }
-  std::sort(points.begin(), points.end());
-  if (std::adjacent_find(points.begin(), points.end()) != points.end())
-    fail(path, "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
-               "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
+  mesh.faces.resize(nf, 3);
+  for (auto fh : om.faces()) {
+    int c = 0;
+    for (auto vh : om.fv_range(fh)) {
+      if (c == 3) fail(path, "face " + std::to_string(fh.idx()) + " is not a triangle after loading");
+      mesh.faces(fh.idx(), c++) = vh.idx();
+    }
+  }
+  return mesh;
 }
 
 }  // namespace
@@ -264,54 +351,38 @@ TriangleMesh read_mesh(const std::string& path) {
   if (fs::file_size(path, ec) == 0) fail(path, "empty file");
 
   const std::string ext = lower_extension(path);
-  FileCounts expected;
-  if (ext == ".off") expected = scan_off(path);
-  else if (ext == ".obj") expected = scan_obj(path);
-  else if (ext == ".ply") expected = scan_ply_counts(path);
-  else if (ext == ".stl") expected = scan_stl(path);
-  else fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
+  WalkedMesh walk;
+  if (ext == ".off") {
+    if (!walk_off(path, walk)) return read_through_openmesh(path, -1, false);
+  } else if (ext == ".obj") {
+    walk_obj(path, walk);
+  } else if (ext == ".ply") {
+    walk_ply(path, walk);
+  } else if (ext == ".stl") {
+    return read_through_openmesh(path, count_stl_triangles(path), true);
+  } else {
+    fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
+  }
 
-  IoMesh om;
-  OpenMesh::IO::Options opt;
-  if (!OpenMesh::IO::read_mesh(om, path, opt)) fail(path, "OpenMesh could not parse the file");
-
-  const long long nv = static_cast<long long>(om.n_vertices());
-  const long long nf = static_cast<long long>(om.n_faces());
-  // OpenMesh adds a face around a non-manifold ("complex") edge or vertex by duplicating its
-  // vertices, so more vertices than the file has means exactly that.
-  if (expected.vertices >= 0 && nv > expected.vertices)
-    fail(path, "non-manifold mesh: OpenMesh had to duplicate " + std::to_string(nv - expected.vertices) +
-                   " vertices to add faces around complex edges or vertices (an edge in more than two "
-                   "faces, or inconsistently oriented faces)");
-  if (expected.vertices >= 0 && nv != expected.vertices)
-    fail(path, "the file declares " + std::to_string(expected.vertices) + " vertices but " +
-                   std::to_string(nv) + " were read");
-  if (ext == ".stl") check_no_split_vertices(path, om);
-  if (expected.triangles >= 0 && nf < expected.triangles)
-    fail(path, "only " + std::to_string(nf) + " of the file's " + std::to_string(expected.triangles) +
-                   " triangles could be added: the mesh has non-manifold (complex) edges, repeated "
-                   "vertex indices in a face, or inconsistently oriented faces");
-
+  // One walk of the file gives the mesh; OpenMesh's half-edge insertion checks its topology.
   TriangleMesh mesh;
-  mesh.vertices.resize(nv, 3);
-  for (auto vh : om.vertices()) {
-    const auto& p = om.point(vh);
-    mesh.vertices.row(vh.idx()) << p[0], p[1], p[2];
-  }
-  // Prefer our double-precision parse, after checking it is the same vertex sequence.
-  if (nv > 0 && static_cast<long long>(expected.coords.size()) == 3 * nv) {
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> exact(expected.coords.data(), nv, 3);
-    const double scale = std::max(1.0, exact.cwiseAbs().maxCoeff());
-    if ((exact - mesh.vertices).cwiseAbs().maxCoeff() <= 1e-5 * scale) mesh.vertices = exact;
-  }
-  mesh.faces.resize(nf, 3);
-  for (auto fh : om.faces()) {
-    int c = 0;
-    for (auto vh : om.fv_range(fh)) {
-      if (c == 3) fail(path, "face " + std::to_string(fh.idx()) + " is not a triangle after loading");
-      mesh.faces(fh.idx(), c++) = vh.idx();
-    }
-  }
+  const Eigen::Index nv = static_cast<Eigen::Index>(walk.coords.size() / 3);
+  const Eigen::Index nt = static_cast<Eigen::Index>(walk.source.size());
+  mesh.vertices = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(walk.coords.data(), nv, 3);
+  std::vector<double>().swap(walk.coords);
+  mesh.faces = Eigen::Map<const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>>(walk.triangles.data(), nt, 3);
+  std::vector<int>().swap(walk.triangles);
+  auto name_face = [&](Eigen::Index t) {
+    std::string face = (walk.source_is_line ? "the face on line " : "face ") + std::to_string(walk.source[t]);
+    // A polygon's triangles share its name: say which one.
+    Eigen::Index first = t, last = t;
+    while (first > 0 && walk.source[first - 1] == walk.source[t]) --first;
+    while (last + 1 < nt && walk.source[last + 1] == walk.source[t]) ++last;
+    if (last == first) return face;
+    return "triangle " + std::to_string(t - first + 1) + " of " + std::to_string(last - first + 1) + " fanned from " + face;
+  };
+  auto name_vertex = [&](int v) { return std::to_string(v + walk.index_base); };
+  half_edge_mesh(path, "", mesh, name_face, name_vertex);
   return mesh;
 }
 
@@ -353,22 +424,10 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) 
   if (ext != ".off" && ext != ".ply" && ext != ".obj" && ext != ".stl")
     fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
 
-  IoMesh om;
-  om.reserve(mesh.num_vertices(), 3 * mesh.num_faces(), mesh.num_faces());
-  std::vector<IoMesh::VertexHandle> vh(mesh.num_vertices());
-  for (Eigen::Index i = 0; i < mesh.num_vertices(); ++i)
-    vh[i] = om.add_vertex(IoMesh::Point(mesh.vertices(i, 0), mesh.vertices(i, 1), mesh.vertices(i, 2)));
-  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
-    for (int c = 0; c < 3; ++c)
-      if (mesh.faces(f, c) < 0 || mesh.faces(f, c) >= mesh.num_vertices())
-        fail(path, "cannot write: face " + std::to_string(f) + " references vertex " +
-                       std::to_string(mesh.faces(f, c)) + " but the mesh has " +
-                       std::to_string(mesh.num_vertices()) + " vertices");
-    auto fh = om.add_face(vh[mesh.faces(f, 0)], vh[mesh.faces(f, 1)], vh[mesh.faces(f, 2)]);
-    // Writing a mesh that OpenMesh cannot represent would silently drop faces in the file.
-    if (!fh.is_valid())
-      fail(path, "cannot write: face " + std::to_string(f) + " makes the mesh non-manifold");
-  }
+  // Writing a mesh that OpenMesh cannot represent would silently drop faces in the file.
+  const IoMesh om = half_edge_mesh(
+      path, "cannot write: ", mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
+      [](int v) { return std::to_string(v); });
 
   // OpenMesh writes STL only (write_exact the rest). OFF has a binary variant, but few readers
   // besides OpenMesh accept it: OFF stays ASCII.

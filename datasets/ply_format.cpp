@@ -17,6 +17,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -272,9 +273,12 @@ PlyContents scan_ply(const std::string& path) {
   if (static_cast<double>(vertex->count) * vertex->properties.size() > static_cast<double>(data.size() - header.body_offset))
     throw MeshError(path + ": the header declares " + std::to_string(vertex->count) +
                     " vertices, more than the file's body can hold");
+  if (vertex->count > std::numeric_limits<int>::max())
+    throw MeshError(path + ": the header declares " + std::to_string(vertex->count) +
+                    " vertices, more than a mesh's int indices can address");
   PlyContents out;
-  out.vertices = vertex->count;
   out.coords.resize(3 * static_cast<std::size_t>(vertex->count));
+  std::vector<int> corner;  // one face's corners, fan-triangulated once the face is read
   BodyReader body(path, data, header);
   for (const Element& e : header.elements) {
     const bool is_vertex = &e == vertex;
@@ -303,6 +307,7 @@ PlyContents scan_ply(const std::string& path) {
         if (k < 0) body.fail(body.record() + ": negative list length " + std::to_string(k));
         const bool corners = is_face && (p.name == "vertex_indices" || p.name == "vertex_index");
         if (corners && k < 3) body.fail("face " + std::to_string(r) + " has " + std::to_string(k) + " corners (at least 3)");
+        corner.clear();
         for (long long j = 0; j < k; ++j) {
           if (!corners) {
             body.next(p.type);
@@ -312,8 +317,15 @@ PlyContents scan_ply(const std::string& path) {
           if (index < 0 || index >= vertex->count)
             body.fail("face " + std::to_string(r) + " references vertex " + std::to_string(index) + " but the mesh has " +
                       std::to_string(vertex->count) + " vertices");
+          corner.push_back(static_cast<int>(index));
         }
-        if (corners) out.triangles += k - 2;
+        if (!corners) continue;
+        if (out.triangle_face.size() + (k - 2) > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+          body.fail("more triangles than a mesh's int indices can address");
+        for (long long j = 1; j + 1 < k; ++j) {
+          out.triangles.insert(out.triangles.end(), {corner[0], corner[j], corner[j + 1]});
+          out.triangle_face.push_back(static_cast<int>(r));
+        }
       }
       body.end_record();
     }

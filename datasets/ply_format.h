@@ -1,12 +1,11 @@
 #pragma once
 // The PLY format (ASCII, binary little- and big-endian) read and written in double precision.
 //
-// Why not only OpenMesh: its PLY reader goes through floats and, on a truncated file, an
-// out-of-range index or a NaN, drops faces or duplicates vertices without an error, which
-// read_mesh could then only blame on non-manifold input; its writer stores float coordinates, so
-// a flow's final.ply and frames lost the last 29 bits of every coordinate. mesh_io still reads
-// every file through OpenMesh (its half-edge insertion is what finds non-manifold faces) and
-// compares what OpenMesh added with what this walk found.
+// Why not OpenMesh's reader: it goes through floats and, on a truncated file, an out-of-range
+// index or a NaN, drops faces or duplicates vertices without an error, which read_mesh could then
+// only blame on non-manifold input; its writer stores float coordinates, so a flow's final.ply
+// and frames lost the last 29 bits of every coordinate. mesh_io builds the mesh from this walk
+// and adds its faces to an OpenMesh half-edge mesh, whose insertion finds non-manifold faces.
 
 #include "datasets/mesh.h"
 
@@ -18,15 +17,18 @@ namespace mcf {
 
 /// What a PLY file holds, from one walk of its header and body.
 struct PlyContents {
-  long long vertices = 0;
-  long long triangles = 0;       ///< after fan triangulation of every face (k corners: k - 2)
   std::vector<double> coords;    ///< x, y, z of every vertex, as stored (float widened exactly)
+  /// Three vertex indices per triangle, every face fan-triangulated from its first corner
+  /// (k corners: k - 2 triangles), in file order.
+  std::vector<int> triangles;
+  std::vector<int> triangle_face;  ///< the file's face (0-based record) each triangle comes from
 };
 
 /// Walks the whole file: header, every element's records, each face's corner indices. Throws
 /// MeshError naming the file and the line (ASCII, header) or byte offset (binary body) on an
 /// unknown format or type, a missing x/y/z or vertex_indices property, a non-finite coordinate, a
-/// face with fewer than 3 corners, an index outside 0..vertices-1, or a file that ends early.
+/// face with fewer than 3 corners, an index outside 0..vertices-1, or a file that ends early (or
+/// more than 2^31 - 1 vertices or triangles, beyond the mesh's int indices).
 PlyContents scan_ply(const std::string& path);
 
 /// The header of a PLY file of this mesh with `property double x, y, z` and faces as `list uchar

@@ -110,9 +110,12 @@ TEST(MeshIo, NonManifoldEdge) {
   TempDir dir;
   // Edge (0,1) is shared by three triangles.
   const std::string verts = "0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n";
-  expect_error_naming(dir.write("fin.off", "OFF\n5 3 0\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"), "non-manifold");
+  // The error names the first face that cannot be added and its edge, as the file numbers them.
+  expect_error_naming(dir.write("fin.off", "OFF\n5 3 0\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"),
+                      "non-manifold mesh: face 2 (vertices 0, 1, 4) cannot be added: its edge (0, 1) already has a face");
   expect_error_naming(dir.write("fin.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\n"
-                                           "f 1 2 3\nf 2 1 4\nf 1 2 5\n"));
+                                           "f 1 2 3\nf 2 1 4\nf 1 2 5\n"),
+                      "the face on line 8 (vertices 1, 2, 5) cannot be added: its edge (1, 2)");
   expect_error_naming(dir.write("fin.stl", "solid fin\n"
                                            "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
                                            "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 0 0 0\nvertex 0 -1 0\nendloop\nendfacet\n"
@@ -121,12 +124,58 @@ TEST(MeshIo, NonManifoldEdge) {
   expect_error_naming(dir.write("fin.ply",
                                 "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
                                 "property float z\nelement face 3\nproperty list uchar int vertex_indices\n"
-                                "end_header\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"));
+                                "end_header\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"),
+                      "face 2 (vertices 0, 1, 4)");
+}
+
+TEST(MeshIo, InconsistentlyOrientedFaces) {
+  TempDir dir;
+  // Both triangles run along 0 -> 1: a half-edge mesh cannot hold them (nor can the flows).
+  expect_error_naming(dir.write("flip.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n3 0 1 2\n3 0 1 3\n"),
+                      "face 1 (vertices 0, 1, 3) cannot be added: its edge (0, 1) already has a face on the same side");
+}
+
+TEST(MeshIo, NonManifoldVertex) {
+  TempDir dir;
+  // Two closed tetrahedra sharing vertex 0: once the first is closed, vertex 0 has no free side.
+  const std::string off = "OFF\n7 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n-1 0 0\n0 -1 0\n0 0 -1\n"
+                          "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+                          "3 0 4 5\n3 0 5 6\n3 0 6 4\n3 4 6 5\n";
+  expect_error_naming(dir.write("pinch.off", off), "face 4 (vertices 0, 4, 5) cannot be added: its vertex 0 is already surrounded");
+}
+
+TEST(MeshIo, NonManifoldPolygonNamesItsFan) {
+  TempDir dir;
+  // The quad 0 1 4 5 is fanned into (0 1 4) and (0 4 5); the first repeats edge 0 -> 1.
+  expect_error_naming(dir.write("quadfin.off", "OFF\n6 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 -1 0\n0 0 1\n"
+                                               "3 0 1 2\n4 0 1 4 5\n"),
+                      "triangle 1 of 2 fanned from face 1 (vertices 0, 1, 4)");
+}
+
+TEST(MeshIo, WritingANonManifoldMeshFails) {
+  TempDir dir;
+  TriangleMesh fin;
+  fin.vertices.resize(5, 3);
+  fin.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
+  fin.faces.resize(3, 3);
+  fin.faces << 0, 1, 2, 1, 0, 3, 0, 1, 4;
+  for (const char* name : {"fin.off", "fin.ply", "fin.stl"}) {
+    const std::string path = dir.file(name);
+    try {
+      write_mesh(path, fin);
+      FAIL() << "wrote " << path;
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("cannot write: non-manifold mesh: face 2 (vertices 0, 1, 4)"), std::string::npos)
+          << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(path)) << path;
+  }
 }
 
 TEST(MeshIo, RepeatedIndexInFace) {
   TempDir dir;
-  expect_error_naming(dir.write("repeat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n"));
+  expect_error_naming(dir.write("repeat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n"), "face 0 repeats vertex 1");
+  expect_error_naming(dir.write("repeat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n"), "the face on line 4 repeats vertex 2");
 }
 
 TEST(MeshIo, UnknownExtension) {
