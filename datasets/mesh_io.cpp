@@ -257,7 +257,8 @@ long long count_stl_triangles(const std::string& path) {
 
 // Adds the faces to an OpenMesh half-edge mesh in order, as its readers do. A face it cannot add
 // means a non-manifold ("complex") edge or vertex, or inconsistently oriented faces: the error
-// names the first such face (name_face(f)) and why, after prefix. The half-edge mesh is returned for writers.
+// names the first such face (name_face(f)) and why, after prefix. The half-edge mesh is
+// returned for the STL writer.
 IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const TriangleMesh& mesh,
                       const std::function<std::string(Eigen::Index)>& name_face,
                       const std::function<std::string(int)>& name_vertex) {

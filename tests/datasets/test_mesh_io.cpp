@@ -144,6 +144,15 @@ TEST(MeshIo, NonManifoldVertex) {
   expect_error_naming(dir.write("pinch.off", off), "face 4 (vertices 0, 4, 5) cannot be added: its vertex 0 is already surrounded");
 }
 
+TEST(MeshIo, OpenFansMeetingAtAVertexLoad) {
+  TempDir dir;
+  // A bow tie: two triangles sharing only vertex 0, which stays on the boundary of both.
+  const auto path = dir.write("bowtie.off", "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n-1 0 0\n-1 -1 0\n3 0 1 2\n3 0 3 4\n");
+  const MeshReport r = validate_mesh(read_mesh(path), path);
+  EXPECT_EQ(r.faces, 2);
+  EXPECT_EQ(r.boundary_loops, 1);  // the two holes touch at vertex 0 (validate.h)
+}
+
 TEST(MeshIo, NonManifoldPolygonNamesItsFan) {
   TempDir dir;
   // The quad 0 1 4 5 is fanned into (0 1 4) and (0 4 5); the first repeats edge 0 -> 1.
