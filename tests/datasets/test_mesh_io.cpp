@@ -208,7 +208,7 @@ TEST(MeshIo, QuadsAreFanTriangulated) {
   const TriangleMesh o = read_mesh(obj);
   EXPECT_EQ(o.num_faces(), 3);
   EXPECT_EQ(o.num_vertices(), 5);
-  // A closed pyramid with a quad base: the PLY walk counts k - 2 triangles per face, as OpenMesh adds.
+  // A closed pyramid with a quad base: the PLY walk fans k - 2 triangles from each face.
   const auto ply = dir.write("pyramid.ply",
                              "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
                              "property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n"
