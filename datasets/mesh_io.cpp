@@ -6,6 +6,7 @@
 #include "datasets/mesh_io.h"
 
 #include "datasets/ply_format.h"
+#include "datasets/walked_mesh.h"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
@@ -63,17 +64,6 @@ std::string lower_extension(const std::string& path) {
   throw MeshError(path + ": " + problem);
 }
 
-// What our own walk of an OFF, OBJ or PLY file found, in file order: the coordinates as exact
-// doubles (OpenMesh's readers go through floats) and every face fan-triangulated from its first
-// corner, as OpenMesh's TriMesh would. Where each triangle came from, for error messages.
-struct WalkedMesh {
-  std::vector<double> coords;      // x, y, z per vertex
-  std::vector<int> triangles;      // 3 vertex indices (0-based) per triangle
-  std::vector<long long> source;   // per triangle: the file's face number, or its line (OBJ)
-  bool source_is_line = false;
-  int index_base = 0;              // how the file numbers its vertices (OBJ: from 1)
-};
-
 // Strips '#' comments and surrounding blanks.
 std::string clean_line(std::string line) {
   if (auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
@@ -81,14 +71,6 @@ std::string clean_line(std::string line) {
   size_t start = 0;
   while (start < line.size() && std::isspace(static_cast<unsigned char>(line[start]))) ++start;
   return line.substr(start);
-}
-
-// Appends the fan of one face (corners c0 c1 ... ck-1: triangles c0 ci ci+1).
-void add_fan(WalkedMesh& walk, const std::vector<int>& corner, long long source) {
-  for (std::size_t j = 1; j + 1 < corner.size(); ++j) {
-    walk.triangles.insert(walk.triangles.end(), {corner[0], corner[j], corner[j + 1]});
-    walk.source.push_back(source);
-  }
 }
 
 void check_int_range(const std::string& path, long long count, const char* what) {
@@ -222,14 +204,6 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
                    " but the file has " + std::to_string(vertices) + " vertices");
 }
 
-// PLY: a full walk of header and body (ply_format.cpp).
-void walk_ply(const std::string& path, WalkedMesh& walk) {
-  PlyContents ply = scan_ply(path);
-  walk.coords = std::move(ply.coords);
-  walk.triangles = std::move(ply.triangles);
-  walk.source.assign(ply.triangle_face.begin(), ply.triangle_face.end());
-}
-
 // STL: ASCII counts 'facet' records, binary stores the triangle count at byte 80. Vertices are
 // merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance.
 long long count_stl_triangles(const std::string& path) {
@@ -358,7 +332,7 @@ TriangleMesh read_mesh(const std::string& path) {
   } else if (ext == ".obj") {
     walk_obj(path, walk);
   } else if (ext == ".ply") {
-    walk_ply(path, walk);
+    walk = scan_ply(path);  // a full walk of header and body (ply_format.cpp)
   } else if (ext == ".stl") {
     return read_through_openmesh(path, count_stl_triangles(path), true);
   } else {

@@ -27,21 +27,38 @@ namespace {
 
 enum class Encoding { Ascii, LittleEndian, BigEndian };
 
-// A scalar type's size in bytes, 0 for an unknown name. Both spellings of the format: the
-// original (char, uchar, ...) and the sized one (int8, uint8, ...).
-int type_size(const std::string& t) {
-  if (t == "char" || t == "int8" || t == "uchar" || t == "uint8") return 1;
-  if (t == "short" || t == "int16" || t == "ushort" || t == "uint16") return 2;
-  if (t == "int" || t == "int32" || t == "uint" || t == "uint32" || t == "float" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
+// The scalar types, both spellings of the format: the original (char, uchar, ...) and the sized
+// one (int8, uint8, ...). Resolved once from the header, so the body's values switch on an enum.
+enum class Scalar : unsigned char { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64, None };
+
+Scalar scalar_type(const std::string& t) {
+  if (t == "char" || t == "int8") return Scalar::Int8;
+  if (t == "uchar" || t == "uint8") return Scalar::UInt8;
+  if (t == "short" || t == "int16") return Scalar::Int16;
+  if (t == "ushort" || t == "uint16") return Scalar::UInt16;
+  if (t == "int" || t == "int32") return Scalar::Int32;
+  if (t == "uint" || t == "uint32") return Scalar::UInt32;
+  if (t == "float" || t == "float32") return Scalar::Float32;
+  if (t == "double" || t == "float64") return Scalar::Float64;
+  return Scalar::None;
+}
+
+int scalar_size(Scalar t) {
+  switch (t) {
+    case Scalar::Int8: case Scalar::UInt8: return 1;
+    case Scalar::Int16: case Scalar::UInt16: return 2;
+    case Scalar::Int32: case Scalar::UInt32: case Scalar::Float32: return 4;
+    case Scalar::Float64: return 8;
+    case Scalar::None: break;
+  }
   return 0;
 }
 
 struct Property {
   std::string name;
-  std::string type;        // the item type of a list
-  std::string count_type;  // empty: a scalar property
-  bool is_list() const { return !count_type.empty(); }
+  Scalar type = Scalar::None;        // the item type of a list
+  Scalar count_type = Scalar::None;  // None: a scalar property
+  bool is_list() const { return count_type != Scalar::None; }
 };
 
 struct Element {
@@ -101,17 +118,20 @@ Header parse_header(const std::string& path, const std::string& data) {
     } else if (word == "property") {
       if (h.elements.empty()) fail(line_number, "property before any element");
       Property p;
-      std::string first;
+      std::string first, count_type, type;
       ls >> first;
-      if (first == "list") ls >> p.count_type >> p.type >> p.name;
+      const bool list = first == "list";
+      if (list) ls >> count_type >> type >> p.name;
       else {
-        p.type = first;
+        type = first;
         ls >> p.name;
       }
       if (p.name.empty()) fail(line_number, "bad property line '" + line + "'");
-      for (const std::string* t : {&p.type, &p.count_type})
-        if ((t == &p.type || p.is_list()) && type_size(*t) == 0)
+      for (const std::string* t : {&type, &count_type})
+        if ((t == &type || list) && scalar_type(*t) == Scalar::None)
           fail(line_number, "unknown property type '" + *t + "'");
+      p.type = scalar_type(type);
+      p.count_type = list ? scalar_type(count_type) : Scalar::None;
       h.elements.back().properties.push_back(p);
     } else {
       fail(line_number, "unknown header keyword '" + word + "'");
@@ -123,18 +143,20 @@ Header parse_header(const std::string& path, const std::string& data) {
 class BodyReader {
  public:
   BodyReader(const std::string& path, const std::string& data, const Header& h)
-      : path_(path), data_(data), encoding_(h.encoding), pos_(h.body_offset), line_(h.body_line) {}
+      : path_(path), data_(data), encoding_(h.encoding), pos_(h.body_offset), line_(h.body_line),
+        swap_(h.encoding != Encoding::Ascii &&
+              (h.encoding == Encoding::LittleEndian) != (std::endian::native == std::endian::little)) {}
 
   /// What the next values are, for error messages only (composed by what(), on failure).
   enum class Part { value, list_length, corner };
 
   /// The next value, converted to double (exact for every PLY type).
-  double next(const std::string& type) {
+  double next(Scalar type) {
     if (encoding_ == Encoding::Ascii) return next_text(/*integer=*/false);
     return next_binary(type);
   }
   /// The next value, which must be an integer (list counts, vertex indices).
-  long long next_integer(const std::string& type, Part part, long long corner = -1) {
+  long long next_integer(Scalar type, Part part, long long corner = -1) {
     part_ = part;
     corner_ = corner;
     const double v = encoding_ == Encoding::Ascii ? next_text(/*integer=*/true) : next_binary(type);
@@ -205,29 +227,32 @@ class BodyReader {
     return v;
   }
 
-  double next_binary(const std::string& type) {
-    const int size = type_size(type);
+  double next_binary(Scalar type) {
+    const int size = scalar_size(type);
     if (pos_ + size > data_.size()) fail_at_end();
     token_pos_ = pos_;
     unsigned char b[8];
     std::memcpy(b, data_.data() + pos_, size);
     pos_ += size;
-    const bool swap = (encoding_ == Encoding::LittleEndian) != (std::endian::native == std::endian::little);
-    if (swap)
+    if (swap_)
       for (int i = 0; i < size / 2; ++i) std::swap(b[i], b[size - 1 - i]);
     auto as = [&b]<typename T>(T) {
       T v;
       std::memcpy(&v, b, sizeof v);
       return static_cast<double>(v);
     };
-    if (type == "char" || type == "int8") return as(std::int8_t{});
-    if (type == "uchar" || type == "uint8") return as(std::uint8_t{});
-    if (type == "short" || type == "int16") return as(std::int16_t{});
-    if (type == "ushort" || type == "uint16") return as(std::uint16_t{});
-    if (type == "int" || type == "int32") return as(std::int32_t{});
-    if (type == "uint" || type == "uint32") return as(std::uint32_t{});
-    if (type == "float" || type == "float32") return as(float{});
-    return as(double{});
+    switch (type) {
+      case Scalar::Int8: return as(std::int8_t{});
+      case Scalar::UInt8: return as(std::uint8_t{});
+      case Scalar::Int16: return as(std::int16_t{});
+      case Scalar::UInt16: return as(std::uint16_t{});
+      case Scalar::Int32: return as(std::int32_t{});
+      case Scalar::UInt32: return as(std::uint32_t{});
+      case Scalar::Float32: return as(float{});
+      case Scalar::Float64: return as(double{});
+      case Scalar::None: break;
+    }
+    return 0.0;  // not reached: the header admits known types only
   }
 
   const std::string& path_;
@@ -235,6 +260,7 @@ class BodyReader {
   Encoding encoding_;
   std::size_t pos_;
   long long line_;
+  bool swap_;  // binary body in the other byte order than this machine's
   long long token_line_ = 0;
   const Element* element_ = nullptr;
   long long index_ = 0;
@@ -252,7 +278,7 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
-PlyContents scan_ply(const std::string& path) {
+WalkedMesh scan_ply(const std::string& path) {
   const std::string data = read_file(path);
   const Header header = parse_header(path, data);
   const Element* vertex = nullptr;
@@ -276,17 +302,19 @@ PlyContents scan_ply(const std::string& path) {
   if (vertex->count > std::numeric_limits<int>::max())
     throw MeshError(path + ": the header declares " + std::to_string(vertex->count) +
                     " vertices, more than a mesh's int indices can address");
-  PlyContents out;
+  WalkedMesh out;
   out.coords.resize(3 * static_cast<std::size_t>(vertex->count));
   std::vector<int> corner;  // one face's corners, fan-triangulated once the face is read
   BodyReader body(path, data, header);
   for (const Element& e : header.elements) {
     const bool is_vertex = &e == vertex;
-    const bool is_face = e.name == "face";
-    bool face_has_indices = false;
-    for (const Property& p : e.properties)
-      face_has_indices |= p.is_list() && (p.name == "vertex_indices" || p.name == "vertex_index");
-    if (is_face && !face_has_indices && e.count > 0)
+    // The face element's corner list, found once (names are not compared per record).
+    int corner_list = -1;
+    if (e.name == "face")
+      for (std::size_t i = 0; i < e.properties.size(); ++i)
+        if (e.properties[i].is_list() && (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
+          corner_list = static_cast<int>(i);
+    if (e.name == "face" && corner_list < 0 && e.count > 0)
       throw MeshError(path + ": the face element has no list property 'vertex_indices'");
     for (long long r = 0; r < e.count; ++r) {
       body.start_record(e, r);
@@ -305,7 +333,7 @@ PlyContents scan_ply(const std::string& path) {
         }
         const long long k = body.next_integer(p.count_type, BodyReader::Part::list_length);
         if (k < 0) body.fail(body.record() + ": negative list length " + std::to_string(k));
-        const bool corners = is_face && (p.name == "vertex_indices" || p.name == "vertex_index");
+        const bool corners = static_cast<int>(i) == corner_list;
         if (corners && k < 3) body.fail("face " + std::to_string(r) + " has " + std::to_string(k) + " corners (at least 3)");
         corner.clear();
         for (long long j = 0; j < k; ++j) {
@@ -320,12 +348,9 @@ PlyContents scan_ply(const std::string& path) {
           corner.push_back(static_cast<int>(index));
         }
         if (!corners) continue;
-        if (out.triangle_face.size() + (k - 2) > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+        if (out.source.size() + (k - 2) > static_cast<std::size_t>(std::numeric_limits<int>::max()))
           body.fail("more triangles than a mesh's int indices can address");
-        for (long long j = 1; j + 1 < k; ++j) {
-          out.triangles.insert(out.triangles.end(), {corner[0], corner[j], corner[j + 1]});
-          out.triangle_face.push_back(static_cast<int>(r));
-        }
+        add_fan(out, corner, r);
       }
       body.end_record();
     }

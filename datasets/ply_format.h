@@ -8,6 +8,7 @@
 // and adds its faces to an OpenMesh half-edge mesh, whose insertion finds non-manifold faces.
 
 #include "datasets/mesh.h"
+#include "datasets/walked_mesh.h"
 
 #include <cstdio>
 #include <string>
@@ -15,21 +16,13 @@
 
 namespace mcf {
 
-/// What a PLY file holds, from one walk of its header and body.
-struct PlyContents {
-  std::vector<double> coords;    ///< x, y, z of every vertex, as stored (float widened exactly)
-  /// Three vertex indices per triangle, every face fan-triangulated from its first corner
-  /// (k corners: k - 2 triangles), in file order.
-  std::vector<int> triangles;
-  std::vector<int> triangle_face;  ///< the file's face (0-based record) each triangle comes from
-};
-
-/// Walks the whole file: header, every element's records, each face's corner indices. Throws
+/// Walks the whole file: header, every element's records, each face's corner indices (faces
+/// fan-triangulated, `source` their record number). Throws
 /// MeshError naming the file and the line (ASCII, header) or byte offset (binary body) on an
 /// unknown format or type, a missing x/y/z or vertex_indices property, a non-finite coordinate, a
 /// face with fewer than 3 corners, an index outside 0..vertices-1, or a file that ends early (or
 /// more than 2^31 - 1 vertices or triangles, beyond the mesh's int indices).
-PlyContents scan_ply(const std::string& path);
+WalkedMesh scan_ply(const std::string& path);
 
 /// The header of a PLY file of this mesh with `property double x, y, z` and faces as `list uchar
 /// int vertex_indices`; ASCII bodies (17 significant digits, one record a line) are written by

@@ -16,6 +16,7 @@
 #include <numeric>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace mcf {
@@ -389,6 +390,58 @@ TEST(MeshIoPly, BinaryBothByteOrders) {
                       "byte " + std::to_string(header_bytes(false) + 4 * 13 + 2 * 13 + 5) + ": face 2 references vertex 6");
   expect_error_naming(dir.write("short_bin.ply", binary_tetra(true, 2, 3)),
                       "the file ends at byte " + std::to_string(header_bytes(true) + 4 * 13 + 3 * 13) + " before face 3 of 4");
+}
+
+// A binary tetrahedron whose coordinates are of type T (spelled `name` in the header) and whose
+// faces are a list of index type I with count type C: every scalar type, either spelling, read
+// in either byte order. Signed types get the negative corner -1 (a sign-extension check).
+template <typename T, typename C, typename I>
+void expect_binary_types(const TempDir& dir, const std::string& name, const std::string& count, const std::string& index,
+                         bool big) {
+  const std::string header = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+                             " 1.0\nelement vertex 4\nproperty " + name + " x\nproperty " + name + " y\nproperty " +
+                             name + " z\nelement face 4\nproperty list " + count + " " + index +
+                             " vertex_indices\nend_header\n";
+  const int low = std::is_signed_v<T> ? -1 : 0;
+  const int v[4][3] = {{low, low, low}, {2, low, low}, {low, 2, low}, {low, low, 2}};
+  std::string body;
+  for (const auto& p : v)
+    for (int c : p) body += bytes(static_cast<T>(c), big);
+  const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  for (const auto& face : f) {
+    body += bytes(static_cast<C>(3), big);
+    for (int c : face) body += bytes(static_cast<I>(c), big);
+  }
+  const std::string label = name + "/" + count + "/" + index + (big ? " big" : " little");
+  const TriangleMesh m = read_mesh(dir.write("types.ply", header + body));
+  ASSERT_EQ(m.num_vertices(), 4) << label;
+  ASSERT_EQ(m.num_faces(), 4) << label;
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(m.vertices.row(i), Eigen::RowVector3d(v[i][0], v[i][1], v[i][2])) << label << " vertex " << i;
+    EXPECT_EQ(m.faces.row(i), Eigen::RowVector3i(f[i][0], f[i][1], f[i][2])) << label << " face " << i;
+  }
+}
+
+TEST(MeshIoPly, EveryScalarTypeInBothSpellingsAndByteOrders) {
+  TempDir dir;
+  for (bool big : {false, true}) {
+    expect_binary_types<std::int8_t, std::uint8_t, std::int32_t>(dir, "char", "uchar", "int", big);
+    expect_binary_types<std::int8_t, std::uint16_t, std::uint32_t>(dir, "int8", "ushort", "uint32", big);
+    expect_binary_types<std::uint8_t, std::int8_t, std::int16_t>(dir, "uchar", "char", "short", big);
+    expect_binary_types<std::uint8_t, std::uint32_t, std::uint16_t>(dir, "uint8", "uint", "uint16", big);
+    expect_binary_types<std::int16_t, std::int16_t, std::uint8_t>(dir, "short", "int16", "uint8", big);
+    expect_binary_types<std::int16_t, std::int32_t, std::int8_t>(dir, "int16", "int32", "int8", big);
+    expect_binary_types<std::uint16_t, std::uint8_t, std::int32_t>(dir, "ushort", "uint8", "int", big);
+    expect_binary_types<std::uint16_t, std::uint8_t, std::int32_t>(dir, "uint16", "uchar", "int32", big);
+    expect_binary_types<std::int32_t, std::uint8_t, std::uint32_t>(dir, "int", "uchar", "uint", big);
+    expect_binary_types<std::int32_t, std::uint8_t, std::int32_t>(dir, "int32", "uchar", "int", big);
+    expect_binary_types<std::uint32_t, std::uint8_t, std::int32_t>(dir, "uint", "uchar", "int", big);
+    expect_binary_types<std::uint32_t, std::uint8_t, std::int32_t>(dir, "uint32", "uchar", "int", big);
+    expect_binary_types<float, std::uint8_t, std::int32_t>(dir, "float", "uchar", "int", big);
+    expect_binary_types<float, std::uint8_t, std::int32_t>(dir, "float32", "uchar", "int", big);
+    expect_binary_types<double, std::uint8_t, std::int32_t>(dir, "double", "uchar", "int", big);
+    expect_binary_types<double, std::uint8_t, std::int32_t>(dir, "float64", "uchar", "int", big);
+  }
 }
 
 // Round trip of a torus (irrational coordinates) through every format.
