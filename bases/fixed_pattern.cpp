@@ -38,22 +38,18 @@ FixedPattern::FixedPattern(Eigen::Index n, const std::vector<int>& rows, const s
   for (Eigen::Index c = 0; c < n; ++c) outer[c + 1] += outer[c];
   slot_of_ = std::move(order);
 
-  const std::vector<double> zeros(inner.size(), 0.0);
-  zero_ = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int>>(
-      n, n, Eigen::Index(inner.size()), outer.data(), inner.data(), zeros.data());
-  zero_.makeCompressed();
+  outer_ = std::move(outer);
+  inner_ = std::move(inner);
 }
 
-void FixedPattern::gather(const std::vector<double>& local,
-                          Eigen::SparseMatrix<double, Eigen::ColMajor, int>& out) const {
-  if (out.nonZeros() != zero_.nonZeros() || out.rows() != zero_.rows()) out = zero_;
-  double* values = out.valuePtr();
-  const Eigen::Index nnz = zero_.nonZeros();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, nnz, 4096), [&](const auto& r) {
+void FixedPattern::gather(const std::vector<double>& local, std::vector<double>& values) const {
+  values.resize(inner_.size());
+  double* out = values.data();
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, non_zeros(), 4096), [&](const auto& r) {
     for (Eigen::Index nz = r.begin(); nz != r.end(); ++nz) {
       double sum = 0.0;
       for (std::int64_t i = first_[nz]; i < first_[nz + 1]; ++i) sum += local[slot_of_[i]];
-      values[nz] = sum;
+      out[nz] = sum;
     }
   });
 }

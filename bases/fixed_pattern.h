@@ -3,6 +3,8 @@
 // from per-element local values without locks: each nonzero gathers the slots that land on it
 // in a fixed order, so assembly is parallel and bitwise deterministic for any thread count.
 
+#include "bases/basis.h"
+
 #include <Eigen/SparseCore>
 
 #include <cstdint>
@@ -16,16 +18,20 @@ class FixedPattern {
   /// rows/cols: one entry per local slot (element e, slot s stored at e * slots + s).
   FixedPattern(Eigen::Index dimension, const std::vector<int>& rows, const std::vector<int>& cols);
 
-  /// A compressed matrix with this pattern and zero values.
-  const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& zero_matrix() const { return zero_; }
+  Eigen::Index non_zeros() const { return Eigen::Index(inner_.size()); }
 
-  /// values[nz] = Σ local[slot] over the slots of nonzero nz (parallel over nonzeros).
-  void gather(const std::vector<double>& local, Eigen::SparseMatrix<double, Eigen::ColMajor, int>& out) const;
+  /// values[nz] = Σ local[slot] over the slots of nonzero nz (parallel over nonzeros); `values`
+  /// is resized to non_zeros().
+  void gather(const std::vector<double>& local, std::vector<double>& values) const;
+
+  /// Values on this pattern (non_zeros() of them, in CSC order) seen as a matrix, so that several
+  /// matrices on the pattern share its index arrays.
+  SparseView view(const std::vector<double>& values) const { return view_of(outer_, inner_, values); }
 
   std::size_t num_slots() const { return slot_of_.size(); }
 
  private:
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> zero_;
+  std::vector<int> outer_, inner_;    // the pattern: column starts and row indices
   std::vector<std::int64_t> first_;   // per nonzero: range into slot_of_
   std::vector<std::int64_t> slot_of_; // slots grouped by nonzero, ascending slot order
 };

@@ -19,8 +19,8 @@ class HatBasis final : public Basis {
   Eigen::Index dimension() const override { return faces_.rows() ? vertices0_.rows() : 0; }
   Coefficients initial_coefficients() const override { return vertices0_; }
   void update(const Coefficients& x, bool update_mass, bool update_stiffness) override;
-  const SparseMatrix& mass() const override { return mass_; }
-  const SparseMatrix& stiffness() const override { return stiffness_; }
+  SparseView mass() const override { return pattern_.view(mass_); }
+  SparseView stiffness() const override { return pattern_.view(stiffness_); }
   Positions evaluate_vertices(const Coefficients& x) const override { return x; }
   std::vector<int> locked_functions() const override { return boundary_; }
   const BasisStats& stats() const override { return stats_; }
@@ -30,7 +30,7 @@ class HatBasis final : public Basis {
   Triangles faces_;
   MassKind mass_kind_;
   FixedPattern pattern_;  // 9 slots per face, gathered per nonzero
-  SparseMatrix mass_, stiffness_;
+  std::vector<double> mass_, stiffness_;  // values on pattern_
   std::vector<double> local_mass_, local_stiffness_;  // per-face 3x3 blocks, reused every step
   std::vector<int> boundary_;
   BasisStats stats_;

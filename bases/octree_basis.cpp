@@ -141,11 +141,11 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
       static_cast<double>(sizeof(ClippedTriangle) + sizeof(int)) / cubature_rule(options_.cubature).size();
 }
 
-void RebuiltOctreeBasis::release_assembly(SparseMatrix& mass, SparseMatrix& stiffness) {
+void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass, std::vector<double>& stiffness) {
   mass.swap(mass_);
   stiffness.swap(stiffness_);
-  mass_ = SparseMatrix();
-  stiffness_ = SparseMatrix();
+  std::vector<double>().swap(mass_);
+  std::vector<double>().swap(stiffness_);
   // swap with empty vectors: clear() alone keeps the capacity (6.5e6 pieces at depth 9: ~600 MB).
   std::vector<ClippedTriangle>().swap(pieces_);
   std::vector<int>().swap(piece_cells_);
@@ -154,6 +154,17 @@ void RebuiltOctreeBasis::release_assembly(SparseMatrix& mass, SparseMatrix& stif
   std::vector<PointStencil>().swap(stencils_);
   std::vector<int>().swap(referenced_);
 }
+
+namespace {
+// What mass() and stiffness() show before assembly and after release_assembly.
+SparseView values_view(const OctreeSystem* system, const std::vector<double>& values) {
+  if (system && static_cast<Eigen::Index>(values.size()) == system->non_zeros()) return system->view(values);
+  return view_of(std::vector<int>{}, std::vector<int>{}, std::vector<double>{});
+}
+}  // namespace
+
+SparseView RebuiltOctreeBasis::mass() const { return values_view(system_.get(), mass_); }
+SparseView RebuiltOctreeBasis::stiffness() const { return values_view(system_.get(), stiffness_); }
 
 Coefficients RebuiltOctreeBasis::initial_coefficients() const {
   return octree_.function_positions(octree_.num_levels() - 1);

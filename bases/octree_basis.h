@@ -49,8 +49,9 @@ class RebuiltOctreeBasis : public Basis {
   /// initial_coefficients(); this basis cannot re-integrate at another embedding, so update() is a
   /// no-op (it only checks the dimension). Call rebuild() to move to a new embedding.
   void update(const Coefficients& x, bool update_mass, bool update_stiffness) override;
-  const SparseMatrix& mass() const override { return mass_; }
-  const SparseMatrix& stiffness() const override { return stiffness_; }
+  /// On the system's pattern (OctreeSystem::view): one copy of the index arrays for both.
+  SparseView mass() const override;
+  SparseView stiffness() const override;
   /// v = Σ_I B_I(v) x^I for the input mesh's vertices (trilinear stencils in an active finest cell).
   /// Vertices used by no face keep the position they had at the last rebuild.
   Positions evaluate_vertices(const Coefficients& x) const override;
@@ -69,15 +70,15 @@ class RebuiltOctreeBasis : public Basis {
   const OctreeSystem& system() const { return *system_; }
 
   /// For the tracked basis, which from now on re-integrates on this basis's fixed pattern: swaps
-  /// the assembled mass and stiffness into `mass` and `stiffness`, so their memory (allocated and
-  /// touched already) is reused instead of a fresh copy of the pattern — a swap, because Eigen
-  /// 3.4's SparseMatrix has no move constructor — and frees the pieces and their cells (the
-  /// tracked basis keeps its own compact copy), the system's row indices and piece order
-  /// (OctreeSystem::release_pieces) and the vertex stencils (the tracked basis computes those of
-  /// the input's vertices). Afterwards mass(), stiffness() and pieces() are empty, system() can no
-  /// longer assemble or hand out its pattern, and evaluate_vertices() throws std::logic_error;
-  /// octree, hierarchy, locked functions and stats stay. rebuild() starts over from scratch as usual.
-  void release_assembly(SparseMatrix& mass, SparseMatrix& stiffness);
+  /// the assembled values of mass and stiffness (on system()'s pattern) into `mass` and
+  /// `stiffness`, so their memory (allocated and touched already) is reused instead of fresh
+  /// zeroed arrays, and frees the pieces and their cells (the tracked basis keeps its own compact
+  /// copy), the system's piece order (OctreeSystem::release_pieces) and the vertex stencils (the
+  /// tracked basis computes those of the input's vertices). Afterwards mass(), stiffness() and
+  /// pieces() are empty, system() can no longer assemble, and evaluate_vertices() throws
+  /// std::logic_error; octree, pattern, hierarchy, locked functions and stats stay. rebuild()
+  /// starts over from scratch as usual.
+  void release_assembly(std::vector<double>& mass, std::vector<double>& stiffness);
 
  private:
   OctreeOptions options_;
@@ -87,7 +88,7 @@ class RebuiltOctreeBasis : public Basis {
   std::vector<ClippedTriangle> pieces_;
   std::vector<int> piece_cells_;
   std::unique_ptr<OctreeSystem> system_;
-  SparseMatrix mass_, stiffness_;
+  std::vector<double> mass_, stiffness_;  // values on system_'s pattern
   std::vector<SparseMatrix> prolongations_;
   std::vector<std::vector<std::uint8_t>> colours_;
   std::vector<PointStencil> stencils_;  ///< of mesh_'s referenced vertices (see referenced_)

@@ -158,29 +158,27 @@ void OctreeSystem::release_pieces() {
   // swap with empty vectors: clear() alone keeps the capacity.
   std::vector<int>().swap(piece_cell_);
   std::vector<int>().swap(piece_order_);
-  std::vector<int>().swap(inner_);
   released_ = true;
 }
 
 SparseMatrix OctreeSystem::pattern() const {
-  if (released_)
-    throw std::logic_error("OctreeSystem::pattern: the row indices were released (RebuiltOctreeBasis::release_assembly)");
   SparseMatrix A;
   set_pattern(A, outer_, inner_);
   return A;
 }
 
-void OctreeSystem::assemble(const CubatureRule& rule, SparseMatrix& mass, SparseMatrix& stiffness) const {
+void OctreeSystem::assemble(const CubatureRule& rule, std::vector<double>& mass, std::vector<double>& stiffness) const {
   const OctreeLevel& L = octree_->levels[static_cast<std::size_t>(level_)];
   const GridCube& cube = octree_->cube;
   const double h = cube.cell_size(L.depth), inv_h = 1.0 / h;
   // The pieces are held by reference; the tracked basis frees them once it has its own copy.
   if (released_)
     throw std::logic_error("OctreeSystem::assemble: the pieces were released (RebuiltOctreeBasis::release_assembly)");
-  set_pattern(mass, outer_, inner_);
-  set_pattern(stiffness, outer_, inner_);
-  double* Mv = mass.valuePtr();
-  double* Kv = stiffness.valuePtr();
+  // assign, not resize: a rebuild on a new octree reuses the vectors' memory, zeroed.
+  mass.assign(inner_.size(), 0.0);
+  stiffness.assign(inner_.size(), 0.0);
+  double* Mv = mass.data();
+  double* Kv = stiffness.data();
   const int nq = rule.size();
   const auto& pieces = *pieces_;
 

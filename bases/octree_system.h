@@ -74,11 +74,13 @@ class OctreeSystem {
   Eigen::Index dimension() const { return static_cast<Eigen::Index>(outer_.size()) - 1; }
   /// From the column starts, so it stays after release_pieces().
   Eigen::Index non_zeros() const { return outer_.empty() ? 0 : outer_.back(); }
-  /// A matrix with this pattern and zero values (compressed, full symmetric storage). Throws
-  /// std::logic_error after release_pieces().
+  /// A matrix with this pattern and zero values (compressed, full symmetric storage).
   SparseMatrix pattern() const;
-  /// Column starts (dimension+1) and row indices of the pattern (inner() is empty after
-  /// release_pieces()).
+  /// Values on this pattern (non_zeros() of them, in CSC order) seen as a matrix: mass and
+  /// stiffness share the system's index arrays instead of each carrying a copy (~100 MB each
+  /// at depth 9). The view is valid while the system and `values` are alive and unresized.
+  SparseView view(const std::vector<double>& values) const { return view_of(outer_, inner_, values); }
+  /// Column starts (dimension+1) and row indices of the pattern.
   const std::vector<int>& outer() const { return outer_; }
   const std::vector<int>& inner() const { return inner_; }
   int slot(int cell, int corner_row, int corner_col) const {
@@ -145,18 +147,17 @@ class OctreeSystem {
   }
   const std::vector<int>& piece_cell() const { return piece_cell_; }
 
-  /// For the tracked basis, once it holds its own compact copy of the pieces and the matrices
-  /// with this pattern: frees what only assemble() and pattern() read — the pieces' cells and
-  /// order and the row indices (at depth 9 ~52 MB and ~94 MB, the latter a third copy of the
-  /// pattern beside M's and K's). outer(), the masks, the tiles, cell_start() and non_zeros()
-  /// stay, so add_cell_blocks() still works; assemble() and pattern() then throw.
+  /// For the tracked basis, once it holds its own compact copy of the pieces: frees what only
+  /// assemble() reads — the pieces' cells and order (~52 MB at depth 9). The pattern, the masks,
+  /// the tiles and cell_start() stay, so add_cell_blocks() and view() still work; assemble()
+  /// then throws.
   void release_pieces();
   bool pieces_released() const { return released_; }
 
   /// Mass and stiffness with the identity metric (the pieces' own geometry), any cubature rule.
-  /// M and K get this system's pattern; accumulation is lock-free (tiles(): 8 colour passes,
-  /// parallel over the tiles of a pass) and deterministic.
-  void assemble(const CubatureRule& rule, SparseMatrix& mass, SparseMatrix& stiffness) const;
+  /// `mass` and `stiffness` become values on this system's pattern (see view()); accumulation is
+  /// lock-free (tiles(): 8 colour passes, parallel over the tiles of a pass) and deterministic.
+  void assemble(const CubatureRule& rule, std::vector<double>& mass, std::vector<double>& stiffness) const;
 
  private:
   const Octree* octree_;
@@ -166,7 +167,7 @@ class OctreeSystem {
   std::vector<int> cell_start_, piece_order_;
   CellTiles tiles_;
   std::vector<std::uint32_t> mask_;
-  std::vector<int> outer_, inner_;  // the pattern (no values stored: M and K carry their own)
+  std::vector<int> outer_, inner_;  // the pattern (no values stored: the bases keep M's and K's)
   bool released_ = false;
 };
 

@@ -292,18 +292,13 @@ void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool up
   const OctreeLevel& L = octree.finest();
   const double h = octree.cube.cell_size(L.depth);
   const OctreeSystem& system = initial_->system();
-  // The pattern never changes: after the first update only the values are reset (no reallocation
-  // and copy of the pattern every step, ~12 bytes per nonzero per matrix).
-  auto reset = [&system](SparseMatrix& A) {
-    if (A.isCompressed() && A.rows() == system.dimension() && A.nonZeros() == system.non_zeros())
-      std::fill(A.valuePtr(), A.valuePtr() + A.nonZeros(), 0.0);
-    else
-      A = system.pattern();
-  };
+  // The pattern never changes: only the values are reset (assign keeps the memory, so no
+  // reallocation; the values live on the system's pattern, which both matrices share).
+  const auto reset = [&system](std::vector<double>& values) { values.assign(std::size_t(system.non_zeros()), 0.0); };
   if (update_mass) reset(mass_);
   if (update_stiffness) reset(stiffness_);
-  double* Mv = update_mass ? mass_.valuePtr() : nullptr;
-  double* Kv = update_stiffness ? stiffness_.valuePtr() : nullptr;
+  double* Mv = update_mass ? mass_.data() : nullptr;
+  double* Kv = update_stiffness ? stiffness_.data() : nullptr;
   const auto run = [&](auto kernel) {
     return kernel(system, L, x, fan_points_, continues_, cell_start(), point_start_, *rule_, h, Mv, Kv);
   };

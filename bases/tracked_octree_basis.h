@@ -41,8 +41,9 @@ class TrackedOctreeBasis final : public Basis {
   /// summed by CellBlocks then added to the fixed pattern; the result is independent of the
   /// thread count.
   void update(const Coefficients& x, bool update_mass, bool update_stiffness) override;
-  const SparseMatrix& mass() const override { return mass_; }
-  const SparseMatrix& stiffness() const override { return stiffness_; }
+  /// On the initial basis's system pattern (OctreeSystem::view): one copy of the index arrays.
+  SparseView mass() const override { return initial_->system().view(mass_); }
+  SparseView stiffness() const override { return initial_->system().view(stiffness_); }
   /// v = Σ_I β_v^I x^I with the 8 stencil weights of each original vertex on X_0.
   Positions evaluate_vertices(const Coefficients& x) const override;
   std::vector<int> locked_functions() const override { return initial_->locked_functions(); }
@@ -78,7 +79,7 @@ class TrackedOctreeBasis final : public Basis {
   std::vector<std::uint8_t> continues_;  // per piece (cell order): 1 = continues the previous fan
   std::vector<int> point_start_;       // cell c's fan points: [point_start_[c], point_start_[c+1]), 3 doubles each
   std::vector<PointStencil> stencils_; // original vertices
-  SparseMatrix mass_, stiffness_;
+  std::vector<double> mass_, stiffness_;  // values on initial_->system()'s pattern
   BasisStats stats_;
   long long degenerate_points_ = 0;
 };

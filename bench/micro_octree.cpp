@@ -114,7 +114,7 @@ F& acquire(const std::string& key, const std::function<std::unique_ptr<F>()>& ma
 
 /// A = M + δK as the default LinearSolver::set_matrix_sum forms it (M and K share one pattern, so
 /// the sum is value-wise), first giving A M's pattern unless it has it already (compared each call).
-void system_matrix(const SparseMatrix& M, const SparseMatrix& K, double dt, SparseMatrix& A) {
+void system_matrix(const SparseRef& M, const SparseRef& K, double dt, SparseMatrix& A) {
   if (!same_pattern(M, A)) A = M;
   sum_on_pattern(1.0, M, dt, K, A);
 }
@@ -205,11 +205,11 @@ void BM_Rebuilt_Octree(benchmark::State& state) {
 void BM_Rebuilt_Integrate(benchmark::State& state) {
   auto& f = phase_fixture(int(state.range(0)));
   const Octree& octree = f.basis->octree();
-  SparseMatrix M, K;
+  std::vector<double> M, K;
   for (auto _ : state) {
     OctreeSystem sys(octree, octree.num_levels() - 1, f.basis->pieces(), f.basis->piece_cells());
     sys.assemble(cubature_rule(3), M, K);
-    benchmark::DoNotOptimize(K.valuePtr());
+    benchmark::DoNotOptimize(K.data());
   }
   label(state, f);
 }

@@ -16,7 +16,7 @@ ReducedSystem::ReducedSystem(const Basis& basis, LinearSolver& solver)
   std::sort(base_fixed_.begin(), base_fixed_.end());
 }
 
-bool ReducedSystem::shares_pattern(const SparseMatrix& M, const SparseMatrix& K) {
+bool ReducedSystem::shares_pattern(const SparseRef& M, const SparseRef& K) {
   // Checked once: the pattern never changes while this object lives.
   if (shares_pattern_ < 0) shares_pattern_ = same_pattern(M, K) ? 1 : 0;
   return shares_pattern_ == 1;
@@ -24,8 +24,9 @@ bool ReducedSystem::shares_pattern(const SparseMatrix& M, const SparseMatrix& K)
 
 Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, const Coefficients& fixed_values,
                                   const Coefficients& warm) {
-  const SparseMatrix& M = basis_.mass();
-  const SparseMatrix& K = basis_.stiffness();
+  // Views: no copies (the bases keep both on one pattern's index arrays).
+  const SparseView M = basis_.mass();
+  const SparseView K = basis_.stiffness();
   const Eigen::Index n = M.rows();
   // S = a M + b K. Bases assemble M and K on one pattern: then S is a value-wise sum, and it is
   // formed here only when functions are held (below); otherwise the solver forms it itself
@@ -37,7 +38,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   // their columns are zero too), apart from the basis's locked functions.
   std::vector<int> empty;
   {
-    const auto* outer = (shared ? M : sum_).outerIndexPtr();
+    const int* outer = shared ? M.outerIndexPtr() : sum_.outerIndexPtr();
     const double* m = shared ? M.valuePtr() : nullptr;
     const double* k = shared ? K.valuePtr() : nullptr;
     const double* v = shared ? nullptr : sum_.valuePtr();

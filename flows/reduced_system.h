@@ -31,7 +31,7 @@ class ReducedSystem {
 
  private:
   void rebuild_reduction(const SparseMatrix& S);
-  bool shares_pattern(const SparseMatrix& M, const SparseMatrix& K);
+  bool shares_pattern(const SparseRef& M, const SparseRef& K);
 
   const Basis& basis_;
   LinearSolver& solver_;

@@ -25,14 +25,16 @@ std::uint64_t new_pattern_key() {
   return next.fetch_add(1, std::memory_order_relaxed);
 }
 
-bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {
+bool same_pattern(const SparseRef& A, const SparseRef& B) {
+  // Views of one pattern (a basis's mass and stiffness) share its arrays: nothing to compare.
+  const bool shared = A.outerIndexPtr() == B.outerIndexPtr() && A.innerIndexPtr() == B.innerIndexPtr();
   return A.isCompressed() && B.isCompressed() && A.rows() == B.rows() && A.cols() == B.cols() &&
          A.nonZeros() == B.nonZeros() &&
-         std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
-         std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr());
+         (shared || (std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
+                     std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr())));
 }
 
-void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatrix& K, SparseMatrix& S) {
+void sum_on_pattern(double a, const SparseRef& M, double b, const SparseRef& K, SparseMatrix& S) {
   const double *m = M.valuePtr(), *k = K.valuePtr();
   double* s = S.valuePtr();
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, M.nonZeros(), 1 << 14), [&](const auto& r) {
@@ -40,18 +42,18 @@ void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatri
   });
 }
 
-SparseMatrix general_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K) {
+SparseMatrix general_sum(double a, const SparseRef& M, double b, const SparseRef& K) {
   SparseMatrix S = b == 0.0 ? SparseMatrix(a * M) : SparseMatrix(a * M + b * K);
   S.makeCompressed();
   return S;
 }
 
-bool summable(const SparseMatrix& M, const SparseMatrix& K) {
+bool summable(const SparseRef& M, const SparseRef& K) {
   return M.isCompressed() && K.isCompressed() && M.rows() == K.rows() && M.cols() == K.cols() &&
          M.nonZeros() == K.nonZeros();
 }
 
-SolveReport LinearSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+SolveReport LinearSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                          HierarchyView hierarchy) {
   if (!summable(M, K)) {
     // Off one pattern: Eigen merges the patterns; no key, as the union is not what it vouched for.

@@ -14,6 +14,10 @@
 namespace mcf {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+/// Any column-major sparse matrix stored elsewhere — a SparseMatrix or a map of index and value
+/// arrays (a basis's mass and stiffness share one pattern's index arrays: bases/basis.h
+/// SparseView) — without a copy. Functions that read a basis's matrices take this.
+using SparseRef = Eigen::Ref<const SparseMatrix>;
 
 enum class SolveStatus {
   converged,          ///< reached the tolerance (or a direct solve succeeded)
@@ -56,7 +60,7 @@ std::uint64_t new_pattern_key();
 
 /// Whether two compressed matrices have the same sparsity pattern (size, column starts and row
 /// indices compared exactly; values ignored). False when either is not compressed.
-bool same_pattern(const SparseMatrix& A, const SparseMatrix& B);
+bool same_pattern(const SparseRef& A, const SparseRef& B);
 
 /// One entry of a M + b K. Every kernel that forms the system from M and K on one pattern calls
 /// this, so they agree bitwise (the multigrid's fused refill and sum_on_pattern below).
@@ -65,16 +69,16 @@ inline double sum_entry(double a, double m, double b, double k) { return a * m +
 /// S = a M + b K entry by entry, in parallel, for M, K and S on one pattern (same_pattern: the
 /// caller checks; S keeps its pattern and only its values are written). This is how every flow
 /// forms its system matrix when the basis assembles M and K on one pattern.
-void sum_on_pattern(double a, const SparseMatrix& M, double b, const SparseMatrix& K, SparseMatrix& S);
+void sum_on_pattern(double a, const SparseRef& M, double b, const SparseRef& K, SparseMatrix& S);
 
 /// a M + b K for any two patterns (Eigen's sum: the union of the patterns; a M alone when b is 0),
 /// compressed.
-SparseMatrix general_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K);
+SparseMatrix general_sum(double a, const SparseRef& M, double b, const SparseRef& K);
 
 /// Whether M and K may be summed on one pattern as far as O(1) checks tell (compressed, same
 /// size and number of nonzeros); same_pattern() is the full comparison, which a caller that owns
 /// a fixed pattern makes once.
-bool summable(const SparseMatrix& M, const SparseMatrix& K);
+bool summable(const SparseRef& M, const SparseRef& K);
 
 /// Dense blocks of right-hand sides and solutions, n x k, column-major (Eigen::Ref: any column
 /// stride, so a block of a larger matrix binds as well).
@@ -97,7 +101,7 @@ class LinearSolver {
   /// at depth 9 that matrix is 0.28 GB. The default forms the sum in a matrix this object keeps
   /// (CHOLMOD uses it); the multigrid and PCG solvers override it and write a M + b K straight
   /// into the copy they keep anyway (the multigrid's permuted finest level, PCG's matrix).
-  virtual SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+  virtual SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                      HierarchyView hierarchy = {});
 
   /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers

@@ -80,7 +80,7 @@ struct Csc {
   const int* outer = nullptr;
   const int* inner = nullptr;
   const double* val = nullptr;
-  explicit Csc(const SparseMatrix& m)
+  explicit Csc(const SparseRef& m)
       : rows(int(m.rows())), cols(int(m.cols())), outer(m.outerIndexPtr()),
         inner(m.innerIndexPtr()), val(m.valuePtr()) {}
 };
@@ -309,7 +309,7 @@ int new_index(const std::vector<int>& inv, int i) { return inv.empty() ? i : inv
 /// M with entry (i, j) moved to (row_inv[i], col_inv[j]) (col_perm = inverse of col_inv). With
 /// `sort` each column is sorted by its new row indices; without, the entries of each column keep
 /// their relative order (so a row sum visits its terms in the caller's order).
-SparseMatrix permuted(const SparseMatrix& Mm, const std::vector<int>& row_inv, const std::vector<int>& col_perm,
+SparseMatrix permuted(const SparseRef& Mm, const std::vector<int>& row_inv, const std::vector<int>& col_perm,
                       bool sort) {
   const Csc M(Mm);
   SparseMatrix out(M.rows, M.cols);
@@ -339,7 +339,7 @@ SparseMatrix permuted(const SparseMatrix& Mm, const std::vector<int>& row_inv, c
 /// Whether `stored` == permuted(given, row_inv, col_perm, sort) (pattern, and values when asked)
 /// without building the permuted copy. Unsorted, with diag_rank (the finest level): column r
 /// stores the caller's diag_rank[r]-th entry last (Impl::diagonal_last).
-bool same_permuted(const SparseMatrix& stored, const SparseMatrix& given, const std::vector<int>& row_inv,
+bool same_permuted(const SparseMatrix& stored, const SparseRef& given, const std::vector<int>& row_inv,
                    const std::vector<int>& col_perm, bool sort, bool values,
                    const std::vector<int>& diag_rank = {}) {
   if (stored.rows() != given.rows() || stored.cols() != given.cols() ||
@@ -597,7 +597,7 @@ struct MultigridSolver::Impl {
     });
   }
 
-  void symbolic(const SparseMatrix& A, const std::vector<SparseMatrix>& P,
+  void symbolic(const SparseRef& A, const std::vector<SparseMatrix>& P,
                 const std::vector<std::vector<std::uint8_t>>* given_colours) {
     const std::size_t nl = P.size() + 1;
     levels.clear();
@@ -655,7 +655,7 @@ struct MultigridSolver::Impl {
   /// New values of the finest matrix (same pattern as the stored one, in the caller's numbering):
   /// A's, or a A + b K entry by entry when K is given (K on A's pattern; sum_entry, so bitwise
   /// what sum_on_pattern would have handed to set_matrix).
-  void set_fine_values(const SparseMatrix& A, double a, double b, const SparseMatrix* K) {
+  void set_fine_values(const SparseRef& A, double a, double b, const SparseRef* K) {
     Level& F = levels.back();
     const Csc G(A);
     const int* outer = F.A.outerIndexPtr();
@@ -940,13 +940,13 @@ SolveReport MultigridSolver::set_matrix(const SparseMatrix& A, HierarchyView hie
   return set_levels(A, 1.0, 0.0, nullptr, hierarchy);
 }
 
-SolveReport MultigridSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+SolveReport MultigridSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                             HierarchyView hierarchy) {
   if (!summable(M, K)) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);  // the general sum
   return set_levels(M, a, b, &K, hierarchy);
 }
 
-SolveReport MultigridSolver::set_levels(const SparseMatrix& A_in, double a, double b, const SparseMatrix* K,
+SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double b, const SparseRef* K,
                                         HierarchyView hierarchy) {
   SolveReport rep;
   Impl& m = *impl_;
@@ -957,14 +957,13 @@ SolveReport MultigridSolver::set_levels(const SparseMatrix& A_in, double a, doub
     return rep;
   };
   if (A_in.rows() != A_in.cols() || A_in.rows() == 0) return fail(SolveStatus::failed, "matrix is not square or empty");
+  // An uncompressed input is compressed into a copy (the kernels read the CSC arrays alone).
   SparseMatrix compressed;
-  const SparseMatrix* Ap = &A_in;
   if (!A_in.isCompressed()) {
     compressed = A_in;
     compressed.makeCompressed();
-    Ap = &compressed;
   }
-  const SparseMatrix& A = *Ap;
+  const SparseRef A = A_in.isCompressed() ? A_in : SparseRef(compressed);
 
   static const std::vector<SparseMatrix> kNone;
   const std::vector<SparseMatrix>& P = hierarchy.empty() ? kNone : *hierarchy.prolongations;

@@ -108,7 +108,7 @@ class MultigridSolver : public LinearSolver {
   /// finest level: when the pattern is unchanged, a M + b K is written straight into the permuted
   /// finest matrix (one pass over M and K instead of forming the sum and copying it); a new
   /// pattern is set up from M's, and the sum then written the same way.
-  SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                              HierarchyView hierarchy = {}) override;
 
   /// z = one cycle applied to r from z = 0 (a symmetric operator when pre_smooth ==
@@ -156,7 +156,7 @@ class MultigridSolver : public LinearSolver {
  private:
   struct Impl;
   /// Both set_matrix entries: the finest values are A's, or a A + b K when K is given (A = M).
-  SolveReport set_levels(const SparseMatrix& A, double a, double b, const SparseMatrix* K, HierarchyView hierarchy);
+  SolveReport set_levels(const SparseRef& A, double a, double b, const SparseRef* K, HierarchyView hierarchy);
   MultigridOptions options_;
   std::unique_ptr<Impl> impl_;
 };

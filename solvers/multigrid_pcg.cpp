@@ -18,7 +18,7 @@ SolveReport MultigridPcgSolver::set_matrix(const SparseMatrix& A, HierarchyView 
   return pcg_.set_matrix(A, hierarchy);
 }
 
-SolveReport MultigridPcgSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+SolveReport MultigridPcgSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                                HierarchyView hierarchy) {
   SolveReport r = multigrid_.set_matrix_sum(a, M, b, K, hierarchy);
   if (!r.ok()) return r;

@@ -181,7 +181,7 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarc
   return matrix_in_place();
 }
 
-SolveReport PcgSolver::set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+SolveReport PcgSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                       HierarchyView hierarchy) {
   // Off one pattern (the general sum) or not square (set_matrix says so): the default.
   if (!summable(M, K) || M.rows() != M.cols()) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);

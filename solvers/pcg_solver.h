@@ -53,7 +53,7 @@ class PcgSolver final : public LinearSolver {
   /// not_positive_definite for a non-positive diagonal with Jacobi or an IC breakdown.
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
   /// The same for a M + b K, written straight into the copy set_matrix keeps (no other copy).
-  SolveReport set_matrix_sum(double a, const SparseMatrix& M, double b, const SparseMatrix& K,
+  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                              HierarchyView hierarchy = {}) override;
 
   /// Y = A X with the deterministic parallel row SpMV (exposed for tests and other solvers).

@@ -39,7 +39,7 @@ void rows_any(const int* outer, const int* inner, const double* val, const doubl
 
 }  // namespace
 
-void symmetric_multiply(const SparseMatrix& A, const double* X, Index k, double* Y) {
+void symmetric_multiply(const SparseRef& A, const double* X, Index k, double* Y) {
   if (A.rows() != A.cols()) throw std::invalid_argument("symmetric_multiply: the matrix is not square");
   if (!A.isCompressed()) throw std::invalid_argument("symmetric_multiply: the matrix is not compressed");
   const Index n = A.rows();

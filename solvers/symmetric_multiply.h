@@ -18,12 +18,12 @@ namespace mcf {
 /// Y (n x k, column-major, leading dimension n) = A X for symmetric A (n x n, both triangles
 /// stored), X column-major n x k. Uses only A's storage, never its transpose: a non-symmetric A
 /// gives Aᵀ X.
-void symmetric_multiply(const SparseMatrix& A, const double* X, Eigen::Index k, double* Y);
+void symmetric_multiply(const SparseRef& A, const double* X, Eigen::Index k, double* Y);
 
 /// Y = A X for column-major dense Eigen matrices (MatrixXd, the flows' n x 3 coefficients, an
 /// Eigen::Ref); Y must be resizable.
 template <class In, class Out>
-void symmetric_multiply(const SparseMatrix& A, const In& X, Out& Y) {
+void symmetric_multiply(const SparseRef& A, const In& X, Out& Y) {
   static_assert(!In::IsRowMajor && !Out::IsRowMajor, "symmetric_multiply: column-major dense matrices only");
   if (X.rows() != A.cols()) throw std::invalid_argument("symmetric_multiply: sizes do not match");
   Y.resize(A.rows(), X.cols());
@@ -36,7 +36,7 @@ void symmetric_multiply(const SparseMatrix& A, const In& X, Out& Y) {
 }
 
 template <class Dense>
-Dense symmetric_multiply(const SparseMatrix& A, const Dense& X) {
+Dense symmetric_multiply(const SparseRef& A, const Dense& X) {
   Dense Y;
   symmetric_multiply(A, X, Y);
   return Y;

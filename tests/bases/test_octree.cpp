@@ -12,6 +12,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -31,6 +34,14 @@ Fixture make_fixture(int depth, mcf::OctreeCube cube_kind = mcf::OctreeCube::tig
   f.octree = mcf::build_octree(cube, f.pieces, 2);
   f.piece_cells = mcf::locate_pieces(f.octree, f.pieces);
   return f;
+}
+
+// The system's mass and stiffness as matrices of their own (assemble() gives values on the
+// system's pattern, view() shows them as matrices).
+std::pair<mcf::SparseMatrix, mcf::SparseMatrix> assembled(const mcf::OctreeSystem& sys, const mcf::CubatureRule& rule) {
+  std::vector<double> m, k;
+  sys.assemble(rule, m, k);
+  return {mcf::SparseMatrix(sys.view(m)), mcf::SparseMatrix(sys.view(k))};
 }
 
 TEST(Octree, CubeChoice) {
@@ -137,14 +148,12 @@ TEST(Octree, GalerkinEqualsDirectCoarseAssembly) {
   for (int order : {1, 3}) {
     const auto& rule = mcf::cubature_rule(order);
     mcf::OctreeSystem fine_sys(f.octree, finest, f.pieces, f.piece_cells);
-    mcf::SparseMatrix M, K;
-    fine_sys.assemble(rule, M, K);
+    auto [M, K] = assembled(fine_sys, rule);
     for (int l = finest - 1; l >= finest - 3; --l) {
       M = mcf::SparseMatrix(P[l].transpose() * M * P[l]);
       K = mcf::SparseMatrix(P[l].transpose() * K * P[l]);
       mcf::OctreeSystem coarse_sys(f.octree, l, f.pieces, f.piece_cells);
-      mcf::SparseMatrix Mc, Kc;
-      coarse_sys.assemble(rule, Mc, Kc);
+      const auto [Mc, Kc] = assembled(coarse_sys, rule);
       ASSERT_EQ(Mc.rows(), M.rows());
       const mcf::SparseMatrix dM = M - Mc, dK = K - Kc;
       const double em = dM.coeffs().cwiseAbs().maxCoeff(), ek = dK.coeffs().cwiseAbs().maxCoeff();
@@ -191,14 +200,14 @@ TEST(Octree, AssemblyIsDeterministicAcrossThreadCounts) {
   {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
     mcf::OctreeSystem sys(f.octree, finest, f.pieces, f.piece_cells);
-    sys.assemble(mcf::cubature_rule(3), M1, K1);
+    std::tie(M1, K1) = assembled(sys, mcf::cubature_rule(3));
   }
   {
     tbb::global_control many(tbb::global_control::max_allowed_parallelism, 4);
     const auto pieces = mcf::clip_mesh(f.mesh.vertices, f.mesh.faces, f.octree.cube);
     ASSERT_EQ(pieces.size(), f.pieces.size());
     mcf::OctreeSystem sys(f.octree, finest, pieces, f.piece_cells);
-    sys.assemble(mcf::cubature_rule(3), M2, K2);
+    std::tie(M2, K2) = assembled(sys, mcf::cubature_rule(3));
   }
   ASSERT_EQ(M1.nonZeros(), M2.nonZeros());
   for (Eigen::Index s = 0; s < M1.nonZeros(); ++s) {

@@ -6,6 +6,7 @@
 
 #include "test_meshes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -119,6 +120,32 @@ TEST(OctreeBasis, RebuildFollowsTheMesh) {
   EXPECT_NEAR(static_cast<double>(basis.dimension()), static_cast<double>(dim0), 0.05 * dim0);
   EXPECT_LT((basis.evaluate_vertices(basis.initial_coefficients()) - v).cwiseAbs().maxCoeff(), 1e-13);
   EXPECT_THROW(basis.rebuild(mcf::Positions::Zero(4, 3)), std::invalid_argument);
+}
+
+// Mass and stiffness are values on the system's one pattern (OctreeSystem::view): both views
+// show the system's index arrays, before and after a rebuild, and their entries are those of a
+// stand-alone copy of the pattern.
+TEST(OctreeBasis, MassAndStiffnessShareTheSystemsPattern) {
+  const auto mesh = rotated_sphere(3);
+  RebuiltOctreeBasis basis(mesh, OctreeOptions{.depth = 5});
+  for (int build = 0; build < 2; ++build) {
+    const mcf::SparseView M = basis.mass(), K = basis.stiffness();
+    const mcf::OctreeSystem& system = basis.system();
+    EXPECT_EQ(M.outerIndexPtr(), system.outer().data()) << build;
+    EXPECT_EQ(K.outerIndexPtr(), system.outer().data()) << build;
+    EXPECT_EQ(M.innerIndexPtr(), K.innerIndexPtr()) << build;
+    EXPECT_NE(M.valuePtr(), K.valuePtr()) << build;
+    EXPECT_EQ(M.rows(), basis.dimension()) << build;
+    EXPECT_EQ(M.nonZeros(), system.non_zeros()) << build;
+    const mcf::SparseMatrix pattern = system.pattern();
+    ASSERT_EQ(pattern.nonZeros(), M.nonZeros()) << build;
+    EXPECT_TRUE(std::equal(pattern.innerIndexPtr(), pattern.innerIndexPtr() + pattern.nonZeros(), M.innerIndexPtr()))
+        << build;
+    // Not the values of the zero pattern: both matrices were assembled.
+    EXPECT_GT(M.sum(), 0.1) << build;
+    EXPECT_GT(mcf::SparseMatrix(K).diagonal().minCoeff(), -1e-15) << build;
+    basis.rebuild(0.5 * mesh.vertices);
+  }
 }
 
 TEST(OctreeBasis, OpenSurfaceLocksBoundaryFunctions) {

@@ -52,7 +52,7 @@ TEST(OctreeMultigridNearNull, PlainCyclesStagnateButNotBecauseOfNegligibleFuncti
   EXPECT_GT(res[11], 1e-6);
 
   // Fixing every function with M_ii < 1e-8 max M_ii at the exact solution does not cure it.
-  const Eigen::VectorXd md = s.basis.mass().diagonal();
+  const Eigen::VectorXd md = SparseMatrix(s.basis.mass()).diagonal();
   const Eigen::Index n = s.A.rows();
   std::vector<int> free;
   for (Eigen::Index i = 0; i < n; ++i)

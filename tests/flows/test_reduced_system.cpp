@@ -126,8 +126,8 @@ class ChainBasis : public Basis {
     return x;
   }
   void update(const Coefficients&, bool, bool) override {}
-  const SparseMatrix& mass() const override { return mass_; }
-  const SparseMatrix& stiffness() const override { return stiffness_; }
+  SparseView mass() const override { return view_of(mass_); }
+  SparseView stiffness() const override { return view_of(stiffness_); }
   Positions evaluate_vertices(const Coefficients& x) const override { return x; }
   std::vector<int> locked_functions() const override { return locked_; }
   const std::vector<SparseMatrix>* prolongations() const override { return &prolongations_; }

@@ -40,6 +40,15 @@ TEST(SamePattern, ComparesIndicesNotValues) {
   ASSERT_FALSE(U.isCompressed());
   EXPECT_FALSE(mcf::same_pattern(A, U));
   EXPECT_FALSE(mcf::same_pattern(U, U));
+  // Maps of one pattern's arrays (a basis's mass and stiffness views) with their own values.
+  const std::vector<double> values(std::size_t(A.nonZeros()), 5.0);
+  const Eigen::Map<const SparseMatrix> V(3, 3, A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(), values.data());
+  EXPECT_TRUE(mcf::same_pattern(V, A));
+  EXPECT_TRUE(mcf::same_pattern(V, B));
+  EXPECT_FALSE(mcf::same_pattern(V, C));
+  // The same arrays seen with fewer entries or columns are another pattern.
+  const Eigen::Map<const SparseMatrix> W(2, 2, 4, A.outerIndexPtr(), A.innerIndexPtr(), values.data());
+  EXPECT_FALSE(mcf::same_pattern(V, W));
 }
 
 // sum_on_pattern against Eigen's general sparse sum (which merges patterns itself), on a matrix
