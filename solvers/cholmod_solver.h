@@ -28,6 +28,10 @@ class CholmodSolver final : public LinearSolver {
   /// when the pattern differs from the previous call's. Status not_positive_definite when the
   /// factorization meets a non-positive pivot (no abort, no output).
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
+  /// set_matrix(a M + b K) for M and K on one pattern, formed straight into the cached lower
+  /// triangle (bitwise the same factor; no full sum kept). Off one pattern, the default.
+  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
+                             HierarchyView hierarchy = {}) override;
 
   /// Number of symbolic analyses done so far (tests check that refactorization reuses it).
   int analyses() const { return analyses_; }
@@ -50,9 +54,14 @@ class CholmodSolver final : public LinearSolver {
 
  private:
   void free_all();
-  bool same_pattern(const SparseMatrix& A) const;
-  void build_lower(const SparseMatrix& A);   // new pattern: (re)build the cached lower triangle
-  void refresh_values(const SparseMatrix& A);  // same pattern: copy values only
+  bool same_pattern(const SparseRef& A) const;
+  void build_lower(const SparseRef& A);  // new pattern: (re)build the cached lower triangle
+  /// Both set_matrix entries: analyzes A's pattern when it is new, lets `fill(x, gather, count)`
+  /// write the lower triangle's values (x[e] from the caller's entry gather[e]; false when one is
+  /// NaN/inf), then factorizes.
+  template <class Fill>
+  SolveReport factorize(const SparseRef& A, Fill fill);
+  SolveReport fail(SolveStatus status, std::string message);  // records and reports a failure
 
   cholmod_common common_{};
   cholmod_sparse* lower_ = nullptr;   // cached lower triangle of A (stype = -1)

@@ -99,8 +99,9 @@ class LinearSolver {
   /// summable() does not hold, the default below forms Eigen's general sum, whose pattern is the
   /// union), bitwise the same, without the caller storing the sum:
   /// at depth 9 that matrix is 0.28 GB. The default forms the sum in a matrix this object keeps
-  /// (CHOLMOD uses it); the multigrid and PCG solvers override it and write a M + b K straight
-  /// into the copy they keep anyway (the multigrid's permuted finest level, PCG's matrix).
+  /// (the dense reference uses it); the multigrid, PCG and CHOLMOD solvers override it and write
+  /// a M + b K straight into the copy they keep anyway (the multigrid's permuted finest level,
+  /// PCG's matrix, CHOLMOD's lower triangle).
   virtual SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                      HierarchyView hierarchy = {});
 

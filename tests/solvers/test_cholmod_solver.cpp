@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <utility>
+
 namespace mcf {
 namespace {
 
@@ -133,6 +136,56 @@ TEST(CholmodSolver, AcceptsUncompressedInput) {
   ASSERT_EQ(s.set_matrix(U).status, SolveStatus::converged);
   ASSERT_EQ(s.solve(B, X).status, SolveStatus::converged);
   ASSERT_EQ(dense_llt_solve(A, B, Xd).status, SolveStatus::converged);
+  EXPECT_LT(relative_difference(X, Xd), 1e-8);
+}
+
+// set_matrix_sum forms a M + b K in the lower triangle CHOLMOD reads: the factor, and so every
+// solution, is bitwise that of set_matrix on the sum formed by sum_on_pattern; the analysis is
+// reused; NaN/inf in the sum is refused, on a new pattern too, and the next finite sum works.
+TEST(CholmodSolver, SetMatrixSumIsBitwiseTheFactorOfTheSum) {
+  const SparseMatrix M = laplacian3d(7, 6, 5, 0.1, 3);
+  const SparseMatrix K = laplacian3d(7, 6, 5, 0.7, 4, 2.5);  // same pattern, other values
+  ASSERT_TRUE(same_pattern(M, K));
+  // K's values on M's index arrays, as a basis hands them out (bases/basis.h SparseView).
+  const Eigen::Map<const SparseMatrix> K_view(K.rows(), K.cols(), K.nonZeros(), M.outerIndexPtr(),
+                                              M.innerIndexPtr(), K.valuePtr());
+  const Eigen::MatrixXd B = random_rhs(M.rows());
+  CholmodSolver fused, plain;
+  SparseMatrix S = M;
+  for (const auto& [a, b] : {std::pair{1.0, 0.05}, std::pair{2.0, 0.3}}) {
+    sum_on_pattern(a, M, b, K, S);
+    ASSERT_TRUE(plain.set_matrix(S).ok());
+    ASSERT_TRUE(fused.set_matrix_sum(a, M, b, K_view).ok());
+    Eigen::MatrixXd Xp, Xf;
+    ASSERT_TRUE(plain.solve(B, Xp).ok());
+    ASSERT_TRUE(fused.solve(B, Xf).ok());
+    EXPECT_TRUE(Xf == Xp) << "a = " << a << ", b = " << b;
+    Eigen::MatrixXd Xd;
+    ASSERT_TRUE(dense_llt_solve(S, B, Xd).ok());
+    EXPECT_LT(relative_difference(Xf, Xd), 1e-8);
+  }
+  EXPECT_EQ(fused.analyses(), 1);
+  EXPECT_EQ(fused.factorizations(), 2);
+
+  // A NaN in a lower-triangle entry of K, first on a fresh solver (a new pattern), then again.
+  SparseMatrix K_nan = K;
+  K_nan.coeffRef(5, 4) = std::numeric_limits<double>::quiet_NaN();
+  CholmodSolver fresh;
+  EXPECT_EQ(fresh.set_matrix_sum(1.0, M, 0.1, K_nan).status, SolveStatus::numerical_issue);
+  EXPECT_FALSE(fresh.factorized());
+  Eigen::MatrixXd X;
+  EXPECT_EQ(fresh.solve(B, X).status, SolveStatus::numerical_issue);
+  ASSERT_TRUE(fresh.set_matrix_sum(1.0, M, 0.1, K).ok());
+  ASSERT_TRUE(fresh.solve(B, X).ok());
+  EXPECT_EQ(fresh.analyses(), 1);
+  EXPECT_EQ(fused.set_matrix_sum(1.0, M, 0.1, K_nan).status, SolveStatus::numerical_issue);
+
+  // Off one pattern: the default (Eigen's general sum), still the right solution.
+  const SparseMatrix D = SparseMatrix(Eigen::VectorXd::Constant(M.rows(), 3.0).asDiagonal());
+  ASSERT_TRUE(fused.set_matrix_sum(1.0, M, 0.5, D).ok());
+  ASSERT_TRUE(fused.solve(B, X).ok());
+  Eigen::MatrixXd Xd;
+  ASSERT_TRUE(dense_llt_solve(SparseMatrix(M + 0.5 * D), B, Xd).ok());
   EXPECT_LT(relative_difference(X, Xd), 1e-8);
 }
 
