@@ -142,18 +142,6 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level, const std::vector<Cl
   });
 }
 
-namespace {
-// Eigen 3.4's SparseMatrix has no move assignment: fill in place (reusing its storage).
-void set_pattern(SparseMatrix& A, const std::vector<int>& outer, const std::vector<int>& inner) {
-  const auto n = static_cast<Eigen::Index>(outer.size()) - 1, nnz = static_cast<Eigen::Index>(inner.size());
-  A.resize(n, n);
-  A.resizeNonZeros(nnz);
-  std::copy(outer.begin(), outer.end(), A.outerIndexPtr());
-  std::copy(inner.begin(), inner.end(), A.innerIndexPtr());
-  std::fill_n(A.valuePtr(), nnz, 0.0);
-}
-}  // namespace
-
 void OctreeSystem::release_pieces() {
   // swap with empty vectors: clear() alone keeps the capacity.
   std::vector<int>().swap(piece_cell_);
@@ -161,11 +149,7 @@ void OctreeSystem::release_pieces() {
   released_ = true;
 }
 
-SparseMatrix OctreeSystem::pattern() const {
-  SparseMatrix A;
-  set_pattern(A, outer_, inner_);
-  return A;
-}
+SparseMatrix OctreeSystem::pattern() const { return SparseMatrix(view(std::vector<double>(inner_.size(), 0.0))); }
 
 void OctreeSystem::assemble(const CubatureRule& rule, std::vector<double>& mass, std::vector<double>& stiffness) const {
   const OctreeLevel& L = octree_->levels[static_cast<std::size_t>(level_)];
