@@ -102,7 +102,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
     observer.on_step = [&](int step, double, const Positions& V) {
       if (step == 0) initial = TriangleMesh{V, source.mesh.faces};
       if (frames.count(step) || (config.save_every > 0 && step % config.save_every == 0)) {
-        write_mesh((frame_dir / frame_name(step)).string(), TriangleMesh{V, source.mesh.faces});
+        write_mesh((frame_dir / frame_name(step)).string(), TriangleMesh{V, source.mesh.faces}, true, FaceCheck::trusted);
         written.push_back(step);
       }
       // Metrics at step 0 too (the initial sphericity is the baseline of the cMCF plots), then

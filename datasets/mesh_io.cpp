@@ -361,6 +361,12 @@ TriangleMesh read_mesh(const std::string& path) {
   return mesh;
 }
 
+void check_half_edge_faces(const TriangleMesh& mesh, const std::string& name) {
+  half_edge_mesh(
+      name, "", mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
+      [](int v) { return std::to_string(v); });
+}
+
 namespace {
 
 // OFF, OBJ and PLY are written here rather than by OpenMesh, whose writers round coordinates to
@@ -393,16 +399,20 @@ bool write_exact(const fs::path& file, const TriangleMesh& mesh, const std::stri
 
 }  // namespace
 
-void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary) {
+void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary, FaceCheck check) {
   silence_openmesh();
   const std::string ext = lower_extension(path);
   if (ext != ".off" && ext != ".ply" && ext != ".obj" && ext != ".stl")
     fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
 
-  // Writing a mesh that OpenMesh cannot represent would silently drop faces in the file.
-  const IoMesh om = half_edge_mesh(
-      path, "cannot write: ", mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
-      [](int v) { return std::to_string(v); });
+  // Writing a mesh that OpenMesh cannot represent would silently drop faces in an STL file, and
+  // our own writers would write a file that no reader here accepts. The STL writer needs the
+  // half-edge mesh whatever the caller vouches for.
+  const IoMesh om = check == FaceCheck::half_edge || ext == ".stl"
+                        ? half_edge_mesh(
+                              path, "cannot write: ", mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
+                              [](int v) { return std::to_string(v); })
+                        : IoMesh();
 
   // OpenMesh writes STL only (write_exact the rest). OFF has a binary variant, but few readers
   // besides OpenMesh accept it: OFF stays ASCII.

@@ -212,6 +212,9 @@ MeshSource load_mesh_spec(const std::string& spec) {
       src.analytic = true;
       try {
         src.mesh = g->build(values);
+        // As read_mesh does for files: then every MeshSource's faces hold in a half-edge mesh,
+        // and a flow writes them without checking each frame again (FaceCheck::trusted).
+        check_half_edge_faces(src.mesh, name);
       } catch (const MeshError& e) {
         fail(spec, e.what());
       }

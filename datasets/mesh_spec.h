@@ -17,6 +17,8 @@
 namespace mcf {
 
 struct MeshSource {
+  /// Its faces hold in a half-edge mesh (read_mesh or load_mesh_spec checked them; subdivision
+  /// keeps that), so writers may pass FaceCheck::trusted for it and its flowed copies.
   TriangleMesh mesh;
   std::string spec;           ///< as given
   std::string kind;           ///< "sphere", "icosphere", "cgal", "file", ...

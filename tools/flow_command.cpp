@@ -132,7 +132,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
           if (config.save_every > 0 && step % config.save_every == 0) {
             char name[32];
             std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-            write_mesh((out / name).string(), TriangleMesh{V, mesh.mesh.faces});
+            write_mesh((out / name).string(), TriangleMesh{V, mesh.mesh.faces}, true, FaceCheck::trusted);
             frames.insert(name);
           }
         };
@@ -146,7 +146,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       outcome.result["peak_memory_bytes"] = peak_memory_bytes();
       if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
         outcome.result["steal_seconds"] = steal;
-      write_mesh((out / "final.ply").string(), outcome.final_mesh);
+      write_mesh((out / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
       write_file_atomic((out / "result.json").string(), outcome.result.dump(1) + "\n");
       // Frames of an earlier run into the same folder would sit beside this run's result as if
       // they were its own: once the new result is in place, they go.

@@ -38,7 +38,7 @@ void add_mesh_info_command(CLI::App& app, std::function<int()>& run) {
                           {"bbox_max", {hi.x(), hi.y(), hi.z()}}};
       if (m.sphere_radius) j["sphere_radius"] = *m.sphere_radius;
       std::printf("%s\n", j.dump(2).c_str());
-      if (!out->empty()) write_mesh(*out, m.mesh);
+      if (!out->empty()) write_mesh(*out, m.mesh, true, FaceCheck::trusted);
       return 0;
     };
   });

@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <numeric>
 #include <random>
@@ -241,6 +243,49 @@ TEST(MeshIo, WritingANonManifoldMeshFails) {
     }
     EXPECT_FALSE(std::filesystem::exists(path)) << path;
   }
+  // The STL writer needs the half-edge mesh, so it checks whatever the caller vouches for.
+  EXPECT_THROW(write_mesh(dir.file("fin_trusted.stl"), fin, true, FaceCheck::trusted), MeshError);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("fin_trusted.stl")));
+  // The check on its own names the mesh and the face, as on writing.
+  try {
+    check_half_edge_faces(fin, "the fin");
+    FAIL() << "no MeshError";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("the fin: non-manifold mesh: face 2 (vertices 0, 1, 4)"), std::string::npos) << e.what();
+  }
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// FaceCheck::trusted skips only the check: the files are byte for byte those written after it.
+// And it does skip it (the speed-up of writing a flow's frames), which the fin shows: written
+// as trusted, it is in the file, and reading that file back names it.
+TEST(MeshIo, TrustedFacesWriteTheSameBytes) {
+  TempDir dir;
+  TriangleMesh m = make_icosphere(2);
+  m.vertices *= 1.0 / 3.0;  // doubles that need all 17 digits
+  for (const char* ext : {".ply", ".off", ".obj", ".stl"})
+    for (const bool binary : {true, false}) {
+      const std::string checked = dir.file(std::string("checked") + (binary ? "_b" : "_a") + ext);
+      const std::string trusted = dir.file(std::string("trusted") + (binary ? "_b" : "_a") + ext);
+      write_mesh(checked, m, binary);
+      write_mesh(trusted, m, binary, FaceCheck::trusted);
+      const std::string bytes = file_bytes(checked);
+      EXPECT_GT(bytes.size(), 1000u) << checked;
+      EXPECT_EQ(bytes, file_bytes(trusted)) << trusted;
+    }
+
+  TriangleMesh fin;
+  fin.vertices.resize(5, 3);
+  fin.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
+  fin.faces.resize(3, 3);
+  fin.faces << 0, 1, 2, 1, 0, 3, 0, 1, 4;
+  const std::string path = dir.file("fin.ply");
+  write_mesh(path, fin, true, FaceCheck::trusted);
+  expect_error_naming(path, "non-manifold mesh: face 2 (vertices 0, 1, 4)");
 }
 
 TEST(MeshIo, RepeatedIndexInFace) {
