@@ -33,9 +33,10 @@ enum class FaceCheck {
   /// every file written reads back.
   half_edge,
   /// The caller vouches that the faces passed that check already: a flow writing its frames and
-  /// final mesh with the faces of a MeshSource (checked by load_mesh_spec), which no flow changes. Building the
-  /// half-edge mesh again was four fifths of writing a frame (binary PLY of the 832k-face
-  /// armadillo: 0.25 s with it, 0.053 s without). STL, which OpenMesh writes from a half-edge mesh, is checked anyway.
+  /// final mesh with the faces of a MeshSource (checked by load_mesh_spec), which no flow
+  /// changes. Building the half-edge mesh again was four fifths of writing a frame (binary PLY of
+  /// the 832k-face armadillo: 0.25 s with it, 0.053 s without). STL, which OpenMesh writes from
+  /// a half-edge mesh, is checked anyway.
   trusted,
 };
 
