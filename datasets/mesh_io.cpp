@@ -205,27 +205,35 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
 }
 
 // STL: ASCII counts 'facet' records, binary stores the triangle count at byte 80. Vertices are
-// merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance.
+// merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance. A binary
+// file is not read here beyond its header (OpenMesh reads it next); only a file that starts with
+// "solid" is read whole, since some binary exporters start their header with it too.
 long long count_stl_triangles(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file");
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto start = data.find_first_not_of(" \t\r\n");
-  bool ascii = start != std::string::npos && data.compare(start, 5, "solid") == 0 &&
-               data.find("facet", start) != std::string::npos;
-  if (ascii) {
-    long long n = 0;
-    for (size_t pos = data.find("facet"); pos != std::string::npos; pos = data.find("facet", pos + 5)) {
-      // "endfacet" also contains "facet": count only the opening keyword.
-      if (pos >= 3 && data.compare(pos - 3, 3, "end") == 0) continue;
-      ++n;
+  std::string head(84, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  const auto start = head.find_first_not_of(" \t\r\n");
+  if (start != std::string::npos && head.compare(start, 5, "solid") == 0) {
+    std::string data = head + std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (data.find("facet", start) != std::string::npos) {
+      long long n = 0;
+      for (size_t pos = data.find("facet"); pos != std::string::npos; pos = data.find("facet", pos + 5)) {
+        // "endfacet" also contains "facet": count only the opening keyword.
+        if (pos >= 3 && data.compare(pos - 3, 3, "end") == 0) continue;
+        ++n;
+      }
+      return n;
     }
-    return n;
   }
-  if (data.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
+  if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
   std::uint32_t n = 0;
-  std::memcpy(&n, data.data() + 80, 4);
-  if (data.size() < 84 + 50ull * n) fail(path, "binary STL truncated (" + std::to_string(n) + " triangles announced)");
+  std::memcpy(&n, head.data() + 80, 4);
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot read the file's size: " + ec.message());
+  if (size < 84 + 50ull * n) fail(path, "binary STL truncated (" + std::to_string(n) + " triangles announced)");
   return n;
 }
 

@@ -529,6 +529,28 @@ TEST(MeshIo, RoundTripObj) { expect_round_trip("t.obj", false, 1e-15); }
 TEST(MeshIo, RoundTripStlAscii) { expect_round_trip("t.stl", false, 1e-6, false); }
 TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false); }
 
+// A binary STL is checked by its header's triangle count against the file's length; one whose
+// header starts with "solid" (as some exporters write) is still binary when it has no facet.
+TEST(MeshIo, BinaryStlHeaderAndLength) {
+  TempDir dir;
+  const TriangleMesh m = make_icosphere(1);
+  const std::string good = dir.file("good.stl");
+  write_mesh(good, m, true);
+  std::string bytes = file_bytes(good);
+  ASSERT_EQ(bytes.size(), 84u + 50u * static_cast<size_t>(m.num_faces()));
+  EXPECT_EQ(read_mesh(good).num_faces(), m.num_faces());
+
+  expect_error_naming(dir.write("truncated.stl", bytes.substr(0, bytes.size() - 10)),
+                      "binary STL truncated (" + std::to_string(m.num_faces()) + " triangles announced)");
+  expect_error_naming(dir.write("short.stl", bytes.substr(0, 60)), "shorter than its 84-byte header");
+
+  std::string solid = bytes;
+  solid.replace(0, 12, "solid binary");
+  const TriangleMesh r = read_mesh(dir.write("solid_header.stl", solid));
+  EXPECT_EQ(r.num_faces(), m.num_faces());
+  EXPECT_EQ(r.num_vertices(), m.num_vertices());
+}
+
 TEST(MeshIo, WriteIntoMissingFolderFails) {
   const TriangleMesh m = make_icosphere(0);
   EXPECT_THROW(write_mesh("/nonexistent_dir_xyz/out.ply", m), MeshError);
