@@ -369,10 +369,19 @@ TriangleMesh read_mesh(const std::string& path) {
   return mesh;
 }
 
-void check_half_edge_faces(const TriangleMesh& mesh, const std::string& name) {
-  half_edge_mesh(
-      name, "", mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
+namespace {
+
+// half_edge_mesh for a mesh in memory: faces and vertices named by their 0-based indices.
+IoMesh half_edge_mesh_in_memory(const std::string& name, const std::string& prefix, const TriangleMesh& mesh) {
+  return half_edge_mesh(
+      name, prefix, mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
       [](int v) { return std::to_string(v); });
+}
+
+}  // namespace
+
+void check_half_edge_faces(const TriangleMesh& mesh, const std::string& name) {
+  half_edge_mesh_in_memory(name, "", mesh);
 }
 
 namespace {
@@ -417,9 +426,7 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary, 
   // our own writers would write a file that no reader here accepts. The STL writer needs the
   // half-edge mesh whatever the caller vouches for.
   const IoMesh om = check == FaceCheck::half_edge || ext == ".stl"
-                        ? half_edge_mesh(
-                              path, "cannot write: ", mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
-                              [](int v) { return std::to_string(v); })
+                        ? half_edge_mesh_in_memory(path, "cannot write: ", mesh)
                         : IoMesh();
 
   // OpenMesh writes STL only (write_exact the rest). OFF has a binary variant, but few readers

@@ -225,13 +225,19 @@ TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
   EXPECT_GT(refusals["vertex"], 0);  // a vertex already surrounded by a closed fan
 }
 
-TEST(MeshIo, WritingANonManifoldMeshFails) {
-  TempDir dir;
+// Three triangles on the edge (0, 1): a fin, which no half-edge mesh holds (face 2 is refused).
+TriangleMesh fin_mesh() {
   TriangleMesh fin;
   fin.vertices.resize(5, 3);
   fin.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
   fin.faces.resize(3, 3);
   fin.faces << 0, 1, 2, 1, 0, 3, 0, 1, 4;
+  return fin;
+}
+
+TEST(MeshIo, WritingANonManifoldMeshFails) {
+  TempDir dir;
+  const TriangleMesh fin = fin_mesh();
   for (const char* name : {"fin.off", "fin.ply", "fin.stl"}) {
     const std::string path = dir.file(name);
     try {
@@ -278,13 +284,8 @@ TEST(MeshIo, TrustedFacesWriteTheSameBytes) {
       EXPECT_EQ(bytes, file_bytes(trusted)) << trusted;
     }
 
-  TriangleMesh fin;
-  fin.vertices.resize(5, 3);
-  fin.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
-  fin.faces.resize(3, 3);
-  fin.faces << 0, 1, 2, 1, 0, 3, 0, 1, 4;
   const std::string path = dir.file("fin.ply");
-  write_mesh(path, fin, true, FaceCheck::trusted);
+  write_mesh(path, fin_mesh(), true, FaceCheck::trusted);
   expect_error_naming(path, "non-manifold mesh: face 2 (vertices 0, 1, 4)");
 }
 
