@@ -62,13 +62,26 @@ std::int64_t CholmodSolver::factor_nonzeros() const {
 }
 
 bool CholmodSolver::same_pattern(const SparseRef& A) const {
-  if (!lower_ || A.rows() != rows_) return false;
-  const auto nnz = static_cast<std::size_t>(A.nonZeros());
-  if (inner_.size() != nnz) return false;
-  // Exact comparison: O(nnz) integer compares, negligible next to the numeric factorization,
-  // and unlike a hash it can never wrongly reuse a symbolic analysis.
-  return std::equal(outer_.begin(), outer_.end(), A.outerIndexPtr()) &&
-         std::equal(inner_.begin(), inner_.end(), A.innerIndexPtr());
+  // The caller has checked that A has the cached pattern's size and number of nonzeros. Exact, and exactly what the factor depends on: every lower-triangle entry of A must be the
+  // cached entry at the same place of lower_ (same column, same row) and sit at the position
+  // gather_ reads it from. Then the gather forms A's lower triangle, which is all CHOLMOD reads
+  // (stype = -1), whatever A's upper triangle holds; a column with an entry more or fewer, or
+  // any shift of positions, fails. O(nnz) integer compares, negligible next to the numeric
+  // factorization, and unlike a hash it can never wrongly reuse a symbolic analysis.
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const auto* p = static_cast<const Long*>(lower_->p);
+  const auto* i = static_cast<const Long*>(lower_->i);
+  for (Long j = 0; j < rows_; ++j) {
+    Long pos = p[j];
+    for (int k = outer[j]; k < outer[j + 1]; ++k) {
+      if (inner[k] < j) continue;
+      if (pos == p[j + 1] || i[pos] != inner[k] || gather_[static_cast<std::size_t>(pos)] != k) return false;
+      ++pos;
+    }
+    if (pos != p[j + 1]) return false;
+  }
+  return true;
 }
 
 void CholmodSolver::build_lower(const SparseRef& A) {
@@ -102,8 +115,7 @@ void CholmodSolver::build_lower(const SparseRef& A) {
   p[n] = pos;
 
   rows_ = n;
-  outer_.assign(outer, outer + n + 1);
-  inner_.assign(inner, inner + A.nonZeros());
+  nonzeros_ = A.nonZeros();
 }
 
 SolveReport CholmodSolver::fail(SolveStatus status, std::string message) {
@@ -113,11 +125,19 @@ SolveReport CholmodSolver::fail(SolveStatus status, std::string message) {
 }
 
 template <class Fill>
-SolveReport CholmodSolver::factorize(const SparseRef& A, Fill fill) {
-  if (!same_pattern(A)) {
+SolveReport CholmodSolver::factorize(const SparseRef& A, std::uint64_t key, Fill fill) {
+  // A key the cached pattern was set with vouches for A's pattern (linear_solver.h); the O(1)
+  // checks stay, so a caller's mistake in size is still caught. Otherwise compare exactly.
+  const bool sized = lower_ && A.rows() == rows_ && A.nonZeros() == nonzeros_;
+  const bool vouched = sized && key != 0 && key == key_;
+  bool same = vouched;
+  if (sized && !vouched) {
+    ++pattern_comparisons_;
+    same = same_pattern(A);
+  }
+  key_ = key;  // later calls with it are vouched for against this call's (now cached) pattern
+  if (!same) {
     free_all();
-    outer_.clear();
-    inner_.clear();
     rows_ = -1;
     build_lower(A);
     if (!lower_) return fail(SolveStatus::failed, "cholmod_allocate_sparse failed");
@@ -155,7 +175,7 @@ SolveReport CholmodSolver::factorize(const SparseRef& A, Fill fill) {
   return r;
 }
 
-SolveReport CholmodSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarchy*/) {
+SolveReport CholmodSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
   factor_ok_ = false;
   if (A.rows() != A.cols()) return fail(SolveStatus::failed, "matrix is not square");
   if (!A.isCompressed()) {
@@ -163,13 +183,13 @@ SolveReport CholmodSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hie
     // pattern comparison and the gather simple.
     SparseMatrix C = A;
     C.makeCompressed();
-    return set_matrix(C);
+    return set_matrix(C, hierarchy);
   }
   // Every entry is checked, the upper triangle's too, as given.
   const double* v = A.valuePtr();
   for (Eigen::Index k = 0; k < A.nonZeros(); ++k)
     if (!std::isfinite(v[k])) return fail(SolveStatus::numerical_issue, "matrix has NaN/inf");
-  return factorize(A, [v](double* x, const std::int64_t* gather, std::size_t count) {
+  return factorize(A, hierarchy.pattern_key, [v](double* x, const int* gather, std::size_t count) {
     for (std::size_t e = 0; e < count; ++e) x[e] = v[gather[e]];
     return true;
   });
@@ -186,7 +206,7 @@ SolveReport CholmodSolver::set_matrix_sum(double a, const SparseRef& M, double b
   // set_matrix on sum_on_pattern's result. Only the lower triangle is formed, so only it is
   // checked for NaN/inf (M and K are symmetric).
   const double *m = M.valuePtr(), *k = K.valuePtr();
-  return factorize(M, [=](double* x, const std::int64_t* gather, std::size_t count) {
+  return factorize(M, hierarchy.pattern_key, [=](double* x, const int* gather, std::size_t count) {
     bool finite = true;
     for (std::size_t e = 0; e < count; ++e) {
       x[e] = sum_entry(a, m[gather[e]], b, k[gather[e]]);

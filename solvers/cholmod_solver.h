@@ -25,8 +25,10 @@ class CholmodSolver final : public LinearSolver {
   std::string name() const override { return "cholmod"; }
 
   /// Factorizes A (full symmetric storage; only its lower triangle is read). Re-analyzes only
-  /// when the pattern differs from the previous call's. Status not_positive_definite when the
-  /// factorization meets a non-positive pivot (no abort, no output).
+  /// when the pattern differs from the previous call's: compared exactly against the cached
+  /// lower triangle, or taken as the same without a comparison when hierarchy.pattern_key
+  /// vouches for it (linear_solver.h). Status not_positive_definite when the factorization
+  /// meets a non-positive pivot (no abort, no output).
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
   /// set_matrix(a M + b K) for M and K on one pattern, formed straight into the cached lower
   /// triangle (bitwise the same factor; no full sum kept). Off one pattern, the default.
@@ -35,6 +37,9 @@ class CholmodSolver final : public LinearSolver {
 
   /// Number of symbolic analyses done so far (tests check that refactorization reuses it).
   int analyses() const { return analyses_; }
+  /// Number of exact pattern comparisons done so far (a call whose pattern_key vouches for the
+  /// pattern skips it; so does a call that must re-analyze anyway).
+  int pattern_comparisons() const { return pattern_comparisons_; }
   /// Number of numeric factorizations done so far.
   int factorizations() const { return factorizations_; }
   /// True if the last set_matrix produced a usable factor.
@@ -54,13 +59,13 @@ class CholmodSolver final : public LinearSolver {
 
  private:
   void free_all();
-  bool same_pattern(const SparseRef& A) const;
+  bool same_pattern(const SparseRef& A) const;  // A of the cached size and nonzeros: exact
   void build_lower(const SparseRef& A);  // new pattern: (re)build the cached lower triangle
-  /// Both set_matrix entries: analyzes A's pattern when it is new, lets `fill(x, gather, count)`
-  /// write the lower triangle's values (x[e] from the caller's entry gather[e]; false when one is
-  /// NaN/inf), then factorizes.
+  /// Both set_matrix entries: analyzes A's pattern when it is new (key: the caller's
+  /// pattern_key), lets `fill(x, gather, count)` write the lower triangle's values (x[e] from
+  /// the caller's entry gather[e]; false when one is NaN/inf), then factorizes.
   template <class Fill>
-  SolveReport factorize(const SparseRef& A, Fill fill);
+  SolveReport factorize(const SparseRef& A, std::uint64_t key, Fill fill);
   SolveReport fail(SolveStatus status, std::string message);  // records and reports a failure
 
   cholmod_common common_{};
@@ -71,13 +76,16 @@ class CholmodSolver final : public LinearSolver {
   cholmod_dense* e_ = nullptr;
   cholmod_dense* r_ = nullptr;        // residual workspace
 
-  // Previous full pattern, compared exactly (cheap next to a factorization).
-  std::vector<int> outer_, inner_;
   std::int64_t rows_ = -1;
-  // lower_->x[k] = A.valuePtr()[gather_[k]]: refreshing values is one gather, no pattern work.
-  std::vector<std::int64_t> gather_;
+  std::int64_t nonzeros_ = 0;  // of the full A the cached pattern came from
+  std::uint64_t key_ = 0;      // pattern_key of the cached pattern (0: none given)
+  // lower_->x[e] = A.valuePtr()[gather_[e]]: refreshing values is one gather, no pattern work.
+  // Together with lower_'s own pattern it is also what a new A is compared against, so no copy
+  // of A's full pattern is kept (94 MB at depth 9). Positions in an int-indexed matrix: int.
+  std::vector<int> gather_;
 
   int analyses_ = 0;
+  int pattern_comparisons_ = 0;
   int factorizations_ = 0;
   bool factor_ok_ = false;
   SolveStatus last_status_ = SolveStatus::failed;

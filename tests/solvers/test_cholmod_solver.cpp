@@ -86,6 +86,94 @@ TEST(CholmodSolver, SameSizeDifferentPatternReanalyses) {
   EXPECT_LT(relative_difference(X, Xd), 1e-8);
 }
 
+// The last set_matrix's factor solves A: against a dense solve of A for a random right-hand side.
+void expect_factor_of(CholmodSolver& s, const SparseMatrix& A) {
+  const Eigen::MatrixXd B = random_rhs(A.rows());
+  Eigen::MatrixXd X, Xd;
+  ASSERT_TRUE(s.solve(B, X).ok());
+  ASSERT_TRUE(dense_llt_solve(A, B, Xd).ok());
+  EXPECT_LT(relative_difference(X, Xd), 1e-8);
+}
+
+// Same size and number of nonzeros, another pattern: a symmetric permutation of a Laplacian.
+// The comparison must see it, and the factor must be the new matrix's.
+TEST(CholmodSolver, PermutedPatternWithTheSameNonzerosReanalyses) {
+  const SparseMatrix A1 = laplacian3d(6, 5, 4, 0.1, 21);
+  Eigen::VectorXi order(A1.rows());
+  for (Eigen::Index i = 0; i < order.size(); ++i) order[i] = int((i * 7) % order.size());  // 120 and 7 coprime
+  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm(order);
+  SparseMatrix A2;
+  A2 = A1.twistedBy(perm);
+  A2.makeCompressed();
+  ASSERT_EQ(A1.nonZeros(), A2.nonZeros());
+  ASSERT_FALSE(same_pattern(A1, A2));
+  CholmodSolver s;
+  ASSERT_TRUE(s.set_matrix(A1).ok());
+  ASSERT_TRUE(s.set_matrix(A2).ok());
+  EXPECT_EQ(s.analyses(), 2);
+  EXPECT_EQ(s.pattern_comparisons(), 1);
+  expect_factor_of(s, A2);
+}
+
+// Only the lower triangle is factorized, and it is gathered from A by position: a matrix with
+// the same lower triangle and the same number of nonzeros, whose upper triangle keeps a stored
+// zero in another column, shifts the positions of every column in between. Taking the cached
+// pattern for it would gather the wrong values.
+TEST(CholmodSolver, ShiftedPositionsAreANewPattern) {
+  const SparseMatrix L = laplacian3d(5, 5, 4, 0.2, 31);
+  const int n = int(L.rows());
+  const auto with_stored_zero = [&](int column) {
+    SparseMatrix A = L;
+    A.coeffRef(0, column) = 0.0;  // a stored zero above the diagonal: A stays symmetric in value
+    A.makeCompressed();
+    return A;
+  };
+  ASSERT_EQ(L.coeff(0, n / 2), 0.0);
+  ASSERT_EQ(L.coeff(0, n - 1), 0.0);
+  const SparseMatrix A1 = with_stored_zero(n / 2);
+  SparseMatrix A2 = with_stored_zero(n - 1);
+  // A2 with other values than A1, so a wrong gather would show in the solution.
+  for (Eigen::Index j = 0; j < n; ++j) A2.coeffRef(j, j) *= 1.5;
+  ASSERT_EQ(A1.nonZeros(), A2.nonZeros());
+  ASSERT_FALSE(same_pattern(A1, A2));
+  CholmodSolver s;
+  ASSERT_TRUE(s.set_matrix(A1).ok());
+  ASSERT_TRUE(s.set_matrix(A2).ok());
+  EXPECT_EQ(s.pattern_comparisons(), 1);
+  EXPECT_EQ(s.analyses(), 2);
+  expect_factor_of(s, A2);
+}
+
+// A pattern key (linear_solver.h) vouches for the pattern: no comparison, no new analysis. Any
+// other key, or none, is compared; a key never saves a matrix of another size from analysis.
+TEST(CholmodSolver, PatternKeyVouchesWithoutComparing) {
+  const SparseMatrix A1 = laplacian3d(8, 7, 6, 0.1, 41);
+  const SparseMatrix A2 = laplacian3d(8, 7, 6, 0.6, 42, 2.0);  // same pattern, new values
+  const std::uint64_t key = new_pattern_key(), other = new_pattern_key();
+  const auto keyed = [](std::uint64_t k) {
+    HierarchyView v;
+    v.pattern_key = k;
+    return v;
+  };
+  CholmodSolver s;
+  ASSERT_TRUE(s.set_matrix(A1, keyed(key)).ok());
+  ASSERT_TRUE(s.set_matrix(A2, keyed(key)).ok());
+  EXPECT_EQ(s.pattern_comparisons(), 0);
+  EXPECT_EQ(s.analyses(), 1);
+  EXPECT_EQ(s.factorizations(), 2);
+  expect_factor_of(s, A2);
+
+  ASSERT_TRUE(s.set_matrix(A1, keyed(other)).ok());  // another key: compared, still reused
+  ASSERT_TRUE(s.set_matrix(A2).ok());                // none: compared
+  EXPECT_EQ(s.pattern_comparisons(), 2);
+  EXPECT_EQ(s.analyses(), 1);
+
+  const SparseMatrix small = laplacian3d(4, 4, 4);
+  ASSERT_TRUE(s.set_matrix(small, keyed(key)).ok());  // the old key, another size
+  EXPECT_EQ(s.analyses(), 2);
+  expect_factor_of(s, small);
+}
+
 TEST(CholmodSolver, IndefiniteIsReportedAndRecoverable) {
   // Laplacian minus a shift: some eigenvalues negative, diagonal still positive.
   SparseMatrix A = laplacian3d(8, 8, 8);
