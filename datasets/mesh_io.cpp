@@ -206,8 +206,9 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
 
 // STL: ASCII counts 'facet' records, binary stores the triangle count at byte 80. Vertices are
 // merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance. A binary
-// file is not read here beyond its header (OpenMesh reads it next); only a file that starts with
-// "solid" is read whole, since some binary exporters start their header with it too.
+// file is not read here beyond its header (OpenMesh reads it next). A file that starts with
+// "solid" is ASCII if the word "facet" occurs in it (some binary exporters start their header
+// with "solid" too); it is streamed in chunks, never held whole.
 long long count_stl_triangles(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file");
@@ -216,16 +217,30 @@ long long count_stl_triangles(const std::string& path) {
   head.resize(static_cast<size_t>(in.gcount()));
   const auto start = head.find_first_not_of(" \t\r\n");
   if (start != std::string::npos && head.compare(start, 5, "solid") == 0) {
-    std::string data = head + std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (data.find("facet", start) != std::string::npos) {
-      long long n = 0;
-      for (size_t pos = data.find("facet"); pos != std::string::npos; pos = data.find("facet", pos + 5)) {
+    // Each chunk is searched behind the last 7 bytes of the one before ("endfacet" less one), so
+    // a keyword across a boundary is found, and counted only where it ends in the new bytes.
+    constexpr std::size_t kCarry = 7, kChunk = std::size_t(1) << 20;
+    std::string buffer = head.substr(start);
+    std::size_t carried = 0;  // bytes at the buffer's front already searched
+    long long opening = 0;
+    bool any = false;
+    std::string chunk(kChunk, '\0');
+    while (true) {
+      for (std::size_t pos = buffer.find("facet"); pos != std::string::npos; pos = buffer.find("facet", pos + 5)) {
+        if (pos + 5 <= carried) continue;  // found with the previous chunk
+        any = true;
         // "endfacet" also contains "facet": count only the opening keyword.
-        if (pos >= 3 && data.compare(pos - 3, 3, "end") == 0) continue;
-        ++n;
+        if (!(pos >= 3 && buffer.compare(pos - 3, 3, "end") == 0)) ++opening;
       }
-      return n;
+      if (!in) break;
+      in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      const auto got = static_cast<std::size_t>(in.gcount());
+      if (got == 0) break;
+      carried = std::min(kCarry, buffer.size());
+      buffer.erase(0, buffer.size() - carried);
+      buffer.append(chunk, 0, got);
     }
+    if (any) return opening;
   }
   if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
   std::uint32_t n = 0;

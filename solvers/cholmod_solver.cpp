@@ -62,7 +62,8 @@ std::int64_t CholmodSolver::factor_nonzeros() const {
 }
 
 bool CholmodSolver::same_pattern(const SparseRef& A) const {
-  // The caller has checked that A has the cached pattern's size and number of nonzeros. Exact, and exactly what the factor depends on: every lower-triangle entry of A must be the
+  // The caller has checked that A has the cached pattern's size and number of nonzeros.
+  // Exact, and exactly what the factor depends on: every lower-triangle entry of A must be the
   // cached entry at the same place of lower_ (same column, same row) and sit at the position
   // gather_ reads it from. Then the gather forms A's lower triangle, which is all CHOLMOD reads
   // (stype = -1), whatever A's upper triangle holds; a column with an entry more or fewer, or

@@ -530,6 +530,40 @@ TEST(MeshIo, RoundTripObj) { expect_round_trip("t.obj", false, 1e-15); }
 TEST(MeshIo, RoundTripStlAscii) { expect_round_trip("t.stl", false, 1e-6, false); }
 TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false); }
 
+// An ASCII STL is counted in chunks of 1 MiB read after its 84-byte head (mesh_io.cpp). The
+// count is what notices a facet OpenMesh drops without an error (here a degenerate one), so a
+// keyword missed or counted twice at a chunk boundary would hide it or blame a wrong number.
+// One file per way a keyword can meet the first boundary, moved there by blanks ("fa|cet",
+// "end|facet", "endfa|cet", and an opening "facet" that ends exactly at it, seen again behind
+// the next chunk), so that no two mistakes can cancel.
+TEST(MeshIo, AsciiStlCountedAcrossReadChunks) {
+  TempDir dir;
+  const TriangleMesh m = make_icosphere(5);
+  const std::string plain = dir.file("plain.stl");
+  write_mesh(plain, m, false);
+  std::string text = file_bytes(plain);
+  constexpr std::size_t kBoundary = 84 + (std::size_t(1) << 20);
+  ASSERT_GT(text.size(), kBoundary + 1000);
+  text.insert(text.rfind("endsolid"),
+              "facet normal 0 0 1\nouter loop\nvertex 7 7 7\nvertex 7 7 7\nvertex 8 7 7\nendloop\nendfacet\n");
+  const std::string expected = "only " + std::to_string(m.num_faces()) + " of the file's " +
+                               std::to_string(m.num_faces() + 1) + " triangles could be added";
+  // Blanks before the last `word` that fits, so that its "facet" starts at byte `facet_at`.
+  const auto place = [&](const std::string& word, std::size_t facet_at) {
+    std::string placed = text;
+    const std::size_t offset = word.find("facet"), p = placed.rfind(word, facet_at - offset);
+    ASSERT_NE(p, std::string::npos);
+    placed.insert(p, facet_at - offset - p, ' ');
+    ASSERT_EQ(placed.compare(facet_at, 5, "facet"), 0);
+    SCOPED_TRACE(word + " at " + std::to_string(facet_at));
+    expect_error_naming(dir.write("chunks.stl", placed), expected);
+  };
+  place("facet normal", kBoundary - 2);
+  place("endfacet", kBoundary);
+  place("endfacet", kBoundary - 2);
+  place("facet normal", kBoundary - 5);
+}
+
 // A binary STL is checked by its header's triangle count against the file's length; one whose
 // header starts with "solid" (as some exporters write) is still binary when it has no facet.
 TEST(MeshIo, BinaryStlHeaderAndLength) {
