@@ -154,7 +154,19 @@ SolveReport PcgSolver::build_preconditioner() {
   return rep;
 }
 
-SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarchy*/) {
+bool PcgSolver::keeps_pattern(const SparseRef& A, std::uint64_t key) {
+  // The O(1) checks stay under a key, so a caller's mistake in size is still caught.
+  const bool sized = A_.rows() == A.rows() && A_.cols() == A.cols() && A_.nonZeros() == A.nonZeros();
+  bool same = sized && key != 0 && key == key_;
+  if (sized && !same) {
+    ++pattern_comparisons_;
+    same = same_pattern(A, A_);
+  }
+  key_ = key;  // later calls with it are vouched for against this call's pattern
+  return same;
+}
+
+SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
   SolveReport rep;
   auto fail = [&](SolveStatus s, std::string m) {
     matrix_status_ = s;
@@ -168,9 +180,9 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView /*hierarc
   if (!A.isCompressed()) {
     SparseMatrix C = A;
     C.makeCompressed();
-    return set_matrix(C);
+    return set_matrix(C, hierarchy);
   }
-  if (same_pattern(A, A_)) {
+  if (keeps_pattern(A, hierarchy.pattern_key)) {
     // Same pattern (every time step of a tracked flow): refresh values only.
     std::copy(A.valuePtr(), A.valuePtr() + A.nonZeros(), A_.valuePtr());
   } else {
@@ -187,7 +199,7 @@ SolveReport PcgSolver::set_matrix_sum(double a, const SparseRef& M, double b, co
   if (!summable(M, K) || M.rows() != M.cols()) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
   have_matrix_ = false;
   // The sum straight into A_ (the copy set_matrix would make), compared as set_matrix compares.
-  if (!same_pattern(M, A_)) {
+  if (!keeps_pattern(M, hierarchy.pattern_key)) {
     A_ = M;
     ic_.reset();
   }

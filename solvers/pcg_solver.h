@@ -51,6 +51,8 @@ class PcgSolver final : public LinearSolver {
 
   /// Copies A (values only when the pattern is unchanged) and builds the preconditioner.
   /// not_positive_definite for a non-positive diagonal with Jacobi or an IC breakdown.
+  /// hierarchy.pattern_key, when it is the key of the previous call, vouches for A's pattern
+  /// (linear_solver.h): then only the size and nonzero count are checked, not every index.
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
   /// The same for a M + b K, written straight into the copy set_matrix keeps (no other copy).
   SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
@@ -58,6 +60,9 @@ class PcgSolver final : public LinearSolver {
 
   /// Y = A X with the deterministic parallel row SpMV (exposed for tests and other solvers).
   void multiply(const ConstMatrixRef& X, Eigen::MatrixXd& Y) const;
+
+  /// How many set_matrix calls compared the new pattern index by index with the kept one.
+  int pattern_comparisons() const { return pattern_comparisons_; }
 
  protected:
   /// Block PCG from the warm start X (solve(): zero if a resizable X has another shape).
@@ -68,11 +73,14 @@ class PcgSolver final : public LinearSolver {
  private:
   SolveReport build_preconditioner();
   SolveReport matrix_in_place();  ///< A_ holds the new matrix: finite check, preconditioner, status
+  bool keeps_pattern(const SparseRef& A, std::uint64_t key);  ///< A on A_'s pattern? (key or comparison)
   void apply_preconditioner(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) const;
 
   PcgOptions options_;
   Preconditioner external_;
   SparseMatrix A_;
+  std::uint64_t key_ = 0;  // pattern_key of the call that set A_'s pattern or vouched for it
+  int pattern_comparisons_ = 0;
   bool have_matrix_ = false;
   SolveStatus matrix_status_ = SolveStatus::failed;
   std::string matrix_message_ = "set_matrix not called";

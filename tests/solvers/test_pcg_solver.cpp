@@ -277,6 +277,59 @@ TEST(PcgSolver, SetMatrixSumEqualsSetMatrixOfTheSum) {
   EXPECT_LT(relative_difference(X, Xd), 1e-8);
 }
 
+// A pattern key (linear_solver.h) vouches for the pattern: no comparison, only the values are
+// copied and the incomplete Cholesky keeps its ordering. Any other key, or none, is compared: a
+// symmetric permutation with the same size and nonzero count is a new pattern. A key never
+// saves a matrix of another size from being copied whole. Every answer is the dense solve's.
+TEST(PcgSolver, PatternKeyVouchesWithoutComparing) {
+  const SparseMatrix A1 = laplacian3d(7, 6, 5, 0.1, 51);
+  const SparseMatrix A2 = laplacian3d(7, 6, 5, 0.6, 52, 2.0);  // same pattern, new values
+  Eigen::VectorXi order(A1.rows());
+  for (Eigen::Index i = 0; i < order.size(); ++i) order[i] = int((i * 11) % order.size());  // 210 and 11 coprime
+  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm(order);
+  SparseMatrix A3;
+  A3 = A2.twistedBy(perm);
+  A3.makeCompressed();
+  ASSERT_EQ(A3.nonZeros(), A1.nonZeros());
+  ASSERT_FALSE(same_pattern(A1, A3));
+  const SparseMatrix small = laplacian3d(4, 4, 4);
+  const std::uint64_t key = new_pattern_key(), other = new_pattern_key();
+  const auto keyed = [](std::uint64_t k) {
+    HierarchyView v;
+    v.pattern_key = k;
+    return v;
+  };
+  PcgSolver pcg(tight(PcgPreconditioner::incomplete_cholesky));
+  const auto expect_solves = [&](const SparseMatrix& A) {
+    const Eigen::MatrixXd B = random_rhs(A.rows());
+    Eigen::MatrixXd X, Xd;
+    ASSERT_EQ(pcg.solve(B, X).status, SolveStatus::converged);
+    ASSERT_EQ(dense_llt_solve(A, B, Xd).status, SolveStatus::converged);
+    EXPECT_LT(relative_difference(X, Xd), 1e-8);
+  };
+  ASSERT_TRUE(pcg.set_matrix(A1, keyed(key)).ok());
+  ASSERT_TRUE(pcg.set_matrix(A2, keyed(key)).ok());
+  EXPECT_EQ(pcg.pattern_comparisons(), 0);
+  expect_solves(A2);
+  ASSERT_TRUE(pcg.set_matrix_sum(1.0, A1, 0.0, A2, keyed(key)).ok());  // the sum honours it too
+  EXPECT_EQ(pcg.pattern_comparisons(), 0);
+  expect_solves(A1);
+
+  ASSERT_TRUE(pcg.set_matrix(A2, keyed(other)).ok());  // another key: compared, same pattern
+  EXPECT_EQ(pcg.pattern_comparisons(), 1);
+  expect_solves(A2);
+  ASSERT_TRUE(pcg.set_matrix(A3).ok());  // none: compared, a new pattern
+  EXPECT_EQ(pcg.pattern_comparisons(), 2);
+  expect_solves(A3);
+
+  ASSERT_TRUE(pcg.set_matrix(A1, keyed(key)).ok());  // the first key again: compared, as it
+  EXPECT_EQ(pcg.pattern_comparisons(), 3);           // vouches for A3's pattern no more
+  expect_solves(A1);
+  ASSERT_TRUE(pcg.set_matrix(small, keyed(key)).ok());  // the same key, another size
+  EXPECT_EQ(pcg.pattern_comparisons(), 3);
+  expect_solves(small);
+}
+
 TEST(PcgSolver, MultiplyMatchesEigen) {
   const SparseMatrix A = graph_laplacian(9000, 4, 0.05, 4);  // > 2 chunks of 4096 rows
   const Eigen::MatrixXd X = random_rhs(A.rows());
