@@ -1,5 +1,6 @@
 #include "solvers/multigrid.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -406,6 +407,10 @@ struct MultigridSolver::Impl {
   std::vector<Level> levels;           // coarsest first
   std::vector<std::vector<std::uint8_t>> colours;  // as given (to detect changes)
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+  // The coarsest solve when its matrix is only semi-definite (set_matrix: coarsest_pseudo_inverse):
+  // a dense generalized inverse, empty while the LDLᵀ factor serves.
+  Eigen::MatrixXd coarse_pinv;
+  int coarse_null = 0;                 // dimension of the null space it found
   Eigen::MatrixXd coarse_rhs, coarse_sol;
   int k = 0;                           // columns the buffers are sized for
   std::size_t s = 0;                   // their row stride: k rounded up to a multiple of 4
@@ -792,12 +797,67 @@ struct MultigridSolver::Impl {
       for_rows(A.cols, [&](int b, int e) { residual_rows(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e); });
   }
 
+  // Whether the LDLᵀ factor of the coarsest matrix is fit to solve with: it succeeded and no
+  // pivot is below 1e-10 of its row's diagonal entry (a dependent function leaves a pivot of
+  // rounding size, whose inverse would fill the solution with a huge null-space component).
+  bool coarsest_factor_is_sound() const {
+    if (ldlt.info() != Eigen::Success) return false;
+    const Eigen::VectorXd D = ldlt.vectorD();
+    const SparseMatrix& A = levels.front().A;
+    const auto& P = ldlt.permutationP().indices();  // (P A Pᵀ)(P[i], P[i]) = A(i, i)
+    for (Eigen::Index i = 0; i < A.rows(); ++i) {
+      const double d = D[P[i]], a = A.coeff(i, i);
+      if (!(d > 1e-10 * a) || !(a > 0)) return false;
+    }
+    return true;
+  }
+
+  // The coarsest matrix's generalized inverse, from the eigen-decomposition of its Jacobi
+  // scaling Â = S⁻¹AS⁻¹ (S² = diag A, so a function that barely meets the surface is not taken
+  // for a null direction): A⁺ = S⁻¹ V Λ⁺ Vᵀ S⁻¹, with eigenvalues below 1e-11 λ_max taken as 0.
+  // For a consistent right-hand side (the restriction of a fine residual of a consistent
+  // system) it gives the solution without a null-space component. Returns why it cannot be used
+  // (a negative eigenvalue: the matrix is indefinite; too large to decompose), else "".
+  std::string coarsest_pseudo_inverse() {
+    const SparseMatrix& A = levels.front().A;
+    const Eigen::Index n = A.rows();
+    if (n > 4096) return "coarsest-level factorization failed (" + std::to_string(n) + " functions: too many for its dense pseudo-inverse)";
+    Eigen::MatrixXd dense = Eigen::MatrixXd(A);
+    Eigen::VectorXd scale(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      // A zero diagonal entry of a semi-definite matrix has a zero row: a coarse function all of
+      // whose finer functions are held (an open surface's locked boundary); scale 0 leaves it out.
+      if (dense(i, i) == 0 && dense.row(i).isZero(0)) {
+        scale[i] = 0;
+        continue;
+      }
+      if (!(dense(i, i) > 0)) return "coarsest-level matrix is not positive definite";
+      scale[i] = 1.0 / std::sqrt(dense(i, i));
+    }
+    dense = scale.asDiagonal() * dense * scale.asDiagonal();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(dense);
+    if (eig.info() != Eigen::Success) return "coarsest-level eigen-decomposition failed";
+    const Eigen::VectorXd& lambda = eig.eigenvalues();  // ascending
+    const double top = lambda[n - 1], floor = 1e-11 * top;
+    if (!(lambda[0] >= -floor)) return "coarsest-level matrix is not positive definite (eigenvalue " + std::to_string(lambda[0] / top) + " of the largest)";
+    Eigen::VectorXd inverse(n);
+    coarse_null = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      inverse[i] = lambda[i] > floor ? 1.0 / lambda[i] : 0.0;
+      coarse_null += lambda[i] > floor ? 0 : 1;
+    }
+    const Eigen::MatrixXd W = scale.asDiagonal() * eig.eigenvectors();
+    coarse_pinv = W * inverse.asDiagonal() * W.transpose();
+    return {};
+  }
+
   void coarse_solve() {
     Level& L = levels.front();
     const int n = L.n();
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < k; ++c) coarse_rhs(i, c) = L.b[std::size_t(i) * s + std::size_t(c)];
-    coarse_sol = ldlt.solve(coarse_rhs);
+    if (coarse_pinv.size() > 0) coarse_sol.noalias() = coarse_pinv * coarse_rhs;
+    else coarse_sol = ldlt.solve(coarse_rhs);
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < k; ++c) L.x[std::size_t(i) * s + std::size_t(c)] = coarse_sol(i, c);
   }
@@ -1004,11 +1064,18 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double 
   if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);
   m.ldlt.factorize(m.levels.front().A);
   if (!diag_ok) return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
-  if (m.ldlt.info() != Eigen::Success)
-    return fail(SolveStatus::not_positive_definite, "coarsest-level factorization failed");
-  const Eigen::VectorXd D = m.ldlt.vectorD();
-  if (D.size() > 0 && !(D.minCoeff() > 0.0))
-    return fail(SolveStatus::not_positive_definite, "coarsest-level matrix is not positive definite");
+  m.coarse_pinv.resize(0, 0);
+  m.coarse_null = 0;
+  if (!m.coarsest_factor_is_sound()) {
+    // The octree's functions on a flat face parallel to a grid plane (the cubical spiral, a
+    // box) are linearly dependent on the surface: A is then only semi-definite, on every level.
+    // Gauss–Seidel relaxes such a consistent system as it does a definite one (the paper's
+    // solver never factors the fine matrix); the coarsest level needs a generalized inverse.
+    const std::string why = m.coarsest_pseudo_inverse();
+    if (!why.empty()) return fail(SolveStatus::not_positive_definite, why);
+    rep.message = "coarsest level semi-definite (null space of dimension " + std::to_string(m.coarse_null) +
+                  "): solved by its pseudo-inverse";
+  }
   for (std::size_t l = 1; l < m.levels.size(); ++l)
     if (!m.levels[l].coloured)
       rep.message += (rep.message.empty() ? "" : "; ") + std::string("level ") + std::to_string(l) +

@@ -457,6 +457,59 @@ TEST(Multigrid, WCycleConvergesToDirectSolution) { expect_converges_to_direct(Mu
 TEST(Multigrid, VCycleConvergesOnShell) { expect_converges_to_direct(MultigridCycle::V, Drop::shell); }
 TEST(Multigrid, WCycleConvergesOnShell) { expect_converges_to_direct(MultigridCycle::W, Drop::shell); }
 
+// A semi-definite coarsest level (the octree functions on a face parallel to a grid plane are
+// dependent, and a coarse function whose finer functions are all held has a zero row): the
+// LDLᵀ factor has a pivot of rounding size, so the coarsest solve uses a generalized inverse,
+// which solves every consistent right-hand side. One level makes the coarsest level the only one.
+// Here function j := r times function i for pairs of x-neighbours (Wᵀ A W), and one function is
+// dropped (zero row and column); an indefinite matrix is still refused.
+TEST(Multigrid, SemiDefiniteCoarsestLevelIsSolvedByItsPseudoInverse) {
+  const Problem pr = make_problem(3, 3, 0.05);
+  const int n = int(pr.A.rows()), N = 8;
+  Triplets w;
+  std::vector<char> merged(std::size_t(n), 0);
+  int pairs = 0;
+  for (int k = 0; k <= N; k += 3)
+    for (int j = 0; j <= N; j += 2)
+      for (int i = 0; i + 1 <= N; i += 4) {
+        merged[std::size_t(vid(N, i + 1, j, k))] = 1;
+        w.emplace_back(vid(N, i, j, k), vid(N, i + 1, j, k), 0.75);  // column i+1 = 0.75 e_i
+        ++pairs;
+      }
+  const int dropped = vid(N, 5, 5, 5);
+  for (int c = 0; c < n; ++c)
+    if (!merged[std::size_t(c)] && c != dropped) w.emplace_back(c, c, 1.0);
+  SparseMatrix W(n, n);
+  W.setFromTriplets(w.begin(), w.end());
+  SparseMatrix A = SparseMatrix(W.transpose()) * pr.A * W;
+  A.prune(0.0);
+  A.makeCompressed();
+  ASSERT_EQ(A.coeff(dropped, dropped), 0.0);
+  const Eigen::MatrixXd B = W.transpose() * random_matrix(n, 3, 5);  // consistent: in A's range
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
+  ASSERT_TRUE(ldlt.info() != Eigen::Success || ldlt.vectorD().cwiseAbs().minCoeff() < 1e-12 * ldlt.vectorD().maxCoeff())
+      << "the test matrix must be singular";
+
+  MultigridSolver mg;
+  const std::vector<SparseMatrix> none;
+  const mcf::SolveReport set = mg.set_matrix(A, HierarchyView{&none, nullptr});
+  ASSERT_TRUE(set.ok()) << set.message;
+  EXPECT_NE(set.message.find("null space of dimension " + std::to_string(pairs + 1)), std::string::npos) << set.message;
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n, 3);
+  ASSERT_TRUE(mg.solve(B, X).ok());
+  EXPECT_LT(((A * X - B).colwise().norm().array() / B.colwise().norm().array()).maxCoeff(), 1e-11);
+  EXPECT_EQ(X.row(dropped).norm(), 0.0);  // no component along a zero row's null direction
+
+  // Indefinite: one negative eigenvalue, no generalized inverse makes it a flow's system.
+  // Positive diagonal, a 2 x 2 principal minor < 0.
+  SparseMatrix indefinite = A;
+  const int a = vid(N, 2, 0, 0), b = vid(N, 3, 0, 0);
+  indefinite.coeffRef(a, b) = indefinite.coeffRef(b, a) = 3 * std::sqrt(A.coeff(a, a) * A.coeff(b, b));
+  const mcf::SolveReport refused = mg.set_matrix(indefinite, HierarchyView{&none, nullptr});
+  EXPECT_EQ(refused.status, SolveStatus::not_positive_definite);
+  EXPECT_NE(refused.message.find("eigenvalue"), std::string::npos) << refused.message;
+}
+
 TEST(Multigrid, OneWCycleReducesResidualTenfold) {
   for (Drop drop : {Drop::none, Drop::shell}) {
     for (double dt : {1e-3, 0.05, 1.0}) {
