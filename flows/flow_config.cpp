@@ -83,6 +83,10 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
     throw ConfigError(source + ": " + key + ": " + what);
   };
   const bool rebuilt = c.basis == "octree" && c.octree.tracking == "rebuilt";
+  // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
+  if (c.basis != "hat" && c.mass != "consistent")
+    fail("mass", "\"" + c.mass + "\" applies to the hat basis only; the octree basis integrates its "
+                 "consistent mass matrix by cubature");
   if (c.basis == "hat" && (c.solver.name == "multigrid" || c.solver.preconditioner == "multigrid") &&
       (c.solver.name != "pcg" || c.solver.preconditioner == "multigrid"))
     fail("solver", "multigrid needs a hierarchy: use basis \"octree\" (the hat basis has none)");

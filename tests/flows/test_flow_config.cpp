@@ -43,6 +43,11 @@ TEST(FlowConfig, ErrorsNameFileAndKey) {
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"octree", {{"tracking", "rebuilt"}}}, {"flow", "cmcf"}})
                 .find("flow"),
             std::string::npos);
+  // A lumped mass the octree basis would ignore while the result recorded it.
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"mass", "lumped"}})
+                .find("cfg.json: mass: \"lumped\" applies to the hat basis only"),
+            std::string::npos);
+  EXPECT_NO_THROW(flow_config_from_json(json{{"mesh", "a"}, {"basis", "hat"}, {"mass", "lumped"}}, "cfg.json"));
 }
 
 }  // namespace
