@@ -209,6 +209,9 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
       } catch (const std::exception& ex) {
         throw ConfigError(e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + "): mesh: " + ex.what());
       }
+      // Before any cell runs: a cell that cannot run on its mesh stops the whole plan.
+      validate_flow_mesh(c.flow, meshes.get(c.flow.mesh).report,
+                         e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + ")");
       p.key = cell_key(p.cell.config, c.repetition, p.mesh_fingerprint);
       p.config_key = cell_key(p.cell.config, -1, p.mesh_fingerprint);
       p.hash = cell_hash(p.key, version);

@@ -140,6 +140,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
   const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
   tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
 
+  validate_flow_mesh(config, source.report, source.spec);
   FlowOutcome out;
   nlohmann::json& result = out.result;
   result["schema"] = 1;

@@ -101,4 +101,15 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
                        "changes its functions every step");
 }
 
+void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::string& source) {
+  // An open surface's boundary is held where it is (DESIGN.md "Open surfaces"; the cMCF paper
+  // flows an open surface with its boundary fixed), while unit-area normalisation rescales and
+  // recentres the whole surface every step: the held boundary would move with it (a loop grew by
+  // 24% in 8 steps of cMCF on the mannequin). The two contradict each other, so refuse.
+  if (c.normalize_area && mesh.boundary_loops > 0)
+    throw ConfigError(source + ": normalize_area: the mesh has " + std::to_string(mesh.boundary_loops) +
+                      " boundary loop(s), held fixed through the flow, which rescaling to unit area every "
+                      "step would move; run an open surface without normalize_area");
+}
+
 }  // namespace mcf

@@ -2,6 +2,8 @@
 // Every option of one flow run. The same JSON object is a cell of the experiment matrix and the
 // "config" of result.json (with all defaults filled in), so the names below are stable.
 
+#include "datasets/validate.h"
+
 #include <nlohmann/json.hpp>
 
 #include <string>
@@ -49,5 +51,8 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
 nlohmann::json to_json(const FlowConfig& c);
 /// Cross-option checks (e.g. multigrid needs the octree, cMCF needs a fixed basis).
 void validate_flow_config(const FlowConfig& c, const std::string& source);
+/// Checks of the config against its mesh (unit-area normalisation needs a closed surface).
+/// Throws ConfigError naming `source` and the key.
+void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::string& source);
 
 }  // namespace mcf

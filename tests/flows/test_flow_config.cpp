@@ -1,5 +1,7 @@
 #include "flows/config_reader.h"
+#include "flows/flow.h"
 #include "flows/flow_config.h"
+#include "datasets/mesh_spec.h"
 
 #include <gtest/gtest.h>
 
@@ -48,6 +50,24 @@ TEST(FlowConfig, ErrorsNameFileAndKey) {
                 .find("cfg.json: mass: \"lumped\" applies to the hat basis only"),
             std::string::npos);
   EXPECT_NO_THROW(flow_config_from_json(json{{"mesh", "a"}, {"basis", "hat"}, {"mass", "lumped"}}, "cfg.json"));
+}
+
+// Unit-area normalisation rescales the whole surface every step, an open surface's boundary is
+// held fixed: refused before the flow starts, naming the key, for any open mesh.
+TEST(FlowConfig, NormalizeAreaIsRefusedOnAnOpenSurface) {
+  FlowConfig c = flow_config_from_json(json{{"mesh", "open_cylinder"}, {"normalize_area", true}, {"steps", 1}}, "cfg.json");
+  const MeshSource open = load_mesh_spec("open_cylinder:n_around=16,n_along=8");
+  ASSERT_EQ(open.report.boundary_loops, 2);
+  try {
+    run_flow(c, open);
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("normalize_area: the mesh has 2 boundary loop(s)"), std::string::npos) << e.what();
+  }
+  c.mesh = "icosphere:level=2";
+  EXPECT_EQ(run_flow(c, load_mesh_spec(c.mesh)).result["status"], "ok");  // closed: normalised as before
+  c.normalize_area = false;
+  EXPECT_EQ(run_flow(c, open).result["status"], "ok");
 }
 
 }  // namespace
