@@ -47,6 +47,8 @@ nlohmann::json environment_json(int threads) {
           // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the
           // config asked for (that request is in "config.threads").
           {"threads", threads > 0 ? std::min(threads, tbb::info::default_concurrency()) : tbb::info::default_concurrency()},
+          // The flow caps OpenBLAS (under CHOLMOD) at the same count (solvers/blas_threads.h).
+          {"blas_threads", threads > 0 ? std::min(threads, tbb::info::default_concurrency()) : tbb::info::default_concurrency()},
           {"hostname", hostname()},
           {"build", {{"type", MCFBENCH_BUILD_TYPE}, {"compiler", MCFBENCH_CXX_COMPILER}}},
           {"libraries",

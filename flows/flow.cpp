@@ -8,6 +8,7 @@
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
 #include "flows/sphere_reference.h"
+#include "solvers/blas_threads.h"
 #include "solvers/symmetric_multiply.h"
 
 #include <tbb/global_control.h>
@@ -139,6 +140,8 @@ Normalization unit_area_normalization(const Positions& V, const Triangles& F) {
 FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const FlowObserver& observer) {
   const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
   tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+  // CHOLMOD's BLAS has its own pool: capped alike, at what TBB can run (environment.blas_threads).
+  const ScopedBlasThreads blas(std::min(threads, tbb::info::default_concurrency()));
 
   validate_flow_mesh(config, source.report, source.spec);
   FlowOutcome out;

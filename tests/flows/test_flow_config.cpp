@@ -2,6 +2,7 @@
 #include "flows/flow.h"
 #include "flows/flow_config.h"
 #include "datasets/mesh_spec.h"
+#include "solvers/blas_threads.h"
 
 #include <gtest/gtest.h>
 
@@ -68,6 +69,23 @@ TEST(FlowConfig, NormalizeAreaIsRefusedOnAnOpenSurface) {
   EXPECT_EQ(run_flow(c, load_mesh_spec(c.mesh)).result["status"], "ok");  // closed: normalised as before
   c.normalize_area = false;
   EXPECT_EQ(run_flow(c, open).result["status"], "ok");
+}
+
+// `threads` caps CHOLMOD's BLAS as well as TBB while the flow runs, and the cap is restored
+// after (OpenBLAS sizes its own pool to every core otherwise: `--threads 1` ran on all of them).
+TEST(FlowConfig, ThreadsCapTheBlasUnderCholmodForTheFlow) {
+  const int before = blas_threads();
+  FlowConfig c = flow_config_from_json(json{{"mesh", "icosphere:level=2"}, {"steps", 2}, {"threads", 1}}, "cfg.json");
+  std::vector<int> seen;
+  FlowObserver observer;
+  observer.on_step = [&](int, double, const Positions&) { seen.push_back(blas_threads()); };
+  ASSERT_EQ(run_flow(c, load_mesh_spec(c.mesh), observer).result["status"], "ok");
+  EXPECT_EQ(seen, std::vector<int>(3, 1));
+  EXPECT_EQ(blas_threads(), before);
+  {
+    const ScopedBlasThreads none(0);  // 0: leave the cap alone
+    EXPECT_EQ(blas_threads(), before);
+  }
 }
 
 }  // namespace

@@ -1,0 +1,19 @@
+#include "solvers/blas_threads.h"
+
+// OpenBLAS's own entry points (cblas.h declares them too, but pulls in the whole CBLAS API).
+extern "C" {
+void openblas_set_num_threads(int num_threads);
+int openblas_get_num_threads(void);
+}
+
+namespace mcf {
+
+ScopedBlasThreads::ScopedBlasThreads(int threads) : previous_(openblas_get_num_threads()) {
+  if (threads > 0) openblas_set_num_threads(threads);
+}
+
+ScopedBlasThreads::~ScopedBlasThreads() { openblas_set_num_threads(previous_); }
+
+int blas_threads() { return openblas_get_num_threads(); }
+
+}  // namespace mcf
