@@ -8,6 +8,7 @@
 #include "flows/config_reader.h"
 #include "flows/flow.h"
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -222,6 +223,36 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
   return plans;
 }
 
+nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans, int shard_index, int shard_count) {
+  json cells = json::array();
+  for (const CellPlan& p : plans) {
+    json c = {{"index", p.cell.index}, {"repetition", p.cell.repetition}, {"assignment", p.cell.assignment}};
+    if (!p.hash.empty()) c["hash"] = p.hash;
+    cells.push_back(std::move(c));
+  }
+  return {{"schema", 1},
+          {"plan", "mcfbench run"},
+          {"study", e.name},
+          {"quick", e.quick},
+          {"commit", code_version()},
+          {"source", e.source},
+          {"shard", std::to_string(shard_index) + "/" + std::to_string(shard_count)},
+          {"cells_total", plans.size()},
+          {"cells", std::move(cells)},
+          {"study_config", e.study_config}};
+}
+
+std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index, int shard_count) {
+  auto safe = [](std::string s) {
+    for (char& ch : s)
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-') ch = '_';
+    return s;
+  };
+  std::string name = safe(e.name) + (e.quick ? "-quick" : "") + "@" + safe(code_version());
+  if (shard_count > 1) name += ".shard-" + std::to_string(shard_index) + "-of-" + std::to_string(shard_count);
+  return (fs::path(out_dir) / kPlanFolder / (name + ".json")).string();
+}
+
 const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans, const CellPlan& cell) {
   const json& ref = e.metrics.reference;
   if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
@@ -268,6 +299,10 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   for (const auto& p : plans) s.in_shard += in_shard(p.cell.index, o.shard_index, o.shard_count);
   const fs::path out(o.out_dir);
   fs::create_directories(out);
+  // Before the first cell: a run killed at any point leaves the list of cells it owed, which
+  // `collect` checks the results against (without it an empty folder looked complete).
+  write_file_atomic(run_plan_path(o.out_dir, e, o.shard_index, o.shard_count),
+                    run_plan(e, plans, o.shard_index, o.shard_count).dump(1) + "\n");
   std::set<std::string> ran_now;
   int done = 0;
   for (const CellPlan& p : plans) {

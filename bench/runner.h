@@ -77,6 +77,16 @@ void parse_shard(const std::string& text, int& shard_index, int& shard_count);
 std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& out_dir, MeshCache& meshes,
                                  int threads = -1, const std::function<bool(const Cell&)>& wanted = {});
 
+/// The plan `run` writes into OUT before its first cell: the whole matrix it expanded (index,
+/// repetition, assignment of every cell; the hash of the cells it named), the study config, the
+/// commit and the shard, so `collect` knows which cells to expect even when a run was killed
+/// before finishing any. One file per study variant, commit and shard (one writer each):
+/// OUT/plans/<study>[-quick]@<commit>[.shard-<i>-of-<n>].json. Not a `*.json` file of OUT
+/// itself, so nothing that reads cell results sees it.
+nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans, int shard_index, int shard_count);
+std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index, int shard_count);
+inline constexpr const char* kPlanFolder = "plans";
+
 /// Runs the shard. Config problems (including metrics whose hooks this build lacks) throw
 /// before anything is written; an exception inside one cell's flow becomes that cell's
 /// result {"status": "error", "error": ...} and the run goes on.

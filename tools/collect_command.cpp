@@ -1,7 +1,10 @@
 // `mcfbench collect DIR...`: merge result folders (e.g. the shards of a Slurm array) into one
-// index file and check them against the matrix stored in the results: every cell present once.
+// index file and check them against the matrix `run` planned (DIR/plans/, written before its
+// first cell) or, for folders without a plan, the matrix stored in the results: every cell
+// present once. A folder holding neither results nor a plan is an error, not an empty success.
 
 #include "bench/experiment_config.h"
+#include "bench/runner.h"
 #include "datasets/atomic_file.h"
 #include "flows/config_reader.h"
 #include "tools/commands.h"
@@ -35,7 +38,22 @@ struct Group {  // results of one study variant at one commit
   std::map<int, std::vector<std::string>> files_by_index;
   std::vector<int> without_distance;  ///< candidates; reference cells themselves are filtered below
   std::vector<int> errored;           ///< cells whose result is {"status": "error"}
+  std::map<int, json> planned;        ///< index -> {repetition, assignment[, hash]} from `run`'s plans
+  std::vector<std::string> plans;     ///< the plan files read
 };
+
+std::string group_name(const std::string& study, bool quick, const std::string& commit) {
+  return study + (quick ? "-quick" : "") + "@" + commit;
+}
+
+/// "#3 {"dt":0.001} rep 1 (ab12cd34ef56.json)": a cell named as a user can find it.
+std::string describe_cell(int index, const json& c) {
+  std::string s = "#" + std::to_string(index);
+  if (c.contains("assignment") && !c["assignment"].empty()) s += " " + c["assignment"].dump();
+  if (c.value("repetition", 0) != 0) s += " rep " + std::to_string(c.value("repetition", 0));
+  if (c.contains("hash")) s += " (" + c["hash"].get<std::string>() + ".json)";
+  return s;
+}
 
 }  // namespace
 
@@ -49,9 +67,44 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
       json files = json::array();
       std::map<std::string, Group> groups;
       std::set<std::string> seen_hash;
-      json duplicates = json::array(), unreadable = json::array();
+      json duplicates = json::array(), unreadable = json::array(), empty_dirs = json::array();
       for (const auto& dir : a->dirs) {
         if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder");
+        size_t found = 0;  // cell results, unreadable files and plans in this folder
+        // The plans `run` wrote before its first cell: the cells owed even if none finished.
+        std::vector<fs::path> plan_paths;
+        if (fs::is_directory(fs::path(dir) / kPlanFolder))
+          for (const auto& entry : fs::directory_iterator(fs::path(dir) / kPlanFolder))
+            if (entry.is_regular_file() && entry.path().extension() == ".json") plan_paths.push_back(entry.path());
+        std::sort(plan_paths.begin(), plan_paths.end());
+        for (const auto& path : plan_paths) {
+          json p;
+          try {
+            std::ifstream in(path);
+            p = json::parse(in);
+          } catch (const json::parse_error& e) {
+            unreadable.push_back({{"file", path.string()}, {"error", e.what()}});
+            std::printf("%s: unreadable (%s); rerun `mcfbench run` to rewrite it\n", path.c_str(), e.what());
+            ++found;
+            continue;
+          }
+          if (!p.is_object() || !p.contains("cells") || !p["cells"].is_array()) continue;
+          ++found;
+          const bool quick = p.value("quick", false);
+          Group& g = groups[group_name(p.value("study", ""), quick, p.value("commit", "unknown"))];
+          g.study = p.value("study", "");
+          g.commit = p.value("commit", "unknown");
+          g.quick = quick;
+          if (g.study_config.is_null() && p.contains("study_config")) {
+            g.study_config = p["study_config"];
+            g.source = path.string() + " (study_config)";
+          }
+          g.plans.push_back(path.string());
+          for (const json& c : p["cells"]) {
+            json& known = g.planned[c.value("index", -1)];
+            if (known.is_null() || (!known.contains("hash") && c.contains("hash"))) known = c;
+          }
+        }
         std::vector<fs::path> paths;
         for (const auto& entry : fs::directory_iterator(dir))
           if (entry.is_regular_file() && entry.path().extension() == ".json" && entry.path().filename() != "index.json")
@@ -67,9 +120,11 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
             // `mcfbench run` replaces such a file on its next pass.
             unreadable.push_back({{"file", path.string()}, {"error", e.what()}});
             std::printf("%s: unreadable (%s); rerun `mcfbench run` to redo its cell\n", path.c_str(), e.what());
+            ++found;
             continue;
           }
           if (!r.is_object() || !r.contains("cell")) continue;
+          ++found;
           const json& c = r["cell"];
           const std::string commit = r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
           const std::string hash = c.value("hash", path.stem().string());
@@ -83,7 +138,7 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           files.push_back(entry);
           // The same hash in two folders is the same cell computed twice (overlapping shards).
           if (!seen_hash.insert(hash).second) duplicates.push_back({{"hash", hash}, {"file", path.string()}});
-          Group& g = groups[entry["study"].get<std::string>() + (entry["quick"].get<bool>() ? "-quick" : "") + "@" + commit];
+          Group& g = groups[group_name(entry["study"], entry["quick"], commit)];
           if (g.study_config.is_null() && r.contains("study_config")) {
             g.study_config = r["study_config"];
             g.source = path.string() + " (study_config)";
@@ -100,9 +155,16 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
               !r.contains("reference_cell") && r.value("status", "") != "error")
             g.without_distance.push_back(c.value("index", -1));
         }
+        if (found == 0) {
+          // A mistyped shard folder, or a run killed before it planned anything: nothing here
+          // says which cells were meant, so nothing here can vouch that they are all there.
+          empty_dirs.push_back(dir);
+          std::printf("%s: no cell results and no run plan (%s/): not a folder `mcfbench run` wrote into\n",
+                      dir.c_str(), kPlanFolder);
+        }
       }
       json studies = json::array();
-      bool problems = !duplicates.empty() || !unreadable.empty();
+      bool problems = !duplicates.empty() || !unreadable.empty() || !empty_dirs.empty();
       for (auto& [name, g] : groups) {
         json s = {{"study", g.study}, {"quick", g.quick}, {"commit", g.commit}, {"cells_found", g.files_by_index.size()}};
         json missing = json::array(), dup = json::array();
@@ -119,10 +181,16 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
             std::printf("%s: cannot re-expand the stored matrix: %s\n", name.c_str(), err.what());
           }
         }
-        if (e) {
-          s["cells_expected"] = e->cells.size();
-          for (const Cell& c : e->cells)
-            if (!g.files_by_index.count(c.index)) missing.push_back(c.index);
+        // The cells owed: those `run` planned; for results without a plan (an older binary),
+        // the re-expanded matrix.
+        std::map<int, json> expected = g.planned;
+        if (expected.empty() && e)
+          for (const Cell& c : e->cells) expected[c.index] = {{"repetition", c.repetition}, {"assignment", c.assignment}};
+        if (!g.plans.empty()) s["plans"] = g.plans;
+        if (!g.planned.empty() || e) {
+          s["cells_expected"] = expected.size();
+          for (const auto& [index, c] : expected)
+            if (!g.files_by_index.count(index)) missing.push_back(index);
         }
         if (e && !g.without_distance.empty()) {
           json lacking = json::array();
@@ -143,16 +211,23 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         std::printf("%s: %zu cells found%s, %zu missing, %zu duplicated, %zu errored\n", name.c_str(), g.files_by_index.size(),
                     s.contains("cells_expected") ? (" of " + std::to_string(s["cells_expected"].get<size_t>())).c_str() : "",
                     missing.size(), dup.size(), g.errored.size());
-        if (!missing.empty()) std::printf("  missing cell indices: %s\n", missing.dump().c_str());
+        if (!missing.empty()) {
+          constexpr size_t shown = 5;
+          std::string list;
+          for (size_t i = 0; i < std::min(shown, missing.size()); ++i)
+            list += (i ? ", " : "") + describe_cell(missing[i].get<int>(), expected[missing[i].get<int>()]);
+          if (missing.size() > shown) list += ", ... and " + std::to_string(missing.size() - shown) + " more";
+          std::printf("  missing cells (%zu): %s (rerun `mcfbench run` to compute them)\n", missing.size(), list.c_str());
+        }
         if (!g.errored.empty())
           std::printf("  errored cell indices: %s (rerun `mcfbench run` to retry them)\n", json(g.errored).dump().c_str());
         studies.push_back(s);
       }
       const std::string out = !a->out.empty() ? a->out : (fs::path(a->dirs.front()) / "index.json").string();
       write_file_atomic(out, json{{"schema", 1}, {"dirs", a->dirs}, {"studies", studies}, {"duplicates", duplicates},
-                                   {"unreadable", unreadable}, {"files", files}}.dump(1) + "\n");
+                                   {"unreadable", unreadable}, {"empty_dirs", empty_dirs}, {"files", files}}.dump(1) + "\n");
       std::printf("wrote %s (%zu result files)%s\n", out.c_str(), files.size(),
-                  problems ? "; INCOMPLETE (missing, errored or unreadable) or DUPLICATED cells" : "");
+                  problems ? "; INCOMPLETE (missing, errored or unreadable cells, or a folder with nothing to collect) or DUPLICATED cells" : "");
       return problems ? 1 : 0;
     };
   });

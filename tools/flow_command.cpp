@@ -1,4 +1,7 @@
 // `mcfbench flow`: one flow, written to OUT/result.json and OUT/final.ply (+ frames).
+// Frames and final.ply are staged in OUT/.mcfbench-staging while the flow runs and moved into OUT
+// only once it has finished, result.json last: an interrupted or failed run into an existing OUT
+// leaves the previous run's files as they were, never its result beside the new run's frames.
 
 #include "bench/environment.h"
 #include "datasets/atomic_file.h"
@@ -19,6 +22,16 @@
 
 namespace mcf {
 namespace {
+
+/// Hidden (reports' globs and `collect` skip it), and removed by the next flow into OUT when a
+/// killed run left it.
+constexpr const char* kStagingFolder = ".mcfbench-staging";
+
+bool is_frame_file(const std::filesystem::path& p) {
+  const std::string stem = p.stem().string();
+  return p.extension() == ".ply" && stem.rfind("frame_", 0) == 0 && stem.size() > 6 &&
+         stem.find_first_not_of("0123456789", 6) == std::string::npos;
+}
 
 struct FlowArgs {
   std::string config_file, out;
@@ -119,8 +132,11 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       const fs::path out(args->out);
       // A folder this run creates is removed again if the flow throws (a set-up error such as
       // `--cube unit` on a mesh outside the unit cube): no empty folder or partial frames left.
+      // In a folder that exists, only the staging folder is this run's until the flow is done.
       const bool created = !fs::exists(out);
-      fs::create_directories(out);
+      const fs::path staging = out / kStagingFolder;
+      fs::remove_all(staging);  // a killed run's
+      fs::create_directories(staging);
       std::set<std::string> frames;
       FlowOutcome outcome;
       const double steal_before = cpu_steal_seconds();
@@ -132,30 +148,34 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
           if (config.save_every > 0 && step % config.save_every == 0) {
             char name[32];
             std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-            write_mesh((out / name).string(), TriangleMesh{V, mesh.mesh.faces}, true, FaceCheck::trusted);
+            write_mesh((staging / name).string(), TriangleMesh{V, mesh.mesh.faces}, true, FaceCheck::trusted);
             frames.insert(name);
           }
         };
         outcome = run_flow(config, mesh, observer);
         progress.finish();
       } catch (...) {
-        if (created) fs::remove_all(out);
+        std::error_code ec;
+        fs::remove_all(created ? out : staging, ec);
         throw;
       }
       outcome.result["environment"] = environment_json(config.threads);
       outcome.result["peak_memory_bytes"] = peak_memory_bytes();
       if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
         outcome.result["steal_seconds"] = steal;
-      write_mesh((out / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
+      write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
+      // Publish. The earlier run's result goes first, so from here until the new one is in place
+      // OUT holds no result at all rather than one beside frames that are not its own; then the
+      // earlier run's frames that this run does not replace, then this run's files move in
+      // (rename: each appears whole), and result.json comes last, atomically.
+      fs::remove(out / "result.json");
+      for (const auto& entry : fs::directory_iterator(out))
+        if (entry.is_regular_file() && is_frame_file(entry.path()) && !frames.count(entry.path().filename().string()))
+          fs::remove(entry.path());
+      for (const std::string& name : frames) fs::rename(staging / name, out / name);
+      fs::rename(staging / "final.ply", out / "final.ply");
       write_file_atomic((out / "result.json").string(), outcome.result.dump(1) + "\n");
-      // Frames of an earlier run into the same folder would sit beside this run's result as if
-      // they were its own: once the new result is in place, they go.
-      for (const auto& entry : fs::directory_iterator(out)) {
-        const std::string stem = entry.path().stem().string(), name = entry.path().filename().string();
-        const bool frame = entry.path().extension() == ".ply" && stem.rfind("frame_", 0) == 0 && stem.size() > 6 &&
-                           stem.find_first_not_of("0123456789", 6) == std::string::npos;
-        if (frame && !frames.count(name)) fs::remove(entry.path());
-      }
+      fs::remove_all(staging);
       const auto& stop = outcome.result["stop"];
       std::fprintf(stderr, "mcfbench flow: %s after %d steps (%s); wrote %s\n",
                    outcome.result["status"].get<std::string>().c_str(), stop["step"].get<int>(),

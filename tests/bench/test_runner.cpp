@@ -1,6 +1,6 @@
 // The runner in-process (per-step metric hooks, frames, reference distances, a failing cell)
 // and end to end through the binary (resume after a deleted file, after SIGKILL, shards +
-// collect, config errors that write nothing).
+// collect, collect on a run that finished nothing, config errors that write nothing).
 
 #include "bench/environment.h"
 #include "bench/metric_hooks.h"
@@ -332,6 +332,72 @@ TEST(RunnerCli, KilledRunLosesNoFinishedCellAndRepeatsNone) {
       << c.out;
   EXPECT_EQ(result_files(dir / "out").size(), 6u);
   for (const auto& [name, t] : before) EXPECT_EQ(fs::last_write_time(dir / "out" / name), t) << name << " recomputed";
+}
+
+TEST(RunnerCli, CollectFailsOnARunThatFinishedNothingAndOnAFolderWithNothingToCollect) {
+  // `collect` used to find problems only among the result files it found: with none (a run killed
+  // before its first cell, an empty or mistyped shard folder) it wrote an index and exited 0.
+  const fs::path dir = fresh_dir("collect_nothing");
+  write_text(dir / "tiny.json", tiny_config);
+  ASSERT_EQ(mcfbench("run tiny.json --out out", dir).status, 0);
+  Command c = mcfbench("collect out", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("3 cells found of 3, 0 missing"), std::string::npos) << c.out;
+  // No result left, as after a kill before the first cell finished: every planned cell is owed.
+  for (const auto& f : result_files(dir / "out")) fs::remove(f);
+  c = mcfbench("collect out", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("0 cells found of 3, 3 missing"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("missing cells (3): #0 {\"dt\":0.001} ("), std::string::npos) << c.out;
+  EXPECT_EQ(read_json(dir / "out" / "index.json")["studies"][0]["missing"], json::array({0, 1, 2}));
+  // A folder with neither results nor a plan, alone or beside a complete one.
+  fs::create_directories(dir / "empty");
+  c = mcfbench("collect empty", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("empty: no cell results and no run plan"), std::string::npos) << c.out;
+  EXPECT_EQ(read_json(dir / "empty" / "index.json")["empty_dirs"], json::array({"empty"}));
+  ASSERT_EQ(mcfbench("run tiny.json --out full", dir).status, 0);
+  c = mcfbench("collect full empty --out both.json", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  c = mcfbench("collect full emtpy --out typo.json", dir);  // a folder that does not exist
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.err.find("emtpy: not a folder"), std::string::npos) << c.err;
+}
+
+TEST(RunnerCli, CollectAfterAKillBeforeAnyCellFinishedNamesTheMissingCells) {
+  const fs::path dir = fresh_dir("collect_killed");
+  write_text(dir / "slow.json", R"({
+    "name": "slow",
+    "defaults": {"mesh": "icosphere:level=4", "steps": 40, "dt": 1e-4, "threads": 1},
+    "axes": {"dt": [1e-4, 2e-4, 3e-4, 4e-4, 5e-4, 6e-4, 7e-4]}})");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) _exit(127);
+    std::freopen("/dev/null", "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", "slow.json", "--out", "out", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Kill it as soon as it has planned (before its first cell can finish, on any machine but a
+  // very fast one).
+  auto planned = [&] { return fs::is_directory(dir / "out" / "plans") && !fs::is_empty(dir / "out" / "plans"); };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!planned() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(planned());
+  const size_t finished = result_files(dir / "out").size();
+  if (finished == 7u) GTEST_SKIP() << "the run finished before it could be killed";
+  const Command c = mcfbench("collect out", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  const std::string missing = std::to_string(7 - finished);
+  EXPECT_NE(c.out.find(std::to_string(finished) + " cells found of 7, " + missing + " missing"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("missing cells (" + missing + "): #" + std::to_string(finished) + " {\"dt\":"), std::string::npos) << c.out;
+  if (7 - finished > 5) {  // the first five are named, the rest counted
+    EXPECT_NE(c.out.find("... and " + std::to_string(7 - finished - 5) + " more"), std::string::npos) << c.out;
+  }
 }
 
 TEST(RunnerCli, ShardsThenCollect) {

@@ -1,14 +1,21 @@
 // The mcfbench executable end to end: bad input exits non-zero with a message naming the file
-// (or key) and writes nothing; a good run writes result.json with the contract's keys.
+// (or key) and writes nothing; a good run writes result.json with the contract's keys; a flow
+// interrupted or failing in a folder that holds an earlier run leaves that run's files as they were.
 
 #include <nlohmann/json.hpp>
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <map>
 #include <sstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
 
 namespace {
 
@@ -120,6 +127,78 @@ TEST(Cli, ARerunIntoTheSameFolderLeavesNoStaleFrames) {
   ASSERT_EQ(mcfbench("flow --mesh icosphere:level=1 --steps 2 --save-every 1 --out " + out.string()).status, 0);
   EXPECT_TRUE(fs::exists(out / "frame_00002.ply"));
   for (const char* stale : {"frame_00003.ply", "frame_00004.ply", "frame_00005.ply"}) EXPECT_FALSE(fs::exists(out / stale)) << stale;
+}
+
+/// Every entry of a folder (hidden ones too, not recursing): name -> bytes ("<dir>" for folders).
+std::map<std::string, std::string> folder_contents(const fs::path& dir) {
+  std::map<std::string, std::string> m;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.is_directory()) {
+      m[e.path().filename().string()] = "<dir>";
+      continue;
+    }
+    std::ifstream in(e.path(), std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    m[e.path().filename().string()] = ss.str();
+  }
+  return m;
+}
+
+std::string names(const std::map<std::string, std::string>& m) {
+  std::string s;
+  for (const auto& [name, bytes] : m) s += name + " ";
+  return s;
+}
+
+TEST(Cli, AnInterruptedOrFailedFlowIntoAFolderLeavesTheEarlierRunWhole) {
+  const fs::path out = temp_dir() / "out_interrupted";
+  fs::remove_all(out);
+  ASSERT_EQ(mcfbench("flow --mesh icosphere:level=2 --steps 2 --save-every 1 --out " + out.string()).status, 0);
+  const auto earlier = folder_contents(out);
+  ASSERT_EQ(names(earlier), "final.ply frame_00000.ply frame_00001.ply frame_00002.ply result.json ");
+
+  // A long flow of another mesh into the same folder, interrupted (Ctrl-C) once it has saved
+  // frames past the earlier run's last one.
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "flow", "--mesh", "icosphere:level=4", "--solver", "pcg", "--preconditioner",
+          "none", "--dt", "1e-5", "--steps", "100000", "--save-every", "1", "--threads", "1", "--out", out.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  auto saved_frame_3 = [&] {  // wherever the flow keeps its frames while it runs
+    std::error_code ec;
+    for (fs::recursive_directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec))
+      if (it->path().filename() == "frame_00003.ply") return true;
+    return false;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!saved_frame_3() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the flow ended before it was interrupted";
+  auto now = folder_contents(out);
+  now.erase(".mcfbench-staging");  // the interrupted run's, hidden; the next flow removes it
+  EXPECT_EQ(names(now), names(earlier)) << "the interrupted run's files are in the folder";
+  EXPECT_TRUE(now == earlier) << "the earlier run's files changed";
+
+  // A flow that fails in its set-up leaves the earlier run as it was too.
+  EXPECT_NE(mcfbench("flow --mesh icosphere:level=2 --basis octree --depth 4 --cube unit --steps 1 --out " + out.string()).status, 0);
+  now = folder_contents(out);
+  now.erase(".mcfbench-staging");
+  EXPECT_TRUE(now == earlier) << names(now);
+
+  // The next flow that finishes replaces the earlier run entirely and leaves no staging behind.
+  ASSERT_EQ(mcfbench("flow --mesh icosphere:level=1 --steps 3 --save-every 2 --out " + out.string()).status, 0);
+  EXPECT_EQ(names(folder_contents(out)), "final.ply frame_00000.ply frame_00002.ply result.json ");
+  std::ifstream in(out / "result.json");
+  EXPECT_EQ(nlohmann::json::parse(in)["mesh"]["spec"], "icosphere:level=1");
 }
 
 TEST(Cli, EnvironmentRecordsTheThreadsThatRan) {
