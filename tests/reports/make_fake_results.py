@@ -105,6 +105,13 @@ def main(root):
         write(os.path.join(root, s), "cell_%03d" % i,
               result(s, i, {"mesh": mesh, "octree.tracking": mode}, config(mesh=mesh, octree__tracking=mode),
                      [step(n, 1e-3, slow=upd / 0.01) for n in range(1, 4)]))
+    # A model whose tracked flow stopped at step 1: no speed-up from it, named below the table.
+    for i, (mode, status) in enumerate([("tracked", "singular"), ("rebuilt", "ok")]):
+        mesh = "spiral:turns=3"
+        write(os.path.join(root, s), "cell_%03d" % (3 + i),
+              result(s, 3 + i, {"mesh": mesh, "octree.tracking": mode}, config(mesh=mesh, octree__tracking=mode),
+                     [step(n, 1e-3, slow=0.001 if status != "ok" else 20) for n in range(1, 2 if status != "ok" else 4)],
+                     status=status, reason="solver: not_positive_definite" if status != "ok" else "completed"))
     # sphere_error: three variants, one with frames.
     s = "sphere_error"
     for i, (basis, mode) in enumerate([("octree", "tracked"), ("octree", "rebuilt"), ("hat", "tracked")]):

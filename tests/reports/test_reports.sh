@@ -60,6 +60,10 @@ done
 # Contents: paper values beside ours, fitted orders, singular stop recorded, index links all.
 grep -q "Paper (Table 1)" "$work/out/table1.md" || { echo "FAIL: table1 lacks the paper table"; fail=1; }
 grep -q "1.4 + 0.22" "$work/out/table1.md" || { echo "FAIL: table1 lacks the paper row beside ours"; fail=1; }
+grep -q "spiral:turns=3 at depth .*, tracked: singular (solver: not_positive_definite)" "$work/out/table1.md" ||
+  { echo "FAIL: table1 does not name the stopped flow"; fail=1; }
+grep "spiral:turns=3" "$work/out/table1.md" | grep -q "×" &&
+  { echo "FAIL: table1 gives a speed-up from a stopped flow"; fail=1; }
 grep -qE "\| ([a-z]+: )?bdf2 \| 2\.00 \|" "$work/out/time_order.md" || { echo "FAIL: bdf2 order not fitted as 2"; fail=1; }
 grep -qE "\| ([a-z]+: )?semi-implicit \| 1\.00 \|" "$work/out/time_order.md" || { echo "FAIL: semi-implicit order not 1"; fail=1; }
 grep -q "singular" "$work/out/cmcf_summary.md" || { echo "FAIL: singular stop not in cmcf summary"; fail=1; }
