@@ -135,6 +135,10 @@ TEST(SphereFlows, UnstableExplicitStepStopsAsDiverged) {
   const auto o = run(json{{"mesh", "icosphere:level=3"}, {"integrator", "explicit-euler"}, {"dt", 0.01}, {"steps", 50}});
   EXPECT_EQ(o.result["status"], "singular");
   EXPECT_NE(o.result["stop"]["reason"].get<std::string>().find("diverged"), std::string::npos);
+  // The stopping step keeps its seconds and the area that stopped it, as every step does.
+  const auto& last_step = o.result["steps"].back();
+  EXPECT_TRUE(last_step.contains("seconds") && last_step["seconds"].contains("total")) << last_step.dump();
+  EXPECT_GT(last_step["area"].get<double>(), 1.05 * o.result["steps"][o.result["steps"].size() - 2]["area"].get<double>());
   const auto stable = run(json{{"mesh", "icosphere:level=3"}, {"integrator", "explicit-euler"}, {"dt", 5e-4}, {"steps", 50}});
   EXPECT_EQ(stable.result["status"], "ok");
 }
