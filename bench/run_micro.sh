@@ -13,10 +13,11 @@ bin=$build/mcfbench_micro
 out_dir=${MICRO_OUT:-results/micro}
 [ -x "$bin" ] || { echo "run_micro.sh: $bin not built (ninja -C $build mcfbench_micro)" >&2; exit 1; }
 
-# Same commit naming as the results of mcfbench (cmake/build_info.cmake): 12 hex + "-dirty".
+# Same commit naming as the results of mcfbench (cmake/build_info.cmake): 12 hex, and for an
+# uncommitted change "-dirty-" + the first 8 hex of the SHA-1 of `git diff HEAD`.
 commit=$(git -C "$root" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
 if [ "$commit" != unknown ] && [ -n "$(git -C "$root" status --porcelain --untracked-files=no)" ]; then
-  commit="$commit-dirty"
+  commit="$commit-dirty-$(git -C "$root" diff HEAD | sha1sum | cut -c1-8)"
 fi
 mkdir -p "$out_dir"
 out="$out_dir/$commit.json"

@@ -7,7 +7,14 @@ execute_process(COMMAND git status --porcelain --untracked-files=no WORKING_DIRE
 if(NOT MCFBENCH_GIT_COMMIT)
   set(MCFBENCH_GIT_COMMIT "unknown")
 elseif(_dirty)
-  set(MCFBENCH_GIT_COMMIT "${MCFBENCH_GIT_COMMIT}-dirty")
+  # The uncommitted change's own fingerprint, so two different edits of one commit never share
+  # a label: result cells are keyed by it, and a run resumed after an edit must not take the
+  # cells of the earlier edit for its own (bench/run_micro.sh names its files the same way).
+  execute_process(COMMAND git diff HEAD WORKING_DIRECTORY ${SOURCE_DIR}
+                  OUTPUT_VARIABLE _diff ERROR_QUIET)
+  string(SHA1 _diff_hash "${_diff}")
+  string(SUBSTRING "${_diff_hash}" 0 8 _diff_hash)
+  set(MCFBENCH_GIT_COMMIT "${MCFBENCH_GIT_COMMIT}-dirty-${_diff_hash}")
 endif()
 configure_file(${SOURCE_DIR}/cmake/build_info.h.in ${OUTPUT}.tmp @ONLY)
 execute_process(COMMAND ${CMAKE_COMMAND} -E copy_if_different ${OUTPUT}.tmp ${OUTPUT})
