@@ -1,7 +1,8 @@
 // Mesh file I/O. OFF, OBJ and PLY are walked here (and in ply_format.cpp) once, in exact doubles,
 // with errors that name the line; OpenMesh's half-edge insertion then checks the topology, which
 // its own readers would instead repair silently by dropping faces or duplicating vertices
-// (DESIGN.md, practical notes). STL and binary OFF are read by OpenMesh and checked by counts.
+// (DESIGN.md, practical notes). Binary OFF is walked here too, in the layout OpenMesh reads. STL
+// is read by OpenMesh and checked by counts.
 
 #include "datasets/mesh_io.h"
 
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -79,7 +81,7 @@ void check_int_range(const std::string& path, long long count, const char* what)
 }
 
 // ASCII OFF: header counts, finite coordinates, index range; OpenMesh's reader is lenient about
-// all of these. Returns false for binary OFF, which is left to OpenMesh.
+// all of these. Returns false for binary OFF (walk_off_binary).
 bool walk_off(const std::string& path, WalkedMesh& walk) {
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
@@ -97,7 +99,7 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
     fail(path, "not an OFF file (header '" + magic + "')");
   std::string rest;
   std::getline(hs, rest);
-  if (rest.find("BINARY") != std::string::npos) return false;
+  if (rest.find("BINARY") != std::string::npos) return false;  // walk_off_binary's
   rest = clean_line(rest);
   while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
   long long nv = -1, nf = -1;
@@ -147,6 +149,124 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
   }
   if (f < nf) fail(path, "file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
   return true;
+}
+
+// Binary OFF, in the layout OpenMesh's reader (OpenMesh 9, OFFReader.cc) reads and its writer
+// writes: the first line "[ST][C][N]OFF BINARY", then 32-bit words in the machine's byte order
+// (little-endian here; Geomview's spec says big-endian): nV nF nE, per vertex x y z as floats
+// [normal: 3 floats] [colour: 3 ints] [texture: 2 floats], per face k and k vertex indices, and
+// nothing after the last face (no per-face colour count, which Geomview writes after each face's
+// indices). OpenMesh reads a file in another layout without a word: Geomview's colour count 0
+// after a face is read as the next face's corner count, an empty face it skips, and that face's
+// own record is lost (a tetrahedron so written loaded as 2 faces). So the file is walked here
+// instead, every record checked, and errors name the vertex or face and its byte.
+void walk_off_binary(const std::string& path, WalkedMesh& walk) {
+  static_assert(std::endian::native == std::endian::little, "binary OFF is read as little-endian words");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file");
+  std::error_code ec;
+  const unsigned long long size = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot read the file's size: " + ec.message());
+  // The header, as OpenMesh's can_u_read parses it: prefixes in this order, "OFF", one
+  // separator, "BINARY", the rest of the line ignored.
+  std::string header;
+  for (char c; in.get(c) && c != '\n';) {
+    header += c;
+    if (header.size() > 4096) fail(path, "binary OFF: no end to its header line in 4096 bytes");
+  }
+  if (!in) fail(path, "binary OFF: no end to its header line");
+  std::size_t p = 0, vertex_words = 3;
+  const auto prefix = [&](const char* letters, std::size_t words) {
+    const std::size_t n = std::strlen(letters);
+    if (header.compare(p, n, letters) != 0) return;
+    p += n;
+    vertex_words += words;
+  };
+  prefix("ST", 2);  // texture coordinate: 2 floats, after the colour
+  prefix("C", 3);   // vertex colour: 3 ints (OpenMesh reads no face colour unless asked)
+  prefix("N", 3);   // normal: 3 floats, after the point
+  if (p < header.size() && (header[p] == '4' || header[p] == 'n'))
+    fail(path, "binary OFF with other than 3 coordinates per vertex ('" + header + "') is not supported");
+  if (header.size() < p + 10 || header.compare(p, 3, "OFF") != 0 || header.compare(p + 4, 6, "BINARY") != 0)
+    fail(path, "binary OFF header must be the first line, '[ST][C][N]OFF BINARY', not '" + header + "'");
+  const unsigned long long body = header.size() + 1;
+
+  // Words come through a 1 MiB buffer; `at` is the file offset of the next one.
+  std::vector<char> buffer(std::size_t(1) << 20);
+  std::size_t next = 0, filled = 0;
+  unsigned long long at = body;
+  const auto word = [&](const std::string& where) -> std::uint32_t {
+    if (next + 4 > filled) {
+      std::memmove(buffer.data(), buffer.data() + next, filled - next);
+      filled -= next;
+      next = 0;
+      in.read(buffer.data() + filled, static_cast<std::streamsize>(buffer.size() - filled));
+      filled += static_cast<std::size_t>(in.gcount());
+      if (filled < 4) fail(path, "binary OFF ends at byte " + std::to_string(size) + ", inside " + where);
+    }
+    std::uint32_t w;
+    std::memcpy(&w, buffer.data() + next, 4);
+    next += 4;
+    at += 4;
+    return w;
+  };
+  const std::uint32_t nv = word("its counts"), nf = word("its counts");
+  word("its counts");  // edges, unused
+  // The least the counts need (a face is at least 4 words), before anything is allocated.
+  const unsigned long long need = 12 + 4ull * vertex_words * nv + 16ull * nf;
+  if (need > size - body) {
+    std::string why = "binary OFF announces " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                      " faces, at least " + std::to_string(need) + " bytes, but has " +
+                      std::to_string(size - body) + " after its header line";
+    const std::uint32_t snv = __builtin_bswap32(nv), snf = __builtin_bswap32(nf);
+    const unsigned long long swapped_need = 12 + 4ull * vertex_words * snv + 16ull * snf;
+    if (swapped_need <= size - body)
+      why += "; read big-endian (Geomview's byte order) the counts would be " + std::to_string(snv) + " and " + std::to_string(snf) +
+             ", but binary OFF is read here as OpenMesh reads and writes it, little-endian";
+    fail(path, why);
+  }
+  check_int_range(path, nv, "vertices");
+  walk.coords.reserve(3ull * nv);
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    const unsigned long long record = at;
+    const std::string where = "vertex " + std::to_string(v);
+    for (std::size_t w = 0; w < vertex_words; ++w) {
+      const std::uint32_t bits = word(where);
+      if (w >= 3) continue;  // normal, colour, texture coordinate: not kept
+      const float x = std::bit_cast<float>(bits);
+      if (!std::isfinite(x))
+        fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate (byte " + std::to_string(record) + ")");
+      walk.coords.push_back(x);
+    }
+  }
+  std::vector<int> corner;
+  for (std::uint32_t f = 0; f < nf; ++f) {
+    const unsigned long long record = at;
+    const std::string where = "face " + std::to_string(f);
+    const std::uint32_t k = word(where);
+    if (k < 3)
+      fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") has " + std::to_string(k) +
+                     " corners" +
+                     (f > 0 && k <= 1 ? std::string(" (a Geomview colour count after face ") + std::to_string(f - 1) +
+                                            "'s indices? OpenMesh's binary OFF, read here, has none)"
+                                      : std::string()));
+    if (4ull * k > size - at)
+      fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") announces " + std::to_string(k) +
+                     " corners, more than the rest of the file holds");
+    corner.clear();
+    for (std::uint32_t i = 0; i < k; ++i) {
+      const std::uint32_t idx = word(where);
+      if (idx >= nv)
+        fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") references vertex " +
+                       std::to_string(idx) + " but the mesh has " + std::to_string(nv) + " vertices");
+      corner.push_back(static_cast<int>(idx));
+    }
+    add_fan(walk, corner, f);
+  }
+  if (at != size)
+    fail(path, std::to_string(size - at) + " bytes after the last of its " + std::to_string(nf) +
+                   " faces (byte " + std::to_string(at) +
+                   "): not the layout OpenMesh reads (per-face colours, or a wrong count?)");
 }
 
 // OBJ: 'v' and 'f' records; a face corner is "v", "v/vt", "v/vt/vn" or "v//vn", and a negative
@@ -296,15 +416,15 @@ IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const 
   return om;
 }
 
-// Binary OFF and STL: OpenMesh reads them; what it dropped or duplicated is detected by counts.
-// stl: OpenMesh merged the file's corners into vertices.
-TriangleMesh read_through_openmesh(const std::string& path, long long file_triangles, bool stl) {
+// STL: OpenMesh reads it, merging the file's corners into vertices; what it dropped or
+// duplicated is detected by counts.
+TriangleMesh read_stl_through_openmesh(const std::string& path, long long file_triangles) {
   IoMesh om;
   OpenMesh::IO::Options opt;
   if (!OpenMesh::IO::read_mesh(om, path, opt)) fail(path, "OpenMesh could not parse the file");
   const long long nv = static_cast<long long>(om.n_vertices());
   const long long nf = static_cast<long long>(om.n_faces());
-  if (stl) {
+  {
     // STL has no vertex list to count against; OpenMesh merges equal corners, so two loaded
     // vertices at exactly the same position mean it split a vertex to add a non-manifold face.
     std::vector<std::array<double, 3>> points;
@@ -318,7 +438,7 @@ TriangleMesh read_through_openmesh(const std::string& path, long long file_trian
       fail(path, "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
                  "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
   }
-  if (file_triangles >= 0 && nf < file_triangles)
+  if (nf < file_triangles)
     fail(path, "only " + std::to_string(nf) + " of the file's " + std::to_string(file_triangles) +
                    " triangles could be added: the mesh has non-manifold (complex) edges, repeated "
                    "vertex indices in a face, or inconsistently oriented faces");
@@ -351,13 +471,13 @@ TriangleMesh read_mesh(const std::string& path) {
   const std::string ext = lower_extension(path);
   WalkedMesh walk;
   if (ext == ".off") {
-    if (!walk_off(path, walk)) return read_through_openmesh(path, -1, false);
+    if (!walk_off(path, walk)) walk_off_binary(path, walk);
   } else if (ext == ".obj") {
     walk_obj(path, walk);
   } else if (ext == ".ply") {
     walk = scan_ply(path);  // a full walk of header and body (ply_format.cpp)
   } else if (ext == ".stl") {
-    return read_through_openmesh(path, count_stl_triangles(path), true);
+    return read_stl_through_openmesh(path, count_stl_triangles(path));
   } else {
     fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
   }

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <random>
@@ -584,6 +585,98 @@ TEST(MeshIo, BinaryStlHeaderAndLength) {
   const TriangleMesh r = read_mesh(dir.write("solid_header.stl", solid));
   EXPECT_EQ(r.num_faces(), m.num_faces());
   EXPECT_EQ(r.num_vertices(), m.num_vertices());
+}
+
+// A binary OFF: its header line, then 32-bit words, little-endian (as OpenMesh writes it on
+// x86) unless big_endian (as Geomview's spec has it).
+struct BinaryOff {
+  std::string bytes;
+  bool big_endian = false;
+  explicit BinaryOff(const std::string& header = "OFF BINARY") : bytes(header + "\n") {}
+  BinaryOff& word(std::uint32_t w) {
+    for (int i = 0; i < 4; ++i) bytes += static_cast<char>(w >> 8 * (big_endian ? 3 - i : i));
+    return *this;
+  }
+  BinaryOff& real(float x) { return word(std::bit_cast<std::uint32_t>(x)); }
+};
+
+// The tetrahedron of kTetraOff with vertex 3 at z = 0.1f, its faces followed by Geomview's colour
+// count 0 where colour_counts, and with a normal after each point where normals.
+BinaryOff binary_off_tetra(bool colour_counts = false, bool normals = false, bool big_endian = false) {
+  BinaryOff off(normals ? "NOFF BINARY" : "OFF BINARY");
+  off.big_endian = big_endian;
+  off.word(4).word(4).word(0);
+  const float points[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 0.1f}};
+  for (const auto& p : points) {
+    off.real(p[0]).real(p[1]).real(p[2]);
+    if (normals) off.real(0).real(0).real(1);
+  }
+  for (const auto& f : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}) {
+    off.word(3).word(f[0]).word(f[1]).word(f[2]);
+    if (colour_counts) off.word(0);
+  }
+  return off;
+}
+
+// Binary OFF is walked in the layout OpenMesh reads and writes (the bytes of binary_off_tetra() are
+// those OpenMesh 9's writer writes for it): floats widened exactly, polygons fanned as in ASCII.
+TEST(MeshIo, BinaryOffInOpenMeshsLayout) {
+  TempDir dir;
+  for (bool normals : {false, true}) {
+    SCOPED_TRACE(normals ? "NOFF" : "OFF");
+    const auto path = dir.write(normals ? "tetra_n.off" : "tetra.off", binary_off_tetra(false, normals).bytes);
+    const TriangleMesh m = read_mesh(path);
+    ASSERT_EQ(m.num_vertices(), 4);
+    ASSERT_EQ(m.num_faces(), 4);
+    EXPECT_EQ(m.vertices.row(3), Eigen::RowVector3d(0, 0, static_cast<double>(0.1f)));
+    const TriangleMesh ascii = read_mesh(dir.write("tetra_ascii.off", kTetraOff));
+    EXPECT_EQ(m.faces, ascii.faces);
+    const MeshReport r = validate_mesh(m, path);
+    EXPECT_TRUE(r.closed());
+    EXPECT_EQ(r.faces, 4);
+  }
+  // A pyramid with a quad base: 6 triangles, as the ASCII file gives them.
+  BinaryOff pyramid;
+  pyramid.word(5).word(5).word(0);
+  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 0.f, 0.f, 1.f, 0.f, 0.5f, 0.5f, 1.f}) pyramid.real(x);
+  pyramid.word(4).word(0).word(3).word(2).word(1);
+  for (std::uint32_t a = 0; a < 4; ++a) pyramid.word(3).word(a).word((a + 1) % 4).word(4);
+  const TriangleMesh b = read_mesh(dir.write("pyramid.off", pyramid.bytes));
+  const TriangleMesh a = read_mesh(dir.write("pyramid_ascii.off", "OFF\n5 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n"
+                                                                 "4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n"));
+  EXPECT_EQ(b.faces, a.faces);
+  EXPECT_EQ(b.vertices, a.vertices);
+  EXPECT_EQ(b.num_faces(), 6);
+}
+
+// OpenMesh's reader loads a file in another layout without a word: Geomview's colour count 0
+// after each face read as the next face's corner count made it skip every other face (the
+// tetrahedron loaded as 2 faces with a boundary). Every such mismatch is an error naming the file.
+TEST(MeshIo, BinaryOffLosesNoFace) {
+  TempDir dir;
+  expect_error_naming(dir.write("colours.off", binary_off_tetra(true).bytes),
+                      "face 1 (byte 87) has 0 corners (a Geomview colour count after face 0's indices?");
+  expect_error_naming(dir.write("big.off", binary_off_tetra(false, false, true).bytes),
+                      "read big-endian (Geomview's byte order) the counts would be 4 and 4");
+  expect_error_naming(dir.write("trailing.off", binary_off_tetra().word(0).bytes),
+                      "4 bytes after the last of its 4 faces (byte 135)");
+  std::string bytes = binary_off_tetra().bytes;
+  // Counts are checked against the length before anything is read (layout: 11 header bytes, 12
+  // of counts, 12 per vertex from byte 23, 16 per triangle from byte 71).
+  expect_error_naming(dir.write("truncated.off", bytes.substr(0, bytes.size() - 2)),
+                      "announces 4 vertices and 4 faces, at least 124 bytes, but has 122 after its header line");
+  std::string seven = bytes;
+  seven[119] = 7;
+  expect_error_naming(dir.write("seven.off", seven), "face 3 (byte 119) announces 7 corners, more than the rest of the file holds");
+  BinaryOff range = binary_off_tetra();
+  range.bytes.resize(range.bytes.size() - 4);
+  expect_error_naming(dir.write("range.off", range.word(9).bytes), "face 3 (byte 119) references vertex 9 but the mesh has 4");
+  BinaryOff nan = binary_off_tetra();
+  nan.bytes.replace(23 + 12 + 4, 4, BinaryOff("").real(std::numeric_limits<float>::quiet_NaN()).bytes.substr(1));
+  expect_error_naming(dir.write("nan.off", nan.bytes), "vertex 1 has a non-finite coordinate (byte 35)");
+  // OpenMesh takes the first line for the header, and reads no 4D or nOFF binary file.
+  expect_error_naming(dir.write("comment.off", "# made by hand\n" + bytes), "header must be the first line");
+  expect_error_naming(dir.write("4d.off", "4" + bytes), "other than 3 coordinates per vertex");
 }
 
 TEST(MeshIo, WriteIntoMissingFolderFails) {
