@@ -2,7 +2,7 @@
 // with errors that name the line; OpenMesh's half-edge insertion then checks the topology, which
 // its own readers would instead repair silently by dropping faces or duplicating vertices
 // (DESIGN.md, practical notes). Binary OFF is walked here too, in the layout OpenMesh reads. STL
-// is read by OpenMesh and checked by counts.
+// is read by OpenMesh and checked by counts, after a streaming pass that checks its lines.
 
 #include "datasets/mesh_io.h"
 
@@ -17,6 +17,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -29,6 +30,7 @@
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <unistd.h>
 #include <vector>
 
@@ -324,11 +326,127 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
                    " but the file has " + std::to_string(vertices) + " vertices");
 }
 
+// The lines of an ASCII STL as OpenMesh 9's reader takes them (STLReader.cc, read_stla): a line
+// containing "outer" (or "OUTER") opens a facet, and the next three lines are its corners, each
+// read as a word and three floats with `>>`, which on bad text keeps whatever the stream holds
+// (`vertex 0 1 zz` came out as (0, 1, 0), a missing coordinate as the last vertex's, `1e999` as
+// FLT_MAX). Fed the file's bytes in order, in pieces of any size; keeps only the current line
+// (at most 1 MiB). The first problem is kept as an error naming the line.
+class AsciiStlLines {
+ public:
+  void feed(const char* p, std::size_t n) {
+    while (n > 0 && error_.empty()) {
+      const char* nl = static_cast<const char*>(std::memchr(p, '\n', n));
+      const std::size_t len = nl ? static_cast<std::size_t>(nl - p) : n;
+      if (partial_.empty() && !overlong_ && nl) {
+        line(std::string_view(p, len));  // whole in this piece: not copied
+      } else {
+        if (!overlong_ && partial_.size() + len > kMaxLine) {
+          overlong_ = true;
+          partial_.clear();
+        }
+        if (!overlong_) partial_.append(p, len);
+        if (nl) {
+          line(partial_);
+          partial_.clear();
+          overlong_ = false;
+        }
+      }
+      if (!nl) break;
+      p = nl + 1;
+      n -= len + 1;
+    }
+  }
+  // At the end of the file: its last line, if it has no newline, and a facet cut short.
+  void finish() {
+    if (!error_.empty()) return;
+    if (!partial_.empty() || overlong_) line(partial_);
+    if (error_.empty() && corners_due_ > 0)
+      error_ = "the file ends " + std::to_string(corners_due_) + " vertex line(s) short of the facet opened on line " +
+               std::to_string(loop_line_);
+  }
+  const std::string& error() const { return error_; }
+
+ private:
+  static constexpr std::size_t kMaxLine = std::size_t(1) << 20;
+  static constexpr const char* kBlank = " \t\r\n\v\f";
+
+  static std::string quoted(std::string_view s) {
+    const auto b = s.find_first_not_of(kBlank);
+    if (b == std::string_view::npos) return "an empty line";
+    s = s.substr(b, s.find_last_not_of(kBlank) - b + 1);
+    return "'" + std::string(s.substr(0, 80)) + (s.size() > 80 ? "...'" : "'");
+  }
+  // Splits off the next blank-separated word of s (empty at the end).
+  static std::string_view word(std::string_view& s) {
+    const auto b = s.find_first_not_of(kBlank);
+    if (b == std::string_view::npos) return s = {};
+    const auto e = std::min(s.find_first_of(kBlank, b), s.size());
+    const std::string_view w = s.substr(b, e - b);
+    s.remove_prefix(e);
+    return w;
+  }
+  void problem(const std::string& what) { error_ = "line " + std::to_string(number_) + ": " + what; }
+
+  void line(std::string_view s) {
+    ++number_;
+    if (overlong_) return problem("longer than 1 MiB (not an STL line)");
+    std::string_view rest = s;
+    const std::string_view first = word(rest);
+    if (corners_due_ == 0) {
+      if (first == "vertex")
+        return problem("a vertex line outside a facet's three corners (OpenMesh's reader skips it): " + quoted(s));
+      if (s.find("outer") != std::string_view::npos || s.find("OUTER") != std::string_view::npos) {
+        corners_due_ = 3;
+        loop_line_ = number_;
+      }
+      return;
+    }
+    --corners_due_;
+    if (first != "vertex")
+      return problem("expected 'vertex x y z', corner " + std::to_string(3 - corners_due_) +
+                     " of the facet opened by 'outer' on line " + std::to_string(loop_line_) + ", found " + quoted(s));
+    int count = 0;
+    for (std::string_view w = word(rest); !w.empty(); w = word(rest), ++count) {
+      if (count == 3) return problem("vertex line with more than 3 coordinates: " + quoted(s));
+      // Decimal text only, as `>>` reads it (no hex, inf or nan), and finite as a float: STL
+      // stores 32-bit floats and `>>` turns 1e39 into FLT_MAX without a word. from_chars takes
+      // the common case fast; strtof the rest ('+', and out of range: underflow is fine).
+      float y = 0;
+      const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), y);
+      if (ec == std::errc() && ptr == w.data() + w.size()) {
+        if (std::isfinite(y)) continue;
+        return problem("non-finite vertex coordinate '" + std::string(w) +
+                       "' (STL coordinates are 32-bit floats, at most about 3.4e38): " + quoted(s));
+      }
+      number_text_.assign(w);
+      char* end = nullptr;
+      const float x = std::strtof(number_text_.c_str(), &end);
+      const bool whole = end == number_text_.c_str() + number_text_.size();
+      if (whole && !std::isfinite(x))
+        return problem("non-finite vertex coordinate '" + number_text_ +
+                       "' (STL coordinates are 32-bit floats, at most about 3.4e38): " + quoted(s));
+      if (!whole || number_text_.find_first_not_of("0123456789+-.eE") != std::string::npos)
+        return problem("vertex coordinate '" + number_text_ + "' is not a number: " + quoted(s));
+    }
+    if (count < 3) return problem("vertex line with " + std::to_string(count) + " of 3 coordinates: " + quoted(s));
+  }
+
+  std::string partial_;        // the current line's bytes from earlier pieces
+  bool overlong_ = false;      // the current line passed kMaxLine (its bytes are dropped)
+  long long number_ = 0;       // lines ended so far
+  int corners_due_ = 0;        // vertex lines the open facet still needs
+  long long loop_line_ = 0;    // the line that opened it
+  std::string number_text_;    // a coordinate, NUL-terminated for strtof
+  std::string error_;
+};
+
 // STL: ASCII counts 'facet' records, binary stores the triangle count at byte 80. Vertices are
 // merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance. A binary
 // file is not read here beyond its header (OpenMesh reads it next). A file that starts with
 // "solid" is ASCII if the word "facet" occurs in it (some binary exporters start their header
-// with "solid" too); it is streamed in chunks, never held whole.
+// with "solid" too); it is streamed in chunks, never held whole, and the same pass checks its
+// lines (AsciiStlLines), whose error is raised once the file is known to be ASCII.
 long long count_stl_triangles(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file");
@@ -344,6 +462,8 @@ long long count_stl_triangles(const std::string& path) {
     std::size_t carried = 0;  // bytes at the buffer's front already searched
     long long opening = 0;
     bool any = false;
+    AsciiStlLines lines;
+    lines.feed(head.data(), head.size());
     std::string chunk(kChunk, '\0');
     while (true) {
       for (std::size_t pos = buffer.find("facet"); pos != std::string::npos; pos = buffer.find("facet", pos + 5)) {
@@ -352,15 +472,21 @@ long long count_stl_triangles(const std::string& path) {
         // "endfacet" also contains "facet": count only the opening keyword.
         if (!(pos >= 3 && buffer.compare(pos - 3, 3, "end") == 0)) ++opening;
       }
+      if (any && !lines.error().empty()) break;  // ASCII, with a bad line: no need to read on
       if (!in) break;
       in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
       const auto got = static_cast<std::size_t>(in.gcount());
       if (got == 0) break;
+      lines.feed(chunk.data(), got);
       carried = std::min(kCarry, buffer.size());
       buffer.erase(0, buffer.size() - carried);
       buffer.append(chunk, 0, got);
     }
-    if (any) return opening;
+    if (any) {
+      lines.finish();
+      if (!lines.error().empty()) fail(path, lines.error());
+      return opening;
+    }
   }
   if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
   std::uint32_t n = 0;

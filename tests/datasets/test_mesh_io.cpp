@@ -565,6 +565,101 @@ TEST(MeshIo, AsciiStlCountedAcrossReadChunks) {
   place("facet normal", kBoundary - 5);
 }
 
+// The tetrahedron of kTetraOff as ASCII STL, one keyword per line: line 3 opens the first facet,
+// lines 4-6 are its corners (then 11-13, 18-20, 25-27).
+const char* kTetraStl =
+    "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+    "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+    "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n"
+    "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1\nendloop\nendfacet\nendsolid t\n";
+
+// text with its line `number` (from 1) replaced by `line` (which may hold several lines, or none).
+std::string with_line(const std::string& text, int number, const std::string& line) {
+  std::size_t begin = 0;
+  for (int n = 1; n < number; ++n) begin = text.find('\n', begin) + 1;
+  return text.substr(0, begin) + line + text.substr(text.find('\n', begin));
+}
+
+// OpenMesh's reader takes the three lines after one containing "outer" as a facet's corners, a
+// word and three floats each, and reads bad text without a word (`vertex 0 1 zz` as (0, 1, 0), a
+// missing coordinate as the last vertex's, 1e999 as FLT_MAX): the streaming pass that counts the
+// facets checks those lines, and the error names the line.
+TEST(MeshIo, AsciiStlVertexLinesChecked) {
+  TempDir dir;
+  const std::string tetra = kTetraStl;
+  ASSERT_EQ(read_mesh(dir.write("tetra.stl", tetra)).num_faces(), 4);
+  const std::pair<std::string, std::string> bad[] = {
+      {with_line(tetra, 6, "vertex 1 0 zz"), "line 6: vertex coordinate 'zz' is not a number: 'vertex 1 0 zz'"},
+      {with_line(tetra, 5, "  vertex 0 1"), "line 5: vertex line with 2 of 3 coordinates: 'vertex 0 1'"},
+      {with_line(tetra, 12, "vertex 1e999 0 0"), "line 12: non-finite vertex coordinate '1e999'"},
+      {with_line(tetra, 12, "vertex 1e39 0 0"), "line 12: non-finite vertex coordinate '1e39' (STL coordinates are 32-bit floats"},
+      {with_line(tetra, 12, "vertex -inf 0 0"), "line 12: non-finite vertex coordinate '-inf'"},
+      {with_line(tetra, 27, "vertex 0 0 nan"), "line 27: non-finite vertex coordinate 'nan'"},
+      {with_line(tetra, 12, "vertex 0x1p0 0 0"), "line 12: vertex coordinate '0x1p0' is not a number"},
+      {with_line(tetra, 12, "vertex 1 0 0 0"), "line 12: vertex line with more than 3 coordinates"},
+      {with_line(tetra, 6, "endloop"), "line 6: expected 'vertex x y z', corner 3 of the facet opened by 'outer' on line 3, found 'endloop'"},
+      {with_line(tetra, 3, "outer loop\n"), "line 4: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 3, found an empty line"},
+      {with_line(tetra, 6, "vertex 1 0 0\nvertex 1 1 0"), "line 7: a vertex line outside a facet's three corners"},
+      {with_line(tetra, 1, "solid outer_shell"), "line 2: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 1"},
+      {tetra.substr(0, tetra.find("vertex 1 0 0")), "the file ends 1 vertex line(s) short of the facet opened on line 3"},
+  };
+  for (const auto& [text, message] : bad) {
+    SCOPED_TRACE(message);
+    expect_error_naming(dir.write("bad.stl", text), message);
+  }
+  // What `>>` reads as the same numbers still loads: signs, exponents, tabs, an underflow to 0,
+  // CR LF line ends, no newline at the end.
+  std::string good = with_line(with_line(tetra, 4, "vertex 0 0 1e-50"), 6, "\tvertex\t+1.0E+0\t0.0\t-0e-3 ");
+  good.pop_back();
+  std::string crlf;
+  for (char c : good) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  for (const std::string& text : {good, crlf}) {
+    const TriangleMesh m = read_mesh(dir.write("good.stl", text));
+    EXPECT_EQ(m.num_faces(), 4);
+    EXPECT_EQ(m.num_vertices(), 4);
+  }
+}
+
+// The lines are checked in the same 1 MiB chunks the facets are counted in, so a line, a keyword
+// or a number can straddle a chunk: each is put across the first boundary after the 84-byte head
+// (by widening the indentation of a vertex line), once valid (the file loads) and once bad (the
+// error names the right line).
+TEST(MeshIo, AsciiStlLinesCheckedAcrossReadChunks) {
+  TempDir dir;
+  const TriangleMesh m = make_icosphere(5);
+  const std::string plain = dir.file("plain.stl");
+  write_mesh(plain, m, false);
+  const std::string text = file_bytes(plain);
+  constexpr std::size_t kBoundary = 84 + (std::size_t(1) << 20);
+  ASSERT_GT(text.size(), kBoundary + 1000);
+  // A vertex line ending some 200 bytes before the boundary (its number: `number`) is replaced by
+  // `line`, indented so that its byte `split` falls on the boundary.
+  const std::size_t at = text.rfind("\nvertex", kBoundary - 200) + 1, end = text.find('\n', at);
+  const std::string original = text.substr(at, end - at);
+  const long long number = std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1;
+  const auto place = [&](const std::string& line, std::size_t split, const std::string& message) {
+    ASSERT_LE(at + split, kBoundary);
+    const std::string placed = text.substr(0, at) + std::string(kBoundary - split - at, ' ') + line + text.substr(end);
+    ASSERT_EQ(placed.compare(kBoundary - split, line.size() + 1, line + "\n"), 0);
+    SCOPED_TRACE("'" + line + "' split at " + std::to_string(split) + ", line " + std::to_string(number));
+    const auto path = dir.write("chunks.stl", placed);
+    if (message.empty()) {
+      EXPECT_EQ(read_mesh(path).num_faces(), m.num_faces());
+    } else {
+      expect_error_naming(path, "line " + std::to_string(number) + ": " + message);
+    }
+  };
+  place(original, 0, "");                    // the line starts the chunk
+  place(original, 3, "");                    // "ver|tex"
+  place(original, 10, "");                   // inside its first number
+  place(original, original.size(), "");      // its newline starts the chunk
+  place(original, original.size() + 1, "");  // its newline ends the chunk
+  place("vertex 0 0 1e999", 13, "non-finite vertex coordinate '1e999'");   // "1e|999"
+  place("vertex 0 1 zz", 12, "vertex coordinate 'zz' is not a number");    // "z|z"
+  place("vertex 0 1", 10, "vertex line with 2 of 3 coordinates");         // its newline starts the chunk
+  place("vertex 0 1 0 0", 3, "vertex line with more than 3 coordinates");  // "ver|tex"
+}
+
 // A binary STL is checked by its header's triangle count against the file's length; one whose
 // header starts with "solid" (as some exporters write) is still binary when it has no facet.
 TEST(MeshIo, BinaryStlHeaderAndLength) {
