@@ -1,7 +1,7 @@
 #pragma once
 // The triangle mesh value type every layer exchanges: plain Eigen arrays, no topology.
-// OpenMesh is used for STL (and binary OFF) I/O and topology checks only (DESIGN.md, practical
-// notes; datasets/mesh_io.h).
+// OpenMesh is used for STL I/O and topology checks only (DESIGN.md, practical notes;
+// datasets/mesh_io.h).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products are used everywhere meshes are

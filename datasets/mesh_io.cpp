@@ -1,7 +1,8 @@
 // Mesh file I/O. OFF, OBJ and PLY are walked here (and in ply_format.cpp) once, in exact doubles,
 // with errors that name the line; OpenMesh's half-edge insertion then checks the topology, which
 // its own readers would instead repair silently by dropping faces or duplicating vertices
-// (DESIGN.md, practical notes). STL and binary OFF are read by OpenMesh and checked by counts.
+// (DESIGN.md, practical notes). Binary OFF is walked here too, in the layout OpenMesh reads. STL
+// is read by OpenMesh and checked by counts, after a streaming pass that checks its lines.
 
 #include "datasets/mesh_io.h"
 
@@ -15,6 +16,8 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -27,6 +30,7 @@
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <unistd.h>
 #include <vector>
 
@@ -79,7 +83,7 @@ void check_int_range(const std::string& path, long long count, const char* what)
 }
 
 // ASCII OFF: header counts, finite coordinates, index range; OpenMesh's reader is lenient about
-// all of these. Returns false for binary OFF, which is left to OpenMesh.
+// all of these. Returns false for binary OFF (walk_off_binary).
 bool walk_off(const std::string& path, WalkedMesh& walk) {
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
@@ -97,7 +101,7 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
     fail(path, "not an OFF file (header '" + magic + "')");
   std::string rest;
   std::getline(hs, rest);
-  if (rest.find("BINARY") != std::string::npos) return false;
+  if (rest.find("BINARY") != std::string::npos) return false;  // walk_off_binary's
   rest = clean_line(rest);
   while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
   long long nv = -1, nf = -1;
@@ -147,6 +151,124 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
   }
   if (f < nf) fail(path, "file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
   return true;
+}
+
+// Binary OFF, in the layout OpenMesh's reader (OpenMesh 9, OFFReader.cc) reads and its writer
+// writes: the first line "[ST][C][N]OFF BINARY", then 32-bit words in the machine's byte order
+// (little-endian here; Geomview's spec says big-endian): nV nF nE, per vertex x y z as floats
+// [normal: 3 floats] [colour: 3 ints] [texture: 2 floats], per face k and k vertex indices, and
+// nothing after the last face (no per-face colour count, which Geomview writes after each face's
+// indices). OpenMesh reads a file in another layout without a word: Geomview's colour count 0
+// after a face is read as the next face's corner count, an empty face it skips, and that face's
+// own record is lost (a tetrahedron so written loaded as 2 faces). So the file is walked here
+// instead, every record checked, and errors name the vertex or face and its byte.
+void walk_off_binary(const std::string& path, WalkedMesh& walk) {
+  static_assert(std::endian::native == std::endian::little, "binary OFF is read as little-endian words");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file");
+  std::error_code ec;
+  const unsigned long long size = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot read the file's size: " + ec.message());
+  // The header, as OpenMesh's can_u_read parses it: prefixes in this order, "OFF", one
+  // separator, "BINARY", the rest of the line ignored.
+  std::string header;
+  for (char c; in.get(c) && c != '\n';) {
+    header += c;
+    if (header.size() > 4096) fail(path, "binary OFF: no end to its header line in 4096 bytes");
+  }
+  if (!in) fail(path, "binary OFF: no end to its header line");
+  std::size_t p = 0, vertex_words = 3;
+  const auto prefix = [&](const char* letters, std::size_t words) {
+    const std::size_t n = std::strlen(letters);
+    if (header.compare(p, n, letters) != 0) return;
+    p += n;
+    vertex_words += words;
+  };
+  prefix("ST", 2);  // texture coordinate: 2 floats, after the colour
+  prefix("C", 3);   // vertex colour: 3 ints (OpenMesh reads no face colour unless asked)
+  prefix("N", 3);   // normal: 3 floats, after the point
+  if (p < header.size() && (header[p] == '4' || header[p] == 'n'))
+    fail(path, "binary OFF with other than 3 coordinates per vertex ('" + header + "') is not supported");
+  if (header.size() < p + 10 || header.compare(p, 3, "OFF") != 0 || header.compare(p + 4, 6, "BINARY") != 0)
+    fail(path, "binary OFF header must be the first line, '[ST][C][N]OFF BINARY', not '" + header + "'");
+  const unsigned long long body = header.size() + 1;
+
+  // Words come through a 1 MiB buffer; `at` is the file offset of the next one.
+  std::vector<char> buffer(std::size_t(1) << 20);
+  std::size_t next = 0, filled = 0;
+  unsigned long long at = body;
+  const auto word = [&](const std::string& where) -> std::uint32_t {
+    if (next + 4 > filled) {
+      std::memmove(buffer.data(), buffer.data() + next, filled - next);
+      filled -= next;
+      next = 0;
+      in.read(buffer.data() + filled, static_cast<std::streamsize>(buffer.size() - filled));
+      filled += static_cast<std::size_t>(in.gcount());
+      if (filled < 4) fail(path, "binary OFF ends at byte " + std::to_string(size) + ", inside " + where);
+    }
+    std::uint32_t w;
+    std::memcpy(&w, buffer.data() + next, 4);
+    next += 4;
+    at += 4;
+    return w;
+  };
+  const std::uint32_t nv = word("its counts"), nf = word("its counts");
+  word("its counts");  // edges, unused
+  // The least the counts need (a face is at least 4 words), before anything is allocated.
+  const unsigned long long need = 12 + 4ull * vertex_words * nv + 16ull * nf;
+  if (need > size - body) {
+    std::string why = "binary OFF announces " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                      " faces, at least " + std::to_string(need) + " bytes, but has " +
+                      std::to_string(size - body) + " after its header line";
+    const std::uint32_t snv = __builtin_bswap32(nv), snf = __builtin_bswap32(nf);
+    const unsigned long long swapped_need = 12 + 4ull * vertex_words * snv + 16ull * snf;
+    if (swapped_need <= size - body)
+      why += "; read big-endian (Geomview's byte order) the counts would be " + std::to_string(snv) + " and " + std::to_string(snf) +
+             ", but binary OFF is read here as OpenMesh reads and writes it, little-endian";
+    fail(path, why);
+  }
+  check_int_range(path, nv, "vertices");
+  walk.coords.reserve(3ull * nv);
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    const unsigned long long record = at;
+    const std::string where = "vertex " + std::to_string(v);
+    for (std::size_t w = 0; w < vertex_words; ++w) {
+      const std::uint32_t bits = word(where);
+      if (w >= 3) continue;  // normal, colour, texture coordinate: not kept
+      const float x = std::bit_cast<float>(bits);
+      if (!std::isfinite(x))
+        fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate (byte " + std::to_string(record) + ")");
+      walk.coords.push_back(x);
+    }
+  }
+  std::vector<int> corner;
+  for (std::uint32_t f = 0; f < nf; ++f) {
+    const unsigned long long record = at;
+    const std::string where = "face " + std::to_string(f);
+    const std::uint32_t k = word(where);
+    if (k < 3)
+      fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") has " + std::to_string(k) +
+                     " corners" +
+                     (f > 0 && k <= 1 ? std::string(" (a Geomview colour count after face ") + std::to_string(f - 1) +
+                                            "'s indices? OpenMesh's binary OFF, read here, has none)"
+                                      : std::string()));
+    if (4ull * k > size - at)
+      fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") announces " + std::to_string(k) +
+                     " corners, more than the rest of the file holds");
+    corner.clear();
+    for (std::uint32_t i = 0; i < k; ++i) {
+      const std::uint32_t idx = word(where);
+      if (idx >= nv)
+        fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") references vertex " +
+                       std::to_string(idx) + " but the mesh has " + std::to_string(nv) + " vertices");
+      corner.push_back(static_cast<int>(idx));
+    }
+    add_fan(walk, corner, f);
+  }
+  if (at != size)
+    fail(path, std::to_string(size - at) + " bytes after the last of its " + std::to_string(nf) +
+                   " faces (byte " + std::to_string(at) +
+                   "): not the layout OpenMesh reads (per-face colours, or a wrong count?)");
 }
 
 // OBJ: 'v' and 'f' records; a face corner is "v", "v/vt", "v/vt/vn" or "v//vn", and a negative
@@ -204,11 +326,127 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
                    " but the file has " + std::to_string(vertices) + " vertices");
 }
 
+// The lines of an ASCII STL as OpenMesh 9's reader takes them (STLReader.cc, read_stla): a line
+// containing "outer" (or "OUTER") opens a facet, and the next three lines are its corners, each
+// read as a word and three floats with `>>`, which on bad text keeps whatever the stream holds
+// (`vertex 0 1 zz` came out as (0, 1, 0), a missing coordinate as the last vertex's, `1e999` as
+// FLT_MAX). Fed the file's bytes in order, in pieces of any size; keeps only the current line
+// (at most 1 MiB). The first problem is kept as an error naming the line.
+class AsciiStlLines {
+ public:
+  void feed(const char* p, std::size_t n) {
+    while (n > 0 && error_.empty()) {
+      const char* nl = static_cast<const char*>(std::memchr(p, '\n', n));
+      const std::size_t len = nl ? static_cast<std::size_t>(nl - p) : n;
+      if (partial_.empty() && !overlong_ && nl) {
+        line(std::string_view(p, len));  // whole in this piece: not copied
+      } else {
+        if (!overlong_ && partial_.size() + len > kMaxLine) {
+          overlong_ = true;
+          partial_.clear();
+        }
+        if (!overlong_) partial_.append(p, len);
+        if (nl) {
+          line(partial_);
+          partial_.clear();
+          overlong_ = false;
+        }
+      }
+      if (!nl) break;
+      p = nl + 1;
+      n -= len + 1;
+    }
+  }
+  // At the end of the file: its last line, if it has no newline, and a facet cut short.
+  void finish() {
+    if (!error_.empty()) return;
+    if (!partial_.empty() || overlong_) line(partial_);
+    if (error_.empty() && corners_due_ > 0)
+      error_ = "the file ends " + std::to_string(corners_due_) + " vertex line(s) short of the facet opened on line " +
+               std::to_string(loop_line_);
+  }
+  const std::string& error() const { return error_; }
+
+ private:
+  static constexpr std::size_t kMaxLine = std::size_t(1) << 20;
+  static constexpr const char* kBlank = " \t\r\n\v\f";
+
+  static std::string quoted(std::string_view s) {
+    const auto b = s.find_first_not_of(kBlank);
+    if (b == std::string_view::npos) return "an empty line";
+    s = s.substr(b, s.find_last_not_of(kBlank) - b + 1);
+    return "'" + std::string(s.substr(0, 80)) + (s.size() > 80 ? "...'" : "'");
+  }
+  // Splits off the next blank-separated word of s (empty at the end).
+  static std::string_view word(std::string_view& s) {
+    const auto b = s.find_first_not_of(kBlank);
+    if (b == std::string_view::npos) return s = {};
+    const auto e = std::min(s.find_first_of(kBlank, b), s.size());
+    const std::string_view w = s.substr(b, e - b);
+    s.remove_prefix(e);
+    return w;
+  }
+  void problem(const std::string& what) { error_ = "line " + std::to_string(number_) + ": " + what; }
+
+  void line(std::string_view s) {
+    ++number_;
+    if (overlong_) return problem("longer than 1 MiB (not an STL line)");
+    std::string_view rest = s;
+    const std::string_view first = word(rest);
+    if (corners_due_ == 0) {
+      if (first == "vertex")
+        return problem("a vertex line outside a facet's three corners (OpenMesh's reader skips it): " + quoted(s));
+      if (s.find("outer") != std::string_view::npos || s.find("OUTER") != std::string_view::npos) {
+        corners_due_ = 3;
+        loop_line_ = number_;
+      }
+      return;
+    }
+    --corners_due_;
+    if (first != "vertex")
+      return problem("expected 'vertex x y z', corner " + std::to_string(3 - corners_due_) +
+                     " of the facet opened by 'outer' on line " + std::to_string(loop_line_) + ", found " + quoted(s));
+    int count = 0;
+    for (std::string_view w = word(rest); !w.empty(); w = word(rest), ++count) {
+      if (count == 3) return problem("vertex line with more than 3 coordinates: " + quoted(s));
+      // Decimal text only, as `>>` reads it (no hex, inf or nan), and finite as a float: STL
+      // stores 32-bit floats and `>>` turns 1e39 into FLT_MAX without a word. from_chars takes
+      // the common case fast; strtof the rest ('+', and out of range: underflow is fine).
+      float y = 0;
+      const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), y);
+      if (ec == std::errc() && ptr == w.data() + w.size()) {
+        if (std::isfinite(y)) continue;
+        return problem("non-finite vertex coordinate '" + std::string(w) +
+                       "' (STL coordinates are 32-bit floats, at most about 3.4e38): " + quoted(s));
+      }
+      number_text_.assign(w);
+      char* end = nullptr;
+      const float x = std::strtof(number_text_.c_str(), &end);
+      const bool whole = end == number_text_.c_str() + number_text_.size();
+      if (whole && !std::isfinite(x))
+        return problem("non-finite vertex coordinate '" + number_text_ +
+                       "' (STL coordinates are 32-bit floats, at most about 3.4e38): " + quoted(s));
+      if (!whole || number_text_.find_first_not_of("0123456789+-.eE") != std::string::npos)
+        return problem("vertex coordinate '" + number_text_ + "' is not a number: " + quoted(s));
+    }
+    if (count < 3) return problem("vertex line with " + std::to_string(count) + " of 3 coordinates: " + quoted(s));
+  }
+
+  std::string partial_;        // the current line's bytes from earlier pieces
+  bool overlong_ = false;      // the current line passed kMaxLine (its bytes are dropped)
+  long long number_ = 0;       // lines ended so far
+  int corners_due_ = 0;        // vertex lines the open facet still needs
+  long long loop_line_ = 0;    // the line that opened it
+  std::string number_text_;    // a coordinate, NUL-terminated for strtof
+  std::string error_;
+};
+
 // STL: ASCII counts 'facet' records, binary stores the triangle count at byte 80. Vertices are
 // merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance. A binary
 // file is not read here beyond its header (OpenMesh reads it next). A file that starts with
 // "solid" is ASCII if the word "facet" occurs in it (some binary exporters start their header
-// with "solid" too); it is streamed in chunks, never held whole.
+// with "solid" too); it is streamed in chunks, never held whole, and the same pass checks its
+// lines (AsciiStlLines), whose error is raised once the file is known to be ASCII.
 long long count_stl_triangles(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file");
@@ -224,6 +462,8 @@ long long count_stl_triangles(const std::string& path) {
     std::size_t carried = 0;  // bytes at the buffer's front already searched
     long long opening = 0;
     bool any = false;
+    AsciiStlLines lines;
+    lines.feed(head.data(), head.size());
     std::string chunk(kChunk, '\0');
     while (true) {
       for (std::size_t pos = buffer.find("facet"); pos != std::string::npos; pos = buffer.find("facet", pos + 5)) {
@@ -232,15 +472,21 @@ long long count_stl_triangles(const std::string& path) {
         // "endfacet" also contains "facet": count only the opening keyword.
         if (!(pos >= 3 && buffer.compare(pos - 3, 3, "end") == 0)) ++opening;
       }
+      if (any && !lines.error().empty()) break;  // ASCII, with a bad line: no need to read on
       if (!in) break;
       in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
       const auto got = static_cast<std::size_t>(in.gcount());
       if (got == 0) break;
+      lines.feed(chunk.data(), got);
       carried = std::min(kCarry, buffer.size());
       buffer.erase(0, buffer.size() - carried);
       buffer.append(chunk, 0, got);
     }
-    if (any) return opening;
+    if (any) {
+      lines.finish();
+      if (!lines.error().empty()) fail(path, lines.error());
+      return opening;
+    }
   }
   if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
   std::uint32_t n = 0;
@@ -296,15 +542,15 @@ IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const 
   return om;
 }
 
-// Binary OFF and STL: OpenMesh reads them; what it dropped or duplicated is detected by counts.
-// stl: OpenMesh merged the file's corners into vertices.
-TriangleMesh read_through_openmesh(const std::string& path, long long file_triangles, bool stl) {
+// STL: OpenMesh reads it, merging the file's corners into vertices; what it dropped or
+// duplicated is detected by counts.
+TriangleMesh read_stl_through_openmesh(const std::string& path, long long file_triangles) {
   IoMesh om;
   OpenMesh::IO::Options opt;
   if (!OpenMesh::IO::read_mesh(om, path, opt)) fail(path, "OpenMesh could not parse the file");
   const long long nv = static_cast<long long>(om.n_vertices());
   const long long nf = static_cast<long long>(om.n_faces());
-  if (stl) {
+  {
     // STL has no vertex list to count against; OpenMesh merges equal corners, so two loaded
     // vertices at exactly the same position mean it split a vertex to add a non-manifold face.
     std::vector<std::array<double, 3>> points;
@@ -318,7 +564,7 @@ TriangleMesh read_through_openmesh(const std::string& path, long long file_trian
       fail(path, "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
                  "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
   }
-  if (file_triangles >= 0 && nf < file_triangles)
+  if (nf < file_triangles)
     fail(path, "only " + std::to_string(nf) + " of the file's " + std::to_string(file_triangles) +
                    " triangles could be added: the mesh has non-manifold (complex) edges, repeated "
                    "vertex indices in a face, or inconsistently oriented faces");
@@ -351,13 +597,13 @@ TriangleMesh read_mesh(const std::string& path) {
   const std::string ext = lower_extension(path);
   WalkedMesh walk;
   if (ext == ".off") {
-    if (!walk_off(path, walk)) return read_through_openmesh(path, -1, false);
+    if (!walk_off(path, walk)) walk_off_binary(path, walk);
   } else if (ext == ".obj") {
     walk_obj(path, walk);
   } else if (ext == ".ply") {
     walk = scan_ply(path);  // a full walk of header and body (ply_format.cpp)
   } else if (ext == ".stl") {
-    return read_through_openmesh(path, count_stl_triangles(path), true);
+    return read_stl_through_openmesh(path, count_stl_triangles(path));
   } else {
     fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
   }

@@ -1,6 +1,6 @@
 #pragma once
-// Reading and writing OFF, PLY (ASCII and binary), OBJ and STL. OFF, OBJ and PLY are read and
-// written by our own code, in exact doubles; STL (and binary OFF) through OpenMesh. Every mesh
+// Reading and writing OFF, PLY (ASCII and binary), OBJ and STL. OFF (binary OFF read only), OBJ
+// and PLY are read and written by our own code, in exact doubles; STL through OpenMesh. Every mesh
 // read, and every mesh written unless the caller vouches for its faces (FaceCheck), is added face
 // by face to an OpenMesh half-edge mesh, whose insertion finds non-manifold edges and vertices
 // and inconsistently oriented faces.

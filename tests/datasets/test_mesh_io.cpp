@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <random>
@@ -564,6 +565,101 @@ TEST(MeshIo, AsciiStlCountedAcrossReadChunks) {
   place("facet normal", kBoundary - 5);
 }
 
+// The tetrahedron of kTetraOff as ASCII STL, one keyword per line: line 3 opens the first facet,
+// lines 4-6 are its corners (then 11-13, 18-20, 25-27).
+const char* kTetraStl =
+    "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+    "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+    "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n"
+    "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1\nendloop\nendfacet\nendsolid t\n";
+
+// text with its line `number` (from 1) replaced by `line` (which may hold several lines, or none).
+std::string with_line(const std::string& text, int number, const std::string& line) {
+  std::size_t begin = 0;
+  for (int n = 1; n < number; ++n) begin = text.find('\n', begin) + 1;
+  return text.substr(0, begin) + line + text.substr(text.find('\n', begin));
+}
+
+// OpenMesh's reader takes the three lines after one containing "outer" as a facet's corners, a
+// word and three floats each, and reads bad text without a word (`vertex 0 1 zz` as (0, 1, 0), a
+// missing coordinate as the last vertex's, 1e999 as FLT_MAX): the streaming pass that counts the
+// facets checks those lines, and the error names the line.
+TEST(MeshIo, AsciiStlVertexLinesChecked) {
+  TempDir dir;
+  const std::string tetra = kTetraStl;
+  ASSERT_EQ(read_mesh(dir.write("tetra.stl", tetra)).num_faces(), 4);
+  const std::pair<std::string, std::string> bad[] = {
+      {with_line(tetra, 6, "vertex 1 0 zz"), "line 6: vertex coordinate 'zz' is not a number: 'vertex 1 0 zz'"},
+      {with_line(tetra, 5, "  vertex 0 1"), "line 5: vertex line with 2 of 3 coordinates: 'vertex 0 1'"},
+      {with_line(tetra, 12, "vertex 1e999 0 0"), "line 12: non-finite vertex coordinate '1e999'"},
+      {with_line(tetra, 12, "vertex 1e39 0 0"), "line 12: non-finite vertex coordinate '1e39' (STL coordinates are 32-bit floats"},
+      {with_line(tetra, 12, "vertex -inf 0 0"), "line 12: non-finite vertex coordinate '-inf'"},
+      {with_line(tetra, 27, "vertex 0 0 nan"), "line 27: non-finite vertex coordinate 'nan'"},
+      {with_line(tetra, 12, "vertex 0x1p0 0 0"), "line 12: vertex coordinate '0x1p0' is not a number"},
+      {with_line(tetra, 12, "vertex 1 0 0 0"), "line 12: vertex line with more than 3 coordinates"},
+      {with_line(tetra, 6, "endloop"), "line 6: expected 'vertex x y z', corner 3 of the facet opened by 'outer' on line 3, found 'endloop'"},
+      {with_line(tetra, 3, "outer loop\n"), "line 4: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 3, found an empty line"},
+      {with_line(tetra, 6, "vertex 1 0 0\nvertex 1 1 0"), "line 7: a vertex line outside a facet's three corners"},
+      {with_line(tetra, 1, "solid outer_shell"), "line 2: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 1"},
+      {tetra.substr(0, tetra.find("vertex 1 0 0")), "the file ends 1 vertex line(s) short of the facet opened on line 3"},
+  };
+  for (const auto& [text, message] : bad) {
+    SCOPED_TRACE(message);
+    expect_error_naming(dir.write("bad.stl", text), message);
+  }
+  // What `>>` reads as the same numbers still loads: signs, exponents, tabs, an underflow to 0,
+  // CR LF line ends, no newline at the end.
+  std::string good = with_line(with_line(tetra, 4, "vertex 0 0 1e-50"), 6, "\tvertex\t+1.0E+0\t0.0\t-0e-3 ");
+  good.pop_back();
+  std::string crlf;
+  for (char c : good) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  for (const std::string& text : {good, crlf}) {
+    const TriangleMesh m = read_mesh(dir.write("good.stl", text));
+    EXPECT_EQ(m.num_faces(), 4);
+    EXPECT_EQ(m.num_vertices(), 4);
+  }
+}
+
+// The lines are checked in the same 1 MiB chunks the facets are counted in, so a line, a keyword
+// or a number can straddle a chunk: each is put across the first boundary after the 84-byte head
+// (by widening the indentation of a vertex line), once valid (the file loads) and once bad (the
+// error names the right line).
+TEST(MeshIo, AsciiStlLinesCheckedAcrossReadChunks) {
+  TempDir dir;
+  const TriangleMesh m = make_icosphere(5);
+  const std::string plain = dir.file("plain.stl");
+  write_mesh(plain, m, false);
+  const std::string text = file_bytes(plain);
+  constexpr std::size_t kBoundary = 84 + (std::size_t(1) << 20);
+  ASSERT_GT(text.size(), kBoundary + 1000);
+  // A vertex line ending some 200 bytes before the boundary (its number: `number`) is replaced by
+  // `line`, indented so that its byte `split` falls on the boundary.
+  const std::size_t at = text.rfind("\nvertex", kBoundary - 200) + 1, end = text.find('\n', at);
+  const std::string original = text.substr(at, end - at);
+  const long long number = std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1;
+  const auto place = [&](const std::string& line, std::size_t split, const std::string& message) {
+    ASSERT_LE(at + split, kBoundary);
+    const std::string placed = text.substr(0, at) + std::string(kBoundary - split - at, ' ') + line + text.substr(end);
+    ASSERT_EQ(placed.compare(kBoundary - split, line.size() + 1, line + "\n"), 0);
+    SCOPED_TRACE("'" + line + "' split at " + std::to_string(split) + ", line " + std::to_string(number));
+    const auto path = dir.write("chunks.stl", placed);
+    if (message.empty()) {
+      EXPECT_EQ(read_mesh(path).num_faces(), m.num_faces());
+    } else {
+      expect_error_naming(path, "line " + std::to_string(number) + ": " + message);
+    }
+  };
+  place(original, 0, "");                    // the line starts the chunk
+  place(original, 3, "");                    // "ver|tex"
+  place(original, 10, "");                   // inside its first number
+  place(original, original.size(), "");      // its newline starts the chunk
+  place(original, original.size() + 1, "");  // its newline ends the chunk
+  place("vertex 0 0 1e999", 13, "non-finite vertex coordinate '1e999'");   // "1e|999"
+  place("vertex 0 1 zz", 12, "vertex coordinate 'zz' is not a number");    // "z|z"
+  place("vertex 0 1", 10, "vertex line with 2 of 3 coordinates");         // its newline starts the chunk
+  place("vertex 0 1 0 0", 3, "vertex line with more than 3 coordinates");  // "ver|tex"
+}
+
 // A binary STL is checked by its header's triangle count against the file's length; one whose
 // header starts with "solid" (as some exporters write) is still binary when it has no facet.
 TEST(MeshIo, BinaryStlHeaderAndLength) {
@@ -584,6 +680,98 @@ TEST(MeshIo, BinaryStlHeaderAndLength) {
   const TriangleMesh r = read_mesh(dir.write("solid_header.stl", solid));
   EXPECT_EQ(r.num_faces(), m.num_faces());
   EXPECT_EQ(r.num_vertices(), m.num_vertices());
+}
+
+// A binary OFF: its header line, then 32-bit words, little-endian (as OpenMesh writes it on
+// x86) unless big_endian (as Geomview's spec has it).
+struct BinaryOff {
+  std::string bytes;
+  bool big_endian = false;
+  explicit BinaryOff(const std::string& header = "OFF BINARY") : bytes(header + "\n") {}
+  BinaryOff& word(std::uint32_t w) {
+    for (int i = 0; i < 4; ++i) bytes += static_cast<char>(w >> 8 * (big_endian ? 3 - i : i));
+    return *this;
+  }
+  BinaryOff& real(float x) { return word(std::bit_cast<std::uint32_t>(x)); }
+};
+
+// The tetrahedron of kTetraOff with vertex 3 at z = 0.1f, its faces followed by Geomview's colour
+// count 0 where colour_counts, and with a normal after each point where normals.
+BinaryOff binary_off_tetra(bool colour_counts = false, bool normals = false, bool big_endian = false) {
+  BinaryOff off(normals ? "NOFF BINARY" : "OFF BINARY");
+  off.big_endian = big_endian;
+  off.word(4).word(4).word(0);
+  const float points[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 0.1f}};
+  for (const auto& p : points) {
+    off.real(p[0]).real(p[1]).real(p[2]);
+    if (normals) off.real(0).real(0).real(1);
+  }
+  for (const auto& f : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}) {
+    off.word(3).word(f[0]).word(f[1]).word(f[2]);
+    if (colour_counts) off.word(0);
+  }
+  return off;
+}
+
+// Binary OFF is walked in the layout OpenMesh reads and writes (the bytes of binary_off_tetra() are
+// those OpenMesh 9's writer writes for it): floats widened exactly, polygons fanned as in ASCII.
+TEST(MeshIo, BinaryOffInOpenMeshsLayout) {
+  TempDir dir;
+  for (bool normals : {false, true}) {
+    SCOPED_TRACE(normals ? "NOFF" : "OFF");
+    const auto path = dir.write(normals ? "tetra_n.off" : "tetra.off", binary_off_tetra(false, normals).bytes);
+    const TriangleMesh m = read_mesh(path);
+    ASSERT_EQ(m.num_vertices(), 4);
+    ASSERT_EQ(m.num_faces(), 4);
+    EXPECT_EQ(m.vertices.row(3), Eigen::RowVector3d(0, 0, static_cast<double>(0.1f)));
+    const TriangleMesh ascii = read_mesh(dir.write("tetra_ascii.off", kTetraOff));
+    EXPECT_EQ(m.faces, ascii.faces);
+    const MeshReport r = validate_mesh(m, path);
+    EXPECT_TRUE(r.closed());
+    EXPECT_EQ(r.faces, 4);
+  }
+  // A pyramid with a quad base: 6 triangles, as the ASCII file gives them.
+  BinaryOff pyramid;
+  pyramid.word(5).word(5).word(0);
+  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 0.f, 0.f, 1.f, 0.f, 0.5f, 0.5f, 1.f}) pyramid.real(x);
+  pyramid.word(4).word(0).word(3).word(2).word(1);
+  for (std::uint32_t a = 0; a < 4; ++a) pyramid.word(3).word(a).word((a + 1) % 4).word(4);
+  const TriangleMesh b = read_mesh(dir.write("pyramid.off", pyramid.bytes));
+  const TriangleMesh a = read_mesh(dir.write("pyramid_ascii.off", "OFF\n5 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n"
+                                                                 "4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n"));
+  EXPECT_EQ(b.faces, a.faces);
+  EXPECT_EQ(b.vertices, a.vertices);
+  EXPECT_EQ(b.num_faces(), 6);
+}
+
+// OpenMesh's reader loads a file in another layout without a word: Geomview's colour count 0
+// after each face read as the next face's corner count made it skip every other face (the
+// tetrahedron loaded as 2 faces with a boundary). Every such mismatch is an error naming the file.
+TEST(MeshIo, BinaryOffLosesNoFace) {
+  TempDir dir;
+  expect_error_naming(dir.write("colours.off", binary_off_tetra(true).bytes),
+                      "face 1 (byte 87) has 0 corners (a Geomview colour count after face 0's indices?");
+  expect_error_naming(dir.write("big.off", binary_off_tetra(false, false, true).bytes),
+                      "read big-endian (Geomview's byte order) the counts would be 4 and 4");
+  expect_error_naming(dir.write("trailing.off", binary_off_tetra().word(0).bytes),
+                      "4 bytes after the last of its 4 faces (byte 135)");
+  std::string bytes = binary_off_tetra().bytes;
+  // Counts are checked against the length before anything is read (layout: 11 header bytes, 12
+  // of counts, 12 per vertex from byte 23, 16 per triangle from byte 71).
+  expect_error_naming(dir.write("truncated.off", bytes.substr(0, bytes.size() - 2)),
+                      "announces 4 vertices and 4 faces, at least 124 bytes, but has 122 after its header line");
+  std::string seven = bytes;
+  seven[119] = 7;
+  expect_error_naming(dir.write("seven.off", seven), "face 3 (byte 119) announces 7 corners, more than the rest of the file holds");
+  BinaryOff range = binary_off_tetra();
+  range.bytes.resize(range.bytes.size() - 4);
+  expect_error_naming(dir.write("range.off", range.word(9).bytes), "face 3 (byte 119) references vertex 9 but the mesh has 4");
+  BinaryOff nan = binary_off_tetra();
+  nan.bytes.replace(23 + 12 + 4, 4, BinaryOff("").real(std::numeric_limits<float>::quiet_NaN()).bytes.substr(1));
+  expect_error_naming(dir.write("nan.off", nan.bytes), "vertex 1 has a non-finite coordinate (byte 35)");
+  // OpenMesh takes the first line for the header, and reads no 4D or nOFF binary file.
+  expect_error_naming(dir.write("comment.off", "# made by hand\n" + bytes), "header must be the first line");
+  expect_error_naming(dir.write("4d.off", "4" + bytes), "other than 3 coordinates per vertex");
 }
 
 TEST(MeshIo, WriteIntoMissingFolderFails) {
