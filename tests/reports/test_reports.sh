@@ -60,6 +60,9 @@ done
 # Contents: paper values beside ours, fitted orders, singular stop recorded, index links all.
 grep -q "Paper (Table 1)" "$work/out/table1.md" || { echo "FAIL: table1 lacks the paper table"; fail=1; }
 grep -q "1.4 + 0.22" "$work/out/table1.md" || { echo "FAIL: table1 lacks the paper row beside ours"; fail=1; }
+# Step 1's pattern build is the set-up's "+system", not a per-step time.
+grep "sphere:vertices=40000" "$work/out/table1.md" | grep -q "(+0.5) | 0.0103 + 0.002 |" ||
+  { echo "FAIL: table1 counts step 1's system construction as a per-step time"; fail=1; }
 grep -q "spiral:turns=3 at depth .*, tracked: singular (solver: not_positive_definite)" "$work/out/table1.md" ||
   { echo "FAIL: table1 does not name the stopped flow"; fail=1; }
 grep "spiral:turns=3" "$work/out/table1.md" | grep -q "×" &&
