@@ -366,6 +366,9 @@ class AsciiStlLines {
                std::to_string(loop_line_);
   }
   const std::string& error() const { return error_; }
+  /// Facets opened so far: the triangles OpenMesh's reader will try to add, to compare with those
+  /// it added. (The word "facet" is no count: a solid may be named "facet_x".)
+  long long facets() const { return facets_; }
 
  private:
   static constexpr std::size_t kMaxLine = std::size_t(1) << 20;
@@ -399,6 +402,7 @@ class AsciiStlLines {
       if (s.find("outer") != std::string_view::npos || s.find("OUTER") != std::string_view::npos) {
         corners_due_ = 3;
         loop_line_ = number_;
+        ++facets_;
       }
       return;
     }
@@ -436,12 +440,14 @@ class AsciiStlLines {
   bool overlong_ = false;      // the current line passed kMaxLine (its bytes are dropped)
   long long number_ = 0;       // lines ended so far
   int corners_due_ = 0;        // vertex lines the open facet still needs
+  long long facets_ = 0;       // facets opened ('outer' lines): the triangles OpenMesh tries to add
   long long loop_line_ = 0;    // the line that opened it
   std::string number_text_;    // a coordinate, NUL-terminated for strtof
   std::string error_;
 };
 
-// STL: ASCII counts 'facet' records, binary stores the triangle count at byte 80. Vertices are
+// STL: ASCII counts the facets OpenMesh opens ('outer' lines, AsciiStlLines), binary stores the
+// triangle count at byte 80. Vertices are
 // merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance. A binary
 // file is not read here beyond its header (OpenMesh reads it next). A file that starts with
 // "solid" is ASCII if the word "facet" occurs in it (some binary exporters start their header
@@ -455,37 +461,29 @@ long long count_stl_triangles(const std::string& path) {
   head.resize(static_cast<size_t>(in.gcount()));
   const auto start = head.find_first_not_of(" \t\r\n");
   if (start != std::string::npos && head.compare(start, 5, "solid") == 0) {
-    // Each chunk is searched behind the last 7 bytes of the one before ("endfacet" less one), so
-    // a keyword across a boundary is found, and counted only where it ends in the new bytes.
-    constexpr std::size_t kCarry = 7, kChunk = std::size_t(1) << 20;
+    // Each chunk is searched for "facet" (which makes the file ASCII) behind the last 4 bytes of
+    // the one before, so a keyword across a boundary is found.
+    constexpr std::size_t kCarry = 4, kChunk = std::size_t(1) << 20;
     std::string buffer = head.substr(start);
-    std::size_t carried = 0;  // bytes at the buffer's front already searched
-    long long opening = 0;
     bool any = false;
     AsciiStlLines lines;
     lines.feed(head.data(), head.size());
     std::string chunk(kChunk, '\0');
     while (true) {
-      for (std::size_t pos = buffer.find("facet"); pos != std::string::npos; pos = buffer.find("facet", pos + 5)) {
-        if (pos + 5 <= carried) continue;  // found with the previous chunk
-        any = true;
-        // "endfacet" also contains "facet": count only the opening keyword.
-        if (!(pos >= 3 && buffer.compare(pos - 3, 3, "end") == 0)) ++opening;
-      }
+      any = any || buffer.find("facet") != std::string::npos;
       if (any && !lines.error().empty()) break;  // ASCII, with a bad line: no need to read on
       if (!in) break;
       in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
       const auto got = static_cast<std::size_t>(in.gcount());
       if (got == 0) break;
       lines.feed(chunk.data(), got);
-      carried = std::min(kCarry, buffer.size());
-      buffer.erase(0, buffer.size() - carried);
+      buffer.erase(0, buffer.size() - std::min(kCarry, buffer.size()));
       buffer.append(chunk, 0, got);
     }
     if (any) {
       lines.finish();
       if (!lines.error().empty()) fail(path, lines.error());
-      return opening;
+      return lines.facets();
     }
   }
   if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header");

@@ -531,9 +531,10 @@ TEST(MeshIo, RoundTripObj) { expect_round_trip("t.obj", false, 1e-15); }
 TEST(MeshIo, RoundTripStlAscii) { expect_round_trip("t.stl", false, 1e-6, false); }
 TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false); }
 
-// An ASCII STL is counted in chunks of 1 MiB read after its 84-byte head (mesh_io.cpp). The
-// count is what notices a facet OpenMesh drops without an error (here a degenerate one), so a
-// keyword missed or counted twice at a chunk boundary would hide it or blame a wrong number.
+// An ASCII STL is counted in chunks of 1 MiB read after its 84-byte head (mesh_io.cpp: the
+// facets its lines open, and the word "facet" that makes it ASCII). The count is what notices a
+// facet OpenMesh drops without an error (here a degenerate one), so a keyword missed or counted
+// twice at a chunk boundary would hide it or blame a wrong number.
 // One file per way a keyword can meet the first boundary, moved there by blanks ("fa|cet",
 // "end|facet", "endfa|cet", and an opening "facet" that ends exactly at it, seen again behind
 // the next chunk), so that no two mistakes can cancel.
@@ -617,6 +618,11 @@ TEST(MeshIo, AsciiStlVertexLinesChecked) {
     const TriangleMesh m = read_mesh(dir.write("good.stl", text));
     EXPECT_EQ(m.num_faces(), 4);
     EXPECT_EQ(m.num_vertices(), 4);
+  }
+  // The facets are those 'outer' opens, not the word "facet": a solid may carry it in its name.
+  for (const char* name : {"solid facet_x", "solid endfacet facet", "solid"}) {
+    SCOPED_TRACE(name);
+    EXPECT_EQ(read_mesh(dir.write("named.stl", with_line(tetra, 1, name))).num_faces(), 4);
   }
 }
 
