@@ -52,6 +52,18 @@ void check_config_object(const json& j, const std::string& source, const std::st
   }
 }
 
+/// `defaults` with its dotted keys ("solver.name": v, as axes, zip and exclude name keys) put in
+/// place as nested objects, which the flow config reads; a dotted key is applied after the nested
+/// object of the same name, so it wins over it.
+json nest_dotted_keys(const json& defaults) {
+  json nested = json::object();
+  for (auto it = defaults.begin(); it != defaults.end(); ++it)
+    if (it.key().find('.') == std::string::npos) nested[it.key()] = *it;
+  for (auto it = defaults.begin(); it != defaults.end(); ++it)
+    if (it.key().find('.') != std::string::npos) set_json_path(nested, it.key(), *it);
+  return nested;
+}
+
 /// One dimension of the matrix: several keys that vary together (one key for an axis).
 struct Dimension {
   std::vector<std::string> keys;
@@ -244,6 +256,7 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
   json defaults = member(j, "defaults");
   if (defaults.is_null()) defaults = json::object();
   check_config_object(defaults, source, "defaults.");
+  defaults = nest_dotted_keys(defaults);
   check_axes(member(j, "axes"), source, "axes");
   check_zip(member(j, "zip"), source, "zip");
   check_exclude(member(j, "exclude"), source, "exclude");
@@ -271,7 +284,7 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
       if (quick_metrics) e.metrics = quick_metric_config;
       // defaults: deep merge; axes: per key (a quick axis replaces the full one);
       // zip, exclude, repetitions: replaced as a whole.
-      if (q.contains("defaults")) defaults.merge_patch(q["defaults"]);
+      if (q.contains("defaults")) defaults.merge_patch(nest_dotted_keys(q["defaults"]));
       if (q.contains("axes")) {
         if (axes.is_null()) axes = json::object();
         for (auto it = q["axes"].begin(); it != q["axes"].end(); ++it) axes[it.key()] = *it;

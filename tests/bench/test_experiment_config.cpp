@@ -114,6 +114,28 @@ TEST(ExperimentConfig, QuickOverridesTheFullMatrix) {
   EXPECT_EQ(full.cells[0].config["steps"], 100);
 }
 
+// Dotted keys in `defaults` (as axes, zip and exclude name keys, and as the unknown-key message
+// lists them) set the nested option; a dotted key wins over the nested object of its name, and
+// quick.defaults takes them too. (They were accepted by the check and then refused per cell.)
+TEST(ExperimentConfig, DottedKeysInDefaultsSetTheNestedOption) {
+  const json j = {{"name", "s"},
+                  {"defaults", {{"mesh", "icosphere:level=1"},
+                                {"solver", {{"name", "cholmod"}, {"tolerance", 1e-6}}},
+                                {"solver.name", "pcg"},
+                                {"octree.depth", 5}}},
+                  {"axes", {{"flow", {"mcf"}}}},
+                  {"quick", {{"defaults", {{"octree.tracking", "rebuilt"}}}}}};
+  for (const bool quick : {false, true}) {
+    const auto e = expand(j, quick);
+    ASSERT_EQ(e.cells.size(), 1u);
+    const json& c = e.cells[0].config;
+    EXPECT_EQ(c["solver"]["name"], "pcg");
+    EXPECT_EQ(c["solver"]["tolerance"], 1e-6);  // the nested object's other keys kept
+    EXPECT_EQ(c["octree"]["depth"], 5);
+    EXPECT_EQ(c["octree"]["tracking"], quick ? "rebuilt" : "tracked");
+  }
+}
+
 TEST(ExperimentConfig, MetricsAreReadStrictly) {
   json defaults = base;
   defaults["steps"] = 100;
