@@ -29,6 +29,7 @@
 #include "bases/tracked_octree_basis.h"
 #include "bench/environment.h"
 #include "datasets/mesh_spec.h"
+#include "solvers/blas_threads.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"
 #include "solvers/symmetric_multiply.h"
@@ -496,6 +497,8 @@ void BM_Step_HatCholmod(benchmark::State& state) {
     return h;
   });
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
+  // CHOLMOD's BLAS at the same count, as a flow with `threads` runs it (solvers/blas_threads.h).
+  const ScopedBlasThreads blas(int(state.range(0)));
   HatBasis& basis = *f.basis;
   const Coefficients x = f.source->mesh.vertices;
   CholmodSolver solver;
