@@ -127,17 +127,9 @@ SolveReport CholmodSolver::fail(SolveStatus status, std::string message) {
 
 template <class Fill>
 SolveReport CholmodSolver::factorize(const SparseRef& A, std::uint64_t key, Fill fill) {
-  // A key the cached pattern was set with vouches for A's pattern (linear_solver.h); the O(1)
-  // checks stay, so a caller's mistake in size is still caught. Otherwise compare exactly.
+  // A key vouches for A's pattern, else it is compared exactly (KeptPattern, linear_solver.h).
   const bool sized = lower_ && A.rows() == rows_ && A.nonZeros() == nonzeros_;
-  const bool vouched = sized && key != 0 && key == key_;
-  bool same = vouched;
-  if (sized && !vouched) {
-    ++pattern_comparisons_;
-    same = same_pattern(A);
-  }
-  key_ = key;  // later calls with it are vouched for against this call's (now cached) pattern
-  if (!same) {
+  if (!kept_.same(sized, key, [&] { return same_pattern(A); })) {
     free_all();
     rows_ = -1;
     build_lower(A);

@@ -39,7 +39,7 @@ class CholmodSolver final : public LinearSolver {
   int analyses() const { return analyses_; }
   /// Number of exact pattern comparisons done so far (a call whose pattern_key vouches for the
   /// pattern skips it; so does a call that must re-analyze anyway).
-  int pattern_comparisons() const { return pattern_comparisons_; }
+  int pattern_comparisons() const { return kept_.comparisons(); }
   /// Number of numeric factorizations done so far.
   int factorizations() const { return factorizations_; }
   /// True if the last set_matrix produced a usable factor.
@@ -78,14 +78,13 @@ class CholmodSolver final : public LinearSolver {
 
   std::int64_t rows_ = -1;
   std::int64_t nonzeros_ = 0;  // of the full A the cached pattern came from
-  std::uint64_t key_ = 0;      // pattern_key of the cached pattern (0: none given)
+  KeptPattern kept_;           // the key of the cached pattern, the comparisons made
   // lower_->x[e] = A.valuePtr()[gather_[e]]: refreshing values is one gather, no pattern work.
   // Together with lower_'s own pattern it is also what a new A is compared against, so no copy
   // of A's full pattern is kept (94 MB at depth 9). Positions in an int-indexed matrix: int.
   std::vector<int> gather_;
 
   int analyses_ = 0;
-  int pattern_comparisons_ = 0;
   int factorizations_ = 0;
   bool factor_ok_ = false;
   SolveStatus last_status_ = SolveStatus::failed;

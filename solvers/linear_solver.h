@@ -58,6 +58,31 @@ struct HierarchyView {
 /// A key never returned before in this process (thread-safe); never 0.
 std::uint64_t new_pattern_key();
 
+/// What a direct or Krylov solver keeps to tell whether a new matrix has the pattern it holds:
+/// the pattern_key it was last given, and a count of exact comparisons (tests read it). One rule
+/// for all of them: the O(1) checks (`sized`: size and number of nonzeros) are never skipped, so
+/// a stale key on a matrix of another size still means a new pattern; past them, the key of the
+/// previous call vouches, and anything else is compared. (The multigrid keeps its key only once
+/// its levels are built, since a call can fail half-way: multigrid.cpp.)
+class KeptPattern {
+ public:
+  template <class Compare>
+  bool same(bool sized, std::uint64_t key, Compare compare) {
+    bool same = sized && key != 0 && key == key_;
+    if (sized && !same) {
+      ++comparisons_;
+      same = compare();
+    }
+    key_ = key;  // later calls with it are vouched for against this call's pattern
+    return same;
+  }
+  int comparisons() const { return comparisons_; }
+
+ private:
+  std::uint64_t key_ = 0;
+  int comparisons_ = 0;
+};
+
 /// Whether two compressed matrices have the same sparsity pattern (size, column starts and row
 /// indices compared exactly; values ignored). False when either is not compressed.
 bool same_pattern(const SparseRef& A, const SparseRef& B);

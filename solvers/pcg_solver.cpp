@@ -155,15 +155,8 @@ SolveReport PcgSolver::build_preconditioner() {
 }
 
 bool PcgSolver::keeps_pattern(const SparseRef& A, std::uint64_t key) {
-  // The O(1) checks stay under a key, so a caller's mistake in size is still caught.
   const bool sized = A_.rows() == A.rows() && A_.cols() == A.cols() && A_.nonZeros() == A.nonZeros();
-  bool same = sized && key != 0 && key == key_;
-  if (sized && !same) {
-    ++pattern_comparisons_;
-    same = same_pattern(A, A_);
-  }
-  key_ = key;  // later calls with it are vouched for against this call's pattern
-  return same;
+  return kept_.same(sized, key, [&] { return same_pattern(A, A_); });
 }
 
 SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {

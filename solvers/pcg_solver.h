@@ -62,7 +62,7 @@ class PcgSolver final : public LinearSolver {
   void multiply(const ConstMatrixRef& X, Eigen::MatrixXd& Y) const;
 
   /// How many set_matrix calls compared the new pattern index by index with the kept one.
-  int pattern_comparisons() const { return pattern_comparisons_; }
+  int pattern_comparisons() const { return kept_.comparisons(); }
 
  protected:
   /// Block PCG from the warm start X (solve(): zero if a resizable X has another shape).
@@ -79,8 +79,7 @@ class PcgSolver final : public LinearSolver {
   PcgOptions options_;
   Preconditioner external_;
   SparseMatrix A_;
-  std::uint64_t key_ = 0;  // pattern_key of the call that set A_'s pattern or vouched for it
-  int pattern_comparisons_ = 0;
+  KeptPattern kept_;  // the key of A_'s pattern, the comparisons made
   bool have_matrix_ = false;
   SolveStatus matrix_status_ = SolveStatus::failed;
   std::string matrix_message_ = "set_matrix not called";
