@@ -39,16 +39,17 @@ std::string hostname() {
 
 nlohmann::json environment_json(int threads) {
   const int cores = int(std::thread::hardware_concurrency());
+  // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the config
+  // asked for (that request is in "config.threads"); the flow caps OpenBLAS, under CHOLMOD, at
+  // the same count (solvers/blas_threads.h).
+  const int ran = threads > 0 ? std::min(threads, tbb::info::default_concurrency()) : tbb::info::default_concurrency();
   const auto v = [](int a, int b, int c) { return std::to_string(a) + "." + std::to_string(b) + "." + std::to_string(c); };
   return {{"commit", MCFBENCH_GIT_COMMIT},
           {"version", MCFBENCH_VERSION},
           {"cpu", cpu_model()},
           {"cores", cores},
-          // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the
-          // config asked for (that request is in "config.threads").
-          {"threads", threads > 0 ? std::min(threads, tbb::info::default_concurrency()) : tbb::info::default_concurrency()},
-          // The flow caps OpenBLAS (under CHOLMOD) at the same count (solvers/blas_threads.h).
-          {"blas_threads", threads > 0 ? std::min(threads, tbb::info::default_concurrency()) : tbb::info::default_concurrency()},
+          {"threads", ran},
+          {"blas_threads", ran},
           {"hostname", hostname()},
           {"build", {{"type", MCFBENCH_BUILD_TYPE}, {"compiler", MCFBENCH_CXX_COMPILER}}},
           {"libraries",
