@@ -227,41 +227,36 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
       record["split_triangles"] = basis->stats().split_triangles;
       record["setup_seconds"] = basis->stats().setup_seconds;
     }
-    // Every step record has its seconds (the result.json contract), a stopping one too.
-    const auto stop_seconds = [&] {
-      return nlohmann::json{{"update", ctx.update_seconds_}, {"solve", ctx.solve_seconds_}, {"total", seconds_since(step_start)}};
+    // A stopping step is recorded with its seconds too (every step has them: the result.json
+    // contract), then the flow stops.
+    const auto stop_here = [&](const std::string& reason) {
+      record["seconds"] = {{"update", ctx.update_seconds_}, {"solve", ctx.solve_seconds_}, {"total", seconds_since(step_start)}};
+      steps.push_back(record);
+      stop(step, reason);
     };
     if (!worst.ok()) {
-      record["seconds"] = stop_seconds();
-      steps.push_back(record);
-      stop(step, std::string("solver: ") + to_string(worst.status) + (worst.message.empty() ? "" : " (" + worst.message + ")"));
+      stop_here(std::string("solver: ") + to_string(worst.status) + (worst.message.empty() ? "" : " (" + worst.message + ")"));
       break;
     }
 
     const auto eval_start = Clock::now();
     Positions V_new = basis->evaluate_vertices(x_new);
     if (!all_finite(V_new) || !x_new.allFinite()) {
-      record["seconds"] = stop_seconds();
-      steps.push_back(record);
-      stop(step, "non-finite vertex positions");
+      stop_here("non-finite vertex positions");
       break;
     }
     const double area = surface_area(TriangleMesh{V_new, F});
     if (!(area > 1e-12 * area0)) {
-      record["seconds"] = stop_seconds();
       record["area"] = area;
-      steps.push_back(record);
-      stop(step, "collapsed area (" + std::to_string(area) + ")");
+      stop_here("collapsed area (" + std::to_string(area) + ")");
       break;
     }
     if (area > 1.05 * previous_area) {
       // MCF, cMCF and heat flow never increase the area; a step that grows it by more than 5%
       // is an unstable (explicit) step, not a flow.
-      record["seconds"] = stop_seconds();
       record["area"] = area;
-      steps.push_back(record);
-      stop(step, "diverged: the area grew by " + std::to_string(int(std::lround(100 * (area / previous_area - 1)))) +
-                     "% in one step (unstable time step)");
+      stop_here("diverged: the area grew by " + std::to_string(int(std::lround(100 * (area / previous_area - 1)))) +
+                "% in one step (unstable time step)");
       break;
     }
     double step_difference = 0;
