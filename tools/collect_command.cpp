@@ -46,6 +46,20 @@ std::string group_name(const std::string& study, bool quick, const std::string& 
   return study + (quick ? "-quick" : "") + "@" + commit;
 }
 
+/// The JSON in `path`, or nothing when it does not parse: then it is listed in `unreadable` and
+/// named on stdout with what to do (`remedy`). Files not written by the atomic writer (a copy
+/// cut short, an editor) are the cause; `mcfbench run` rewrites them on its next pass.
+std::optional<json> read_or_list(const fs::path& path, json& unreadable, const char* remedy) {
+  try {
+    std::ifstream in(path);
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    unreadable.push_back({{"file", path.string()}, {"error", e.what()}});
+    std::printf("%s: unreadable (%s); %s\n", path.c_str(), e.what(), remedy);
+    return std::nullopt;
+  }
+}
+
 /// "#3 {"dt":0.001} rep 1 (ab12cd34ef56.json)": a cell named as a user can find it.
 std::string describe_cell(int index, const json& c) {
   std::string s = "#" + std::to_string(index);
@@ -78,16 +92,12 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
             if (entry.is_regular_file() && entry.path().extension() == ".json") plan_paths.push_back(entry.path());
         std::sort(plan_paths.begin(), plan_paths.end());
         for (const auto& path : plan_paths) {
-          json p;
-          try {
-            std::ifstream in(path);
-            p = json::parse(in);
-          } catch (const json::parse_error& e) {
-            unreadable.push_back({{"file", path.string()}, {"error", e.what()}});
-            std::printf("%s: unreadable (%s); rerun `mcfbench run` to rewrite it\n", path.c_str(), e.what());
+          const std::optional<json> read = read_or_list(path, unreadable, "rerun `mcfbench run` to rewrite it");
+          if (!read) {
             ++found;
             continue;
           }
+          const json& p = *read;
           if (!p.is_object() || !p.contains("cells") || !p["cells"].is_array()) continue;
           ++found;
           const bool quick = p.value("quick", false);
@@ -111,18 +121,12 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
             paths.push_back(entry.path());
         std::sort(paths.begin(), paths.end());
         for (const auto& path : paths) {
-          json r;
-          try {
-            std::ifstream in(path);
-            r = json::parse(in);
-          } catch (const json::parse_error& e) {
-            // Not written by the atomic writer (a copy cut short, an editor): list it and go on;
-            // `mcfbench run` replaces such a file on its next pass.
-            unreadable.push_back({{"file", path.string()}, {"error", e.what()}});
-            std::printf("%s: unreadable (%s); rerun `mcfbench run` to redo its cell\n", path.c_str(), e.what());
+          const std::optional<json> read = read_or_list(path, unreadable, "rerun `mcfbench run` to redo its cell");
+          if (!read) {
             ++found;
             continue;
           }
+          const json& r = *read;
           if (!r.is_object() || !r.contains("cell")) continue;
           ++found;
           const json& c = r["cell"];
