@@ -298,21 +298,28 @@ TEST(RunnerCli, RerunRedoesExactlyTheMissingCell) {
   EXPECT_EQ(result_files(dir / "results" / "tiny").size(), 1u);
 }
 
+/// `mcfbench run CONFIG --out OUT` started in `dir` in the background, its output discarded (the
+/// tests kill it part-way); the child's pid, or -1 when fork failed.
+pid_t start_run(const fs::path& dir, const char* config, const char* out) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) _exit(127);
+    std::freopen("/dev/null", "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", config, "--out", out, static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
 TEST(RunnerCli, KilledRunLosesNoFinishedCellAndRepeatsNone) {
   const fs::path dir = fresh_dir("killed");
   write_text(dir / "slow.json", R"({
     "name": "slow",
     "defaults": {"mesh": "icosphere:level=4", "steps": 40, "dt": 1e-4, "threads": 1},
     "axes": {"dt": [1e-4, 2e-4, 3e-4, 4e-4, 5e-4, 6e-4]}})");
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) _exit(127);
-    std::freopen("/dev/null", "w", stderr);
-    std::freopen("/dev/null", "w", stdout);
-    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", "slow.json", "--out", "out", static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  const pid_t pid = start_run(dir, "slow.json", "out");
+  ASSERT_GT(pid, 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (result_files(dir / "out").size() < 2 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -370,15 +377,8 @@ TEST(RunnerCli, CollectAfterAKillBeforeAnyCellFinishedNamesTheMissingCells) {
     "name": "slow",
     "defaults": {"mesh": "icosphere:level=4", "steps": 40, "dt": 1e-4, "threads": 1},
     "axes": {"dt": [1e-4, 2e-4, 3e-4, 4e-4, 5e-4, 6e-4, 7e-4]}})");
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) _exit(127);
-    std::freopen("/dev/null", "w", stderr);
-    std::freopen("/dev/null", "w", stdout);
-    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", "slow.json", "--out", "out", static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  const pid_t pid = start_run(dir, "slow.json", "out");
+  ASSERT_GT(pid, 0);
   // Kill it as soon as it has planned (before its first cell can finish, on any machine but a
   // very fast one).
   auto planned = [&] { return fs::is_directory(dir / "out" / "plans") && !fs::is_empty(dir / "out" / "plans"); };

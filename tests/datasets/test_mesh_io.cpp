@@ -531,6 +531,15 @@ TEST(MeshIo, RoundTripObj) { expect_round_trip("t.obj", false, 1e-15); }
 TEST(MeshIo, RoundTripStlAscii) { expect_round_trip("t.stl", false, 1e-6, false); }
 TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false); }
 
+// The first read-chunk boundary of an ASCII STL (mesh_io.cpp reads an 84-byte head, then 1 MiB
+// chunks), and `m` written as ASCII STL, as text (the tests assert that it reaches past it).
+constexpr std::size_t kBoundary = 84 + (std::size_t(1) << 20);
+std::string ascii_stl_past_the_first_chunk(TempDir& dir, const TriangleMesh& m) {
+  const std::string plain = dir.file("plain.stl");
+  write_mesh(plain, m, false);
+  return file_bytes(plain);
+}
+
 // An ASCII STL is counted in chunks of 1 MiB read after its 84-byte head (mesh_io.cpp: the
 // facets its lines open, and the word "facet" that makes it ASCII). The count is what notices a
 // facet OpenMesh drops without an error (here a degenerate one), so a keyword missed or counted
@@ -541,10 +550,7 @@ TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false)
 TEST(MeshIo, AsciiStlCountedAcrossReadChunks) {
   TempDir dir;
   const TriangleMesh m = make_icosphere(5);
-  const std::string plain = dir.file("plain.stl");
-  write_mesh(plain, m, false);
-  std::string text = file_bytes(plain);
-  constexpr std::size_t kBoundary = 84 + (std::size_t(1) << 20);
+  std::string text = ascii_stl_past_the_first_chunk(dir, m);
   ASSERT_GT(text.size(), kBoundary + 1000);
   text.insert(text.rfind("endsolid"),
               "facet normal 0 0 1\nouter loop\nvertex 7 7 7\nvertex 7 7 7\nvertex 8 7 7\nendloop\nendfacet\n");
@@ -633,10 +639,7 @@ TEST(MeshIo, AsciiStlVertexLinesChecked) {
 TEST(MeshIo, AsciiStlLinesCheckedAcrossReadChunks) {
   TempDir dir;
   const TriangleMesh m = make_icosphere(5);
-  const std::string plain = dir.file("plain.stl");
-  write_mesh(plain, m, false);
-  const std::string text = file_bytes(plain);
-  constexpr std::size_t kBoundary = 84 + (std::size_t(1) << 20);
+  const std::string text = ascii_stl_past_the_first_chunk(dir, m);
   ASSERT_GT(text.size(), kBoundary + 1000);
   // A vertex line ending some 200 bytes before the boundary (its number: `number`) is replaced by
   // `line`, indented so that its byte `split` falls on the boundary.

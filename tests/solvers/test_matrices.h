@@ -66,6 +66,18 @@ inline SparseMatrix graph_laplacian(int n, int degree = 4, double m = 0.05, unsi
   return A;
 }
 
+/// P A Pᵀ for the permutation i -> (i * stride) mod n (stride coprime to n): the same size and
+/// number of nonzeros as A, another pattern (for the solvers' pattern comparison), compressed.
+inline SparseMatrix symmetric_permutation(const SparseMatrix& A, int stride) {
+  Eigen::VectorXi order(A.rows());
+  for (Eigen::Index i = 0; i < order.size(); ++i) order[i] = int((i * stride) % order.size());
+  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm(order);
+  SparseMatrix P;
+  P = A.twistedBy(perm);
+  P.makeCompressed();
+  return P;
+}
+
 inline Eigen::MatrixXd random_rhs(Eigen::Index n, Eigen::Index k = 3, unsigned seed = 3) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g(0.0, 1.0);

@@ -15,6 +15,7 @@ using test::graph_laplacian;
 using test::laplacian3d;
 using test::random_rhs;
 using test::relative_difference;
+using test::symmetric_permutation;
 
 const PcgPreconditioner kBuiltIn[] = {PcgPreconditioner::none, PcgPreconditioner::jacobi,
                                       PcgPreconditioner::incomplete_cholesky};
@@ -284,12 +285,7 @@ TEST(PcgSolver, SetMatrixSumEqualsSetMatrixOfTheSum) {
 TEST(PcgSolver, PatternKeyVouchesWithoutComparing) {
   const SparseMatrix A1 = laplacian3d(7, 6, 5, 0.1, 51);
   const SparseMatrix A2 = laplacian3d(7, 6, 5, 0.6, 52, 2.0);  // same pattern, new values
-  Eigen::VectorXi order(A1.rows());
-  for (Eigen::Index i = 0; i < order.size(); ++i) order[i] = int((i * 11) % order.size());  // 210 and 11 coprime
-  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm(order);
-  SparseMatrix A3;
-  A3 = A2.twistedBy(perm);
-  A3.makeCompressed();
+  const SparseMatrix A3 = symmetric_permutation(A2, 11);  // 210 and 11 coprime
   ASSERT_EQ(A3.nonZeros(), A1.nonZeros());
   ASSERT_FALSE(same_pattern(A1, A3));
   const SparseMatrix small = laplacian3d(4, 4, 4);
