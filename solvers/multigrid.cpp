@@ -410,7 +410,6 @@ struct MultigridSolver::Impl {
   // The coarsest solve when its matrix is only semi-definite (set_matrix: coarsest_pseudo_inverse):
   // a dense generalized inverse, empty while the LDLᵀ factor serves.
   Eigen::MatrixXd coarse_pinv;
-  int coarse_null = 0;                 // dimension of the null space it found
   Eigen::MatrixXd coarse_rhs, coarse_sol;
   int k = 0;                           // columns the buffers are sized for
   std::size_t s = 0;                   // their row stride: k rounded up to a multiple of 4
@@ -817,8 +816,9 @@ struct MultigridSolver::Impl {
   // for a null direction): A⁺ = S⁻¹ V Λ⁺ Vᵀ S⁻¹, with eigenvalues below 1e-11 λ_max taken as 0.
   // For a consistent right-hand side (the restriction of a fine residual of a consistent
   // system) it gives the solution without a null-space component. Returns why it cannot be used
-  // (a negative eigenvalue: the matrix is indefinite; too large to decompose), else "".
-  std::string coarsest_pseudo_inverse() {
+  // (a negative eigenvalue: the matrix is indefinite; too large to decompose), else "" and the
+  // null space's dimension in `null_dimension`.
+  std::string coarsest_pseudo_inverse(int& null_dimension) {
     const SparseMatrix& A = levels.front().A;
     const Eigen::Index n = A.rows();
     if (n > 4096) return "coarsest-level factorization failed (" + std::to_string(n) + " functions: too many for its dense pseudo-inverse)";
@@ -841,10 +841,10 @@ struct MultigridSolver::Impl {
     const double top = lambda[n - 1], floor = 1e-11 * top;
     if (!(lambda[0] >= -floor)) return "coarsest-level matrix is not positive definite (eigenvalue " + std::to_string(lambda[0] / top) + " of the largest)";
     Eigen::VectorXd inverse(n);
-    coarse_null = 0;
+    null_dimension = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       inverse[i] = lambda[i] > floor ? 1.0 / lambda[i] : 0.0;
-      coarse_null += lambda[i] > floor ? 0 : 1;
+      null_dimension += lambda[i] > floor ? 0 : 1;
     }
     const Eigen::MatrixXd W = scale.asDiagonal() * eig.eigenvectors();
     coarse_pinv = W * inverse.asDiagonal() * W.transpose();
@@ -1065,15 +1065,15 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double 
   m.ldlt.factorize(m.levels.front().A);
   if (!diag_ok) return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
   m.coarse_pinv.resize(0, 0);
-  m.coarse_null = 0;
   if (!m.coarsest_factor_is_sound()) {
     // The octree's functions on a flat face parallel to a grid plane (the cubical spiral, a
     // box) are linearly dependent on the surface: A is then only semi-definite, on every level.
     // Gauss–Seidel relaxes such a consistent system as it does a definite one (the paper's
     // solver never factors the fine matrix); the coarsest level needs a generalized inverse.
-    const std::string why = m.coarsest_pseudo_inverse();
+    int null_dimension = 0;
+    const std::string why = m.coarsest_pseudo_inverse(null_dimension);
     if (!why.empty()) return fail(SolveStatus::not_positive_definite, why);
-    rep.message = "coarsest level semi-definite (null space of dimension " + std::to_string(m.coarse_null) +
+    rep.message = "coarsest level semi-definite (null space of dimension " + std::to_string(null_dimension) +
                   "): solved by its pseudo-inverse";
   }
   for (std::size_t l = 1; l < m.levels.size(); ++l)
