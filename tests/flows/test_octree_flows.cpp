@@ -253,9 +253,8 @@ TEST(OctreeFlows, TrackedFlowThroughAPinchFinishes) {
 }
 
 TEST(OctreeFlows, EveryRebuiltStepRecordsItsRebuild) {
-  // Step 1 of a rebuilt flow rebuilds on X_0 like every later step, so its update time is that
-  // of a rebuild, as Table 1's per-step means need (it was 0: the set-up's build was re-used),
-  // and the flow is bitwise the one that re-used it (the same system on the same X_0).
+  // Step 1 of a rebuilt flow solves on the set-up's build on X_0, and its update time is that
+  // build's, as Table 1's per-step means need (it was ~0: the build was counted as set-up only).
   json j = octree("icosphere:level=3", "rebuilt", 5, {{"name", "cholmod"}});
   j["steps"] = 3;
   const auto o = run(j);
