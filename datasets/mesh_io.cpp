@@ -82,6 +82,36 @@ void check_int_range(const std::string& path, long long count, const char* what)
     fail(path, std::to_string(count) + " " + what + ": more than a mesh's int indices can address");
 }
 
+// The OFF keyword's prefixes, "[ST][C][N][4][n]OFF" (Geomview's OFF format): colours, normals and
+// texture coordinates follow a vertex's coordinates and are ignored, but "4" makes the coordinates
+// homogeneous (x y z w, the point is (x, y, z)/w) and "n" puts a dimension before the counts.
+// Reading 4OFF's first three numbers as the point would silently scale every vertex by w.
+struct OffKeyword {
+  bool homogeneous = false;  ///< "4": four coordinates per vertex
+  bool dimension = false;    ///< "n": the header gives the dimension before the counts
+};
+
+OffKeyword parse_off_keyword(const std::string& path, const std::string& magic) {
+  if (magic.size() < 3 || magic.compare(magic.size() - 3, 3, "OFF") != 0)
+    fail(path, "not an OFF file (header '" + magic + "')");
+  OffKeyword k;
+  std::string_view prefix(magic.data(), magic.size() - 3);
+  auto take = [&](char c) {
+    if (prefix.empty() || prefix.front() != c) return false;
+    prefix.remove_prefix(1);
+    return true;
+  };
+  take('S');
+  take('T');
+  take('C');
+  take('N');
+  k.homogeneous = take('4');
+  k.dimension = take('n');
+  if (!prefix.empty())
+    fail(path, "not an OFF file (header '" + magic + "'; the keyword is [ST][C][N][4][n]OFF)");
+  return k;
+}
+
 // ASCII OFF: header counts, finite coordinates, index range; OpenMesh's reader is lenient about
 // all of these. Returns false for binary OFF (walk_off_binary).
 bool walk_off(const std::string& path, WalkedMesh& walk) {
@@ -97,31 +127,51 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
   std::istringstream hs(header);
   std::string magic;
   hs >> magic;
-  if (magic.size() < 3 || magic.compare(magic.size() - 3, 3, "OFF") != 0)
-    fail(path, "not an OFF file (header '" + magic + "')");
+  const OffKeyword keyword = parse_off_keyword(path, magic);
   std::string rest;
   std::getline(hs, rest);
   if (rest.find("BINARY") != std::string::npos) return false;  // walk_off_binary's
   rest = clean_line(rest);
   while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
+  if (keyword.dimension) {  // "nOFF": the dimension, then the counts (on the same line or the next)
+    std::istringstream ds(rest);
+    long long dim = -1;
+    if (!(ds >> dim)) fail(path, "bad " + magic + " dimension line '" + rest + "'");
+    if (dim != 3)
+      fail(path, magic + " of dimension " + std::to_string(dim) + ": only surfaces in 3 dimensions are read");
+    rest.clear();  // getline leaves it alone when the dimension ended the line
+    std::getline(ds, rest);
+    rest = clean_line(rest);
+    while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
+  }
   long long nv = -1, nf = -1;
   {
     std::istringstream cs(rest);
     if (!(cs >> nv >> nf) || nv < 0 || nf < 0) fail(path, "bad OFF counts line '" + rest + "'");
   }
   check_int_range(path, nv, "vertices");
+  const int coordinates = keyword.homogeneous ? 4 : 3;
   long long v = 0;
   while (v < nv && std::getline(in, line)) {
     line = clean_line(line);
     if (line.empty()) continue;
     const char* p = line.c_str();
-    for (int c = 0; c < 3; ++c) {
+    double x[4] = {0, 0, 0, 1};
+    for (int c = 0; c < coordinates; ++c) {
       char* end = nullptr;
-      double x = std::strtod(p, &end);
+      x[c] = std::strtod(p, &end);
       if (end == p) fail(path, "vertex " + std::to_string(v) + ": cannot parse coordinates '" + line + "'");
-      if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate ('" + line + "')");
-      walk.coords.push_back(x);
+      if (!std::isfinite(x[c]))
+        fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate ('" + line + "')");
       p = end;
+    }
+    if (x[3] == 0.0)
+      fail(path, "vertex " + std::to_string(v) + " has homogeneous coordinate w = 0, a point at infinity ('" +
+                     line + "')");
+    for (int c = 0; c < 3; ++c) {
+      const double y = x[c] / x[3];  // exact when w = 1
+      if (!std::isfinite(y)) fail(path, "vertex " + std::to_string(v) + ": x/w overflows ('" + line + "')");
+      walk.coords.push_back(y);
     }
     ++v;
   }

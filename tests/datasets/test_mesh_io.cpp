@@ -69,6 +69,40 @@ TEST(MeshIo, ReadsValidOff) {
   EXPECT_GT(test::signed_volume(m), 0);
 }
 
+// Geomview's keyword prefixes: colours and normals after the coordinates are ignored, 4OFF's
+// homogeneous w divides the point (reading its first three numbers would scale the tetrahedron
+// by 2), nOFF's dimension comes before the counts.
+TEST(MeshIo, OffKeywordPrefixes) {
+  TempDir dir;
+  const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const Eigen::RowVector3d last(0, 0, 1);
+  {
+    const TriangleMesh m =
+        read_mesh(dir.write("c.off", "COFF\n4 4 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n0 1 0 1 0 0 1\n0 0 1 1 0 0 1\n" + faces));
+    EXPECT_EQ(m.vertices.row(3), last);
+  }
+  {
+    const TriangleMesh m = read_mesh(dir.write("h.off", "4OFF\n4 4 0\n0 0 0 2\n2 0 0 2\n0 3 0 3\n0 0 -0.5 -0.5\n" + faces));
+    EXPECT_EQ(m.vertices.row(1), Eigen::RowVector3d(1, 0, 0));
+    EXPECT_EQ(m.vertices.row(2), Eigen::RowVector3d(0, 1, 0));
+    EXPECT_EQ(m.vertices.row(3), last);
+  }
+  for (const char* header : {"nOFF\n3\n4 4 0\n", "nOFF 3 4 4 0\n", "CnOFF\n3 4 4 0\n"}) {
+    SCOPED_TRACE(header);
+    const TriangleMesh m = read_mesh(dir.write("n.off", std::string(header) + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces));
+    ASSERT_EQ(m.num_vertices(), 4);
+    ASSERT_EQ(m.num_faces(), 4);
+    EXPECT_EQ(m.vertices.row(3), last);
+  }
+  expect_error_naming(dir.write("n4.off", "nOFF\n4\n4 4 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n" + faces),
+                      "dimension 4");
+  expect_error_naming(dir.write("w0.off", "4OFF\n4 4 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1 0\n" + faces),
+                      "vertex 3 has homogeneous coordinate w = 0");
+  expect_error_naming(dir.write("w.off", "4OFF\n4 4 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1\n" + faces),
+                      "vertex 3: cannot parse");
+  expect_error_naming(dir.write("x.off", "XOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces), "[ST][C][N][4][n]OFF");
+}
+
 TEST(MeshIo, MissingFile) { expect_error_naming("/nonexistent_dir_xyz/missing_mesh.off", "no such file"); }
 
 TEST(MeshIo, GarbageText) {
