@@ -3,12 +3,14 @@
 #include "datasets/validate.h"
 
 #include <Eigen/Geometry>
+#include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
 #include "flows/integrator.h"
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
 #include "flows/sphere_reference.h"
 #include "solvers/blas_threads.h"
+#include "solvers/dense_reference.h"
 #include "solvers/symmetric_multiply.h"
 
 #include <tbb/global_control.h>
@@ -171,6 +173,15 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
   std::unique_ptr<Basis> basis = make_basis(config, mesh, source.analytic);
   const double build_seconds = seconds_since(setup_start);  // a rebuilt basis: its step 1's update
   std::unique_ptr<LinearSolver> solver = make_solver(config.solver);
+  if (config.solver.name == "dense") {
+    // The dense reference refuses a large system at its first factorization; say so now, as the
+    // configuration error it is, rather than stop the flow at step 1 as if it had turned singular.
+    const long long free = basis->dimension() - (long long)basis->locked_functions().size();
+    if (free > kDenseMaxDimension)
+      throw ConfigError(source.spec + ": solver: \"dense\" factorizes at most " + std::to_string(kDenseMaxDimension) +
+                        " functions and this basis has " + std::to_string(free) +
+                        " free ones; use \"cholmod\", \"pcg\" or \"multigrid\"");
+  }
   std::unique_ptr<Integrator> integrator = make_integrator(config.integrator, config.extrapolate);
   result["system"] = stats_json(basis->stats());
   result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);

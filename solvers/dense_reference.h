@@ -8,16 +8,19 @@
 
 namespace mcf {
 
+/// The largest system the dense reference factorizes (5000² doubles = 200 MB).
+inline constexpr Eigen::Index kDenseMaxDimension = 5000;
+
 /// Solves A X = B with Eigen's dense LLT. Refuses (status failed) above max_dimension so a
 /// mistaken call on a real mesh does not allocate n^2 doubles. Reports iterations = 1 and the
 /// true relative residual, like CholmodSolver.
 SolveReport dense_llt_solve(const SparseMatrix& A, const Eigen::MatrixXd& B, Eigen::MatrixXd& X,
-                            Eigen::Index max_dimension = 5000);
+                            Eigen::Index max_dimension = kDenseMaxDimension);
 
 /// The same as a LinearSolver (factorizes in set_matrix, ignores the warm start).
 class DenseLltSolver final : public LinearSolver {
  public:
-  explicit DenseLltSolver(Eigen::Index max_dimension = 5000) : max_dimension_(max_dimension) {}
+  explicit DenseLltSolver(Eigen::Index max_dimension = kDenseMaxDimension) : max_dimension_(max_dimension) {}
   std::string name() const override { return "dense-llt"; }
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
  protected:

@@ -71,6 +71,24 @@ TEST(FlowConfig, NormalizeAreaIsRefusedOnAnOpenSurface) {
   EXPECT_EQ(run_flow(c, open).result["status"], "ok");
 }
 
+// The dense reference's size limit is a configuration error before the first step, not a flow
+// that "turned singular" at step 1 (its old result.json said so, with exit status 0).
+TEST(FlowConfig, DenseSolverOnALargeSystemIsAConfigError) {
+  FlowConfig c = flow_config_from_json(json{{"mesh", "icosphere:level=5"}, {"solver", {{"name", "dense"}}}, {"steps", 1}},
+                                       "cfg.json");
+  try {
+    run_flow(c, load_mesh_spec(c.mesh));
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("icosphere:level=5: solver: \"dense\" factorizes at most 5000 functions "
+                                         "and this basis has 10242 free ones"),
+              std::string::npos)
+        << e.what();
+  }
+  c.mesh = "icosphere:level=2";
+  EXPECT_EQ(run_flow(c, load_mesh_spec(c.mesh)).result["status"], "ok");
+}
+
 // `threads` caps CHOLMOD's BLAS as well as TBB while the flow runs, and the cap is restored
 // after (OpenBLAS sizes its own pool to every core otherwise: `--threads 1` ran on all of them).
 TEST(FlowConfig, ThreadsCapTheBlasUnderCholmodForTheFlow) {
