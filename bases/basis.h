@@ -9,6 +9,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -31,6 +32,10 @@ struct BasisStats {
   int levels = 1;
   double bytes_per_cubature_point = 0.0;
   std::map<std::string, double> setup_seconds;  ///< phase -> seconds of the last (re)build
+  /// Octree bases: the grid's cube on X_0 (octree.cube "auto" picks the unit cube or a tight
+  /// one, which result.json could not tell apart); cube_side 0 for the hat basis.
+  std::array<double, 3> cube_origin{};
+  double cube_side = 0.0;
 };
 
 class Basis {

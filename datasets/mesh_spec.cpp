@@ -140,6 +140,10 @@ void fit_unit_cube(TriangleMesh& mesh) {
   // Uniform scale (shape kept); the shorter axes are centred in [0, 1].
   const Eigen::RowVector3d offset = 0.5 * (Eigen::RowVector3d::Ones() - scale * extent);
   mesh.vertices = ((mesh.vertices.rowwise() - lo) * scale).rowwise() + offset;
+  // The long axis can round an ulp outside [0, 1] (cgal:bunny00's smallest x came out -2.1e-17),
+  // and the octree's "auto" cube would then leave the unit cube for the tight one: clamp the
+  // rounding away (it moves no coordinate by more than a few ulps).
+  mesh.vertices = mesh.vertices.cwiseMax(0.0).cwiseMin(1.0);
 }
 
 MeshSource load_mesh_spec(const std::string& spec) {

@@ -110,12 +110,14 @@ class FlowStepContext final : public StepContext {
 };
 
 nlohmann::json stats_json(const BasisStats& s) {
-  return {{"dimension", s.dimension},
-          {"split_triangles", s.split_triangles},
-          {"cubature_points", s.cubature_points},
-          {"levels", s.levels},
-          {"bytes_per_cubature_point", s.bytes_per_cubature_point},
-          {"setup_seconds", s.setup_seconds}};
+  nlohmann::json j = {{"dimension", s.dimension},
+                      {"split_triangles", s.split_triangles},
+                      {"cubature_points", s.cubature_points},
+                      {"levels", s.levels},
+                      {"bytes_per_cubature_point", s.bytes_per_cubature_point},
+                      {"setup_seconds", s.setup_seconds}};
+  if (s.cube_side > 0) j["cube"] = {{"origin", s.cube_origin}, {"side", s.cube_side}};
+  return j;
 }
 
 bool all_finite(const Positions& V) { return V.allFinite(); }

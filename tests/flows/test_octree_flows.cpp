@@ -5,6 +5,7 @@
 
 #include "bases/octree_basis.h"
 #include "datasets/generators.h"
+#include "datasets/mesh_io.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"
 
@@ -264,6 +265,32 @@ TEST(OctreeFlows, EveryRebuiltStepRecordsItsRebuild) {
   const auto update = [&](int i) { return o.result["steps"][i]["seconds"]["update"].get<double>(); };
   EXPECT_GT(update(0), 0.1 * std::min(update(1), update(2)));
   EXPECT_TRUE(o.result["steps"][0].contains("setup_seconds"));
+}
+
+// result.json records the grid's cube: "auto" takes the unit cube for a file (scaled into it on
+// loading) and a tight cube around a generated sphere, which "cube": "auto" alone cannot tell.
+TEST(OctreeFlows, ResultRecordsTheGridCube) {
+  const std::string path = ::testing::TempDir() + "/mcf_cube_sphere.off";
+  write_mesh(path, make_icosphere(2));
+  for (const char* tracking : {"tracked", "rebuilt"}) {
+    SCOPED_TRACE(tracking);
+    json j = octree(path, tracking, 4, {{"name", "cholmod"}});
+    j["steps"] = 1;
+    const auto file = run(j);
+    ASSERT_EQ(file.result["status"], "ok");
+    EXPECT_EQ(file.result["system"]["cube"]["side"], 1.0);
+    EXPECT_EQ(file.result["system"]["cube"]["origin"], json::array({0.0, 0.0, 0.0}));
+    j["mesh"] = "icosphere:level=2";
+    const auto sphere = run(j);
+    ASSERT_EQ(sphere.result["status"], "ok");
+    const Positions V = load_mesh_spec("icosphere:level=2").mesh.vertices;
+    const Eigen::RowVector3d lo = V.colwise().minCoeff(), hi = V.colwise().maxCoeff();
+    const double side = 1.01 * (hi - lo).maxCoeff() / (1.0 - 1.0 / 16.0);  // 1% margin and one cell
+    EXPECT_DOUBLE_EQ(sphere.result["system"]["cube"]["side"].get<double>(), side);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_DOUBLE_EQ(sphere.result["system"]["cube"]["origin"][c].get<double>(), 0.5 * (lo(c) + hi(c)) - 0.5 * side);
+  }
+  EXPECT_FALSE(run(json{{"mesh", "icosphere:level=2"}, {"steps", 1}}).result["system"].contains("cube"));  // hat
 }
 
 TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
