@@ -5,6 +5,7 @@ reference values, figure style and provenance sidecars.
 Reports read result JSON only (DESIGN.md "Layers"); nothing here runs a flow.
 """
 
+import contextlib
 import glob
 import json
 import math
@@ -86,6 +87,69 @@ def load_results(folder):
         r.setdefault("steps", [])
         results.append(r)
     return results
+
+
+PLAN_FOLDER = "plans"  # bench/runner.h kPlanFolder
+
+
+def load_plans(folder):
+    """The plans `mcfbench run` wrote into a results folder before its first cell
+    (FOLDER/plans/*.json, the format `mcfbench collect` reads): a list of dicts with "study",
+    "quick" and "cells" ([{"index", "repetition", "assignment"[, "hash"]}], every cell of the
+    matrix, also in a shard's plan). A folder without plans (`mcfbench flow` outputs, copied
+    results) gives []. Unreadable plan files are skipped with a warning and returned in the
+    second list."""
+    plans, unreadable = [], []
+    for p in sorted(glob.glob(os.path.join(folder, PLAN_FOLDER, "*.json"))):
+        try:
+            with open(p) as f:
+                plan = json.load(f)
+        except (OSError, ValueError) as e:
+            warn("skipping plan %s: %s" % (p, e))
+            unreadable.append(p)
+            continue
+        if isinstance(plan, dict) and isinstance(plan.get("cells"), list):
+            plan["_path"] = os.path.abspath(p)
+            plans.append(plan)
+    return plans, unreadable
+
+
+def cell_identity(study, quick, cell):
+    """What makes a planned cell and a result the same cell: study, quick flag, index, repetition
+    and assignment (not the commit: the figures draw the cells of every commit in the folders)."""
+    cell = cell if isinstance(cell, dict) else {}
+    return (study, bool(quick), cell.get("index"), cell.get("repetition", 0) or 0,
+            json.dumps(cell.get("assignment") or {}, sort_keys=True))
+
+
+def result_identity(result):
+    """cell_identity of a result file (None for a plain `mcfbench flow` run, which no plan names)."""
+    cell = result.get("cell")
+    if not isinstance(cell, dict):
+        return None
+    return cell_identity(study_of(result), cell.get("quick", False), cell)
+
+
+# (cells with a result, cells planned) while make_report draws a study that lacks planned cells:
+# save_figure and save_markdown mark what they save "incomplete: 3 of 8 cells". None otherwise.
+_incomplete = None
+
+
+@contextlib.contextmanager
+def marked_incomplete(have, total):
+    """Within the block, every figure and table saved says that only `have` of the `total`
+    cells planned have results."""
+    global _incomplete
+    before, _incomplete = _incomplete, (have, total)
+    try:
+        yield
+    finally:
+        _incomplete = before
+
+
+def incomplete_note():
+    """The mark, "incomplete: 3 of 8 cells", inside marked_incomplete; None outside."""
+    return "incomplete: %d of %d cells" % _incomplete if _incomplete else None
 
 
 def study_of(result):
@@ -262,7 +326,12 @@ def save_figure(fig, out_dir, name, results, title, written):
     """Save a figure as OUT_DIR/NAME.png with its sources sidecar; record it in `written`."""
     os.makedirs(out_dir, exist_ok=True)
     path = os.path.join(out_dir, name + ".png")
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    extra, note = {}, incomplete_note()
+    if note:  # a red line above the title, and the PNG's Description
+        fig.text(0.5, 1.0, note, ha="center", va="bottom", color="red", fontsize=10, fontweight="bold")
+        title = "%s (%s)" % (title, note)
+        extra["metadata"] = {"Description": note}
+    fig.savefig(path, dpi=DPI, bbox_inches="tight", **extra)
     plt.close(fig)
     write_sources(path, results)
     print("wrote " + path)
@@ -274,6 +343,10 @@ def save_markdown(text, out_dir, name, results, title, written):
     """Save OUT_DIR/NAME.md (with a sources caption line and sidecar); record it in `written`."""
     os.makedirs(out_dir, exist_ok=True)
     path = os.path.join(out_dir, name + ".md")
+    if _incomplete:
+        text = ("**Incomplete: %d of %d planned cells have results**; the missing cells are listed in "
+                "index.md.\n\n" % _incomplete) + text
+        title = "%s (%s)" % (title, incomplete_note())
     with open(path, "w") as f:
         f.write(text.rstrip() + "\n\n" + sources_line(results) + "\n")
     write_sources(path, results)

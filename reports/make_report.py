@@ -2,14 +2,22 @@
 """Regenerate the studies' figures and tables from result folders.
 
 usage: /usr/bin/python3 reports/make_report.py RESULTS_DIR [RESULTS_DIR ...] OUT_DIR
-                                               [--references bench/configs]
+                                               [--references bench/configs] [--require-complete]
 
 Each results folder holds one study's result JSON files (index.json ignored); results are
 grouped by cell.study and handed to the study's module; frames strips are drawn for any study
 whose cells saved frames; OUT_DIR/index.md links everything. Nothing is rerun.
+
+The cells `mcfbench run` planned (RESULTS_DIR/plans/, written before its first cell) are checked
+against the results: a study whose planned cells do not all have a result yet (a run stopped or
+still going) is warned about ("k of N cells have results"), its missing cells are listed in
+index.md and its figures and tables are marked "incomplete: k of N cells". Folders without plans
+are reported as before. --require-complete writes nothing and exits 1 instead when a planned
+cell has no result or a cell errored.
 """
 
 import argparse
+import contextlib
 import importlib
 import os
 import sys
@@ -28,6 +36,9 @@ def parse_args(argv):
     p.add_argument("paths", nargs="+", metavar="DIR", help="results folder(s), then the output folder")
     p.add_argument("--references", default=common.DEFAULT_REFERENCES,
                    help="folder of <study>.reference.json paper values (default: bench/configs)")
+    p.add_argument("--require-complete", action="store_true",
+                   help="write nothing and exit 1 if a planned cell has no result, a cell errored, a "
+                        "plan is unreadable or a results folder is missing or empty")
     args = p.parse_args(argv)
     if len(args.paths) < 2:
         p.error("need at least one RESULTS_DIR and an OUT_DIR")
@@ -44,47 +55,101 @@ def run_module(name, results, out_dir, reference, written):
         return False
 
 
+def missing_cells(results, planned):
+    """The planned cells ({identity: (quick, cell)}) that no result in `results` is; sorted."""
+    have = {common.result_identity(r) for r in results}
+    missing = [dict(cell, quick=quick) for ident, (quick, cell) in planned.items() if ident not in have]
+    number = lambda v: v if isinstance(v, int) else -1  # noqa: E731 - a plan is read, not trusted
+    return sorted(missing, key=lambda c: (c["quick"], number(c.get("index")), number(c.get("repetition"))))
+
+
 def main(argv):
     args = parse_args(argv)
     *folders, out_dir = args.paths
-    os.makedirs(out_dir, exist_ok=True)
     by_study = {}
+    planned = {}  # study -> {cell identity: (quick, planned cell)}, merged over folders and shards
+    problems = []  # what --require-complete refuses besides missing and errored cells
     for folder in folders:
         if not os.path.isdir(folder):
             common.warn("no such results folder: %s" % folder)
+            problems.append("no such results folder: %s" % folder)
             continue
-        for r in common.load_results(folder):
+        plans, unreadable = common.load_plans(folder)
+        problems += ["unreadable plan %s" % p for p in unreadable]
+        for plan in plans:
+            study, quick = str(plan.get("study") or "flow"), bool(plan.get("quick", False))
+            entry = by_study.setdefault(study, ([], []))
+            if folder not in entry[1]:
+                entry[1].append(folder)
+            for c in plan["cells"]:
+                if isinstance(c, dict):
+                    planned.setdefault(study, {}).setdefault(common.cell_identity(study, quick, c), (quick, c))
+        results = common.load_results(folder)
+        if not results and not plans:
+            problems.append("%s: no results and no run plan" % folder)
+        for r in results:
             entry = by_study.setdefault(common.study_of(r), ([], []))
             entry[0].append(r)
             if folder not in entry[1]:
                 entry[1].append(folder)
+    # Planned cells without a result: {study: {"have", "total", "missing": [cells], "quick_mixed"}}.
+    gaps = {}
+    for study, cells in planned.items():
+        missing = missing_cells(by_study[study][0], cells)
+        if missing:
+            gaps[study] = {"have": len(cells) - len(missing), "total": len(cells), "missing": missing,
+                           "quick_mixed": len({q for q, _ in cells.values()}) > 1}
+    if args.require_complete:
+        for study in sorted(by_study):
+            if study in gaps:
+                problems.append("%s: %d of %d cells have results" % (study, gaps[study]["have"], gaps[study]["total"]))
+            errored = sum(r.get("status") == "error" for r in by_study[study][0])
+            if errored:
+                problems.append("%s: %d cell(s) errored" % (study, errored))
+        if problems:
+            for p in problems:
+                print("error: " + p, file=sys.stderr)
+            print("error: --require-complete: the results are incomplete; nothing written "
+                  "(rerun `mcfbench run`, or leave out --require-complete to report them as they are)", file=sys.stderr)
+            return 1
+    os.makedirs(out_dir, exist_ok=True)
     ok = True
     sections = []
     for study in sorted(by_study, key=lambda s: (STUDIES.index(s) if s in STUDIES else len(STUDIES), s)):
         results, src = by_study[study]
         written = []
         reference = common.load_reference(study, args.references)
+        gap = gaps.get(study)
         print("%s: %d result file(s)%s" % (study, len(results), "" if reference is None else ", paper reference found"))
-        if study in STUDIES:
-            ok &= run_module(study, results, out_dir, reference, written)
-        elif any(common.series(r, "radial_error.rms")[0] for r in results):
-            # Plain `mcfbench flow` runs or a new study: at least show the radial errors.
-            import sphere_error
-            try:
-                sphere_error.plot_radial_errors(results, out_dir, "%s_radial_error" % study,
-                                                "%s: radial error per step" % study, reference, written)
-            except Exception:  # noqa: BLE001
-                common.warn("radial error plot for %s failed:\n%s" % (study, traceback.format_exc()))
-                ok = False
-        else:
-            common.warn("no report module for study %r; frames only" % study)
-        ok &= run_module("frames", results, out_dir, reference, written)
+        if gap:
+            common.warn("%s: %d of %d cells have results; its figures and tables lack the %d other planned "
+                        "cell(s) (listed in index.md; `mcfbench run` computes them)"
+                        % (study, gap["have"], gap["total"], len(gap["missing"])))
+        mark = common.marked_incomplete(gap["have"], gap["total"]) if gap else contextlib.nullcontext()
+        with mark:
+            if not results:
+                pass  # planned, nothing finished yet: the index says so
+            elif study in STUDIES:
+                ok &= run_module(study, results, out_dir, reference, written)
+            elif any(common.series(r, "radial_error.rms")[0] for r in results):
+                # Plain `mcfbench flow` runs or a new study: at least show the radial errors.
+                import sphere_error
+                try:
+                    sphere_error.plot_radial_errors(results, out_dir, "%s_radial_error" % study,
+                                                    "%s: radial error per step" % study, reference, written)
+                except Exception:  # noqa: BLE001
+                    common.warn("radial error plot for %s failed:\n%s" % (study, traceback.format_exc()))
+                    ok = False
+            else:
+                common.warn("no report module for study %r; frames only" % study)
+        if results:  # a strip shows one cell: complete whatever the study lacks
+            ok &= run_module("frames", results, out_dir, reference, written)
         # A cell whose flow threw has no steps: the figures cannot show it, so the index says so.
         errored = [r for r in results if r.get("status") == "error"]
         if errored:
             common.warn("%s: %d cell(s) errored and are missing from its figures (listed in index.md)"
                         % (study, len(errored)))
-        sections.append((study, src, written, errored))
+        sections.append((study, src, written, errored, gap))
     index.make(out_dir, sections)
     return 0 if ok else 1
 

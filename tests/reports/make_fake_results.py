@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Fabricate small results folders, one per study (2–3 result files each, plus frames, a
-singular stop, a one-cell study and paper reference files), for the reports test.
+singular stop, a one-cell study, the run plans and paper reference files), for the reports test.
 
-usage: make_fake_results.py OUT_ROOT   ->  OUT_ROOT/<study>/*.json, OUT_ROOT/references/*.json
+usage: make_fake_results.py OUT_ROOT   ->  OUT_ROOT/<study>/*.json, OUT_ROOT/<study>/plans/*.json,
+                                           OUT_ROOT/references/*.json
 """
 
 import json
@@ -84,6 +85,39 @@ def write(folder, name, r):
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, name + ".json"), "w") as f:
         json.dump(r, f, indent=1)
+
+
+def write_plan(folder, study, shard=(0, 1), cells=None, commit="fake", quick=False):
+    """FOLDER/plans/<study>[-quick]@<commit>[.shard-i-of-n].json as `mcfbench run` writes it: `cells`
+    ([{"index", "repetition", "assignment"}]), by default those of the results in FOLDER; "hash" (the
+    result's file stem) for the cells of this shard. Returns the plan's path."""
+    if cells is None:
+        cells = []
+        for name in sorted(os.listdir(folder)):
+            if name.endswith(".json") and name != "index.json":
+                try:
+                    with open(os.path.join(folder, name)) as f:
+                        c = json.load(f)["cell"]
+                except (ValueError, KeyError, TypeError):
+                    continue
+                cells.append({"index": c["index"], "repetition": c["repetition"], "assignment": c["assignment"],
+                              "hash": os.path.splitext(name)[0]})
+        cells.sort(key=lambda c: c["index"])
+    i, n = shard
+    listed = []
+    for c in cells:
+        c = dict(c)
+        if c["index"] % n != i:
+            c.pop("hash", None)
+        listed.append(c)
+    name = study + ("-quick" if quick else "") + "@" + commit + (".shard-%d-of-%d" % (i, n) if n > 1 else "")
+    path = os.path.join(folder, "plans", name + ".json")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        json.dump({"schema": 1, "plan": "mcfbench run", "study": study, "quick": quick, "commit": commit,
+                   "source": "bench/configs/%s.json" % study, "shard": "%d/%d" % (i, n),
+                   "cells_total": len(listed), "cells": listed, "study_config": {"name": study}}, f, indent=1)
+    return path
 
 
 def frames(folder, stem, count, n_theta=12, n_phi=24, stretch=1.6):
@@ -185,6 +219,13 @@ def main(root):
         f.write('{"config": {')
     with open(os.path.join(root, "cubature", "notes.json"), "w") as f:
         json.dump([1, 2, 3], f)
+    # The plans `mcfbench run` writes before its first cell (RESULTS_DIR/plans/, bench/runner.cpp
+    # run_plan): every cell is planned and has its result, so the report is complete. depth_cycles
+    # ran as two shards, whose plans list every cell and name the hashes of their own.
+    for s in ("table1", "sphere_error", "model_error", "cubature", "cmcf", "time_order"):
+        write_plan(os.path.join(root, s), s)
+    write_plan(os.path.join(root, "depth_cycles"), "depth_cycles", shard=(0, 2))
+    write_plan(os.path.join(root, "depth_cycles"), "depth_cycles", shard=(1, 2))
     # Paper references.
     refs = os.path.join(root, "references")
     os.makedirs(refs, exist_ok=True)
