@@ -110,17 +110,7 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
   system_.reset();
   octree_ = build_octree(cube, pieces_, options_.coarsest_depth);
   piece_cells_ = locate_pieces(octree_, pieces_);
-  {
-    std::vector<char> used(static_cast<std::size_t>(mesh_.num_vertices()), 0);
-    for (Eigen::Index f = 0; f < mesh_.num_faces(); ++f)
-      for (int c = 0; c < 3; ++c) used[static_cast<std::size_t>(mesh_.faces(f, c))] = 1;
-    referenced_.clear();
-    for (std::size_t v = 0; v < used.size(); ++v)
-      if (used[v]) referenced_.push_back(static_cast<int>(v));
-    Positions pts(static_cast<Eigen::Index>(referenced_.size()), 3);
-    for (std::size_t i = 0; i < referenced_.size(); ++i) pts.row(static_cast<Eigen::Index>(i)) = mesh_.vertices.row(referenced_[i]);
-    stencils_ = point_stencils(octree_, pts);
-  }
+  stencils_ = vertex_stencils(octree_, mesh_.vertices, mesh_.faces);
   locked_ = boundary_functions(octree_, mesh_.vertices, mesh_.faces);
   stats_.setup_seconds["octree"] = t_octree + seconds_since(t0);
 
@@ -153,8 +143,7 @@ void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass, std::vector
   std::vector<int>().swap(piece_cells_);
   system_->release_pieces();
   // The tracked basis keeps the stencils of the input's vertices itself (~40 MB at 416k vertices).
-  std::vector<PointStencil>().swap(stencils_);
-  std::vector<int>().swap(referenced_);
+  stencils_ = VertexStencils{};
 }
 
 namespace {
@@ -182,13 +171,7 @@ Positions RebuiltOctreeBasis::evaluate_vertices(const Coefficients& x) const {
     throw std::invalid_argument("RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
   if (system_->pieces_released())
     throw std::logic_error("RebuiltOctreeBasis::evaluate_vertices: the stencils were released (release_assembly)");
-  Positions all = mesh_.vertices;
-  if (static_cast<Eigen::Index>(referenced_.size()) == all.rows()) {
-    all = evaluate_stencils(stencils_, x);
-  } else {
-    const Positions ev = evaluate_stencils(stencils_, x);
-    for (std::size_t i = 0; i < referenced_.size(); ++i) all.row(referenced_[i]) = ev.row(static_cast<Eigen::Index>(i));
-  }
+  Positions all = mcf::evaluate_vertices(stencils_, x);
   if (!options_.refine_input) return all;
   last_evaluated_ = all;
   last_evaluated_build_ = build_id_;

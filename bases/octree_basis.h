@@ -91,8 +91,7 @@ class RebuiltOctreeBasis : public Basis {
   std::vector<double> mass_, stiffness_;  // values on system_'s pattern
   std::vector<SparseMatrix> prolongations_;
   std::vector<std::vector<std::uint8_t>> colours_;
-  std::vector<PointStencil> stencils_;  ///< of mesh_'s referenced vertices (see referenced_)
-  std::vector<int> referenced_;         ///< vertices used by a face; the others keep their position
+  VertexStencils stencils_;  ///< mesh_'s vertices (with refine_input, the midpoints too)
   std::vector<int> locked_;
   BasisStats stats_;
   long long build_id_ = 0;

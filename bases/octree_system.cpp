@@ -338,4 +338,30 @@ Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coe
   return out;
 }
 
+VertexStencils vertex_stencils(const Octree& octree, const Positions& vertices, const Triangles& faces) {
+  std::vector<char> used(static_cast<std::size_t>(vertices.rows()), 0);
+  for (Eigen::Index f = 0; f < faces.rows(); ++f)
+    for (int c = 0; c < 3; ++c) used[static_cast<std::size_t>(faces(f, c))] = 1;
+  VertexStencils s;
+  if (std::find(used.begin(), used.end(), 0) == used.end()) {
+    s.used = point_stencils(octree, vertices);
+    return s;
+  }
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (used[v]) s.used_index.push_back(static_cast<int>(v));
+  Positions points(static_cast<Eigen::Index>(s.used_index.size()), 3);
+  for (std::size_t i = 0; i < s.used_index.size(); ++i) points.row(Eigen::Index(i)) = vertices.row(s.used_index[i]);
+  s.used = point_stencils(octree, points);
+  s.kept = vertices;
+  return s;
+}
+
+Positions evaluate_vertices(const VertexStencils& stencils, const Coefficients& x) {
+  if (stencils.used_index.empty()) return evaluate_stencils(stencils.used, x);
+  Positions all = stencils.kept;
+  const Positions used = evaluate_stencils(stencils.used, x);
+  for (std::size_t i = 0; i < stencils.used_index.size(); ++i) all.row(stencils.used_index[i]) = used.row(Eigen::Index(i));
+  return all;
+}
+
 }  // namespace mcf

@@ -195,4 +195,16 @@ std::vector<PointStencil> point_stencils(const Octree& octree, const Positions& 
 PointStencil cell_stencil(const Octree& octree, int level, int cell, const Eigen::Vector3d& p);
 Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coefficients& x);
 
+/// A mesh's vertices as an octree basis evaluates them. A vertex no face uses (files may have
+/// them; `mesh-info` reports `unreferenced_vertices`) lies on no piece, so no active cell need
+/// hold it: it keeps its position, as the hat basis keeps it.
+struct VertexStencils {
+  std::vector<PointStencil> used;  ///< stencils of the vertices some face uses, in vertex order
+  std::vector<int> used_index;     ///< their vertex numbers; empty when every vertex is used
+  Positions kept;                  ///< every vertex's position at construction; empty when all are used
+};
+VertexStencils vertex_stencils(const Octree& octree, const Positions& vertices, const Triangles& faces);
+/// All vertices: the used ones evaluated from the coefficients, the others where they were.
+Positions evaluate_vertices(const VertexStencils& stencils, const Coefficients& x);
+
 }  // namespace mcf

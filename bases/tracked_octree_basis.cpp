@@ -81,7 +81,7 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
     }
   });
   // Only the original vertices are evaluated (with refine_input the midpoints are internal).
-  stencils_ = point_stencils(octree, mesh.vertices);
+  stencils_ = vertex_stencils(octree, mesh.vertices, mesh.faces);
   // From here on only the compact corners are read: the rebuilt basis's pieces are freed and its
   // assembled matrices become ours, so the first update only resets their values (a fresh copy of
   // the pattern, ~0.28 GB per matrix at depth 9, cost more than the update itself in page faults).
@@ -353,7 +353,7 @@ std::vector<double> TrackedOctreeBasis::cell_local_corners(int c) const {
 Positions TrackedOctreeBasis::evaluate_vertices(const Coefficients& x) const {
   if (x.rows() != dimension())
     throw std::invalid_argument("TrackedOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
-  return evaluate_stencils(stencils_, x);
+  return mcf::evaluate_vertices(stencils_, x);
 }
 
 }  // namespace mcf

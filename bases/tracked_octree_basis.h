@@ -78,7 +78,7 @@ class TrackedOctreeBasis final : public Basis {
   std::vector<double> fan_points_;     // fans' corners, cells in order, local coords in [0,1]
   std::vector<std::uint8_t> continues_;  // per piece (cell order): 1 = continues the previous fan
   std::vector<int> point_start_;       // cell c's fan points: [point_start_[c], point_start_[c+1]), 3 doubles each
-  std::vector<PointStencil> stencils_; // original vertices
+  VertexStencils stencils_;            // original vertices
   std::vector<double> mass_, stiffness_;  // values on initial_->system()'s pattern
   BasisStats stats_;
   long long degenerate_points_ = 0;

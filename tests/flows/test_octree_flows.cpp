@@ -318,6 +318,34 @@ TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
   EXPECT_LT((one.final_mesh.vertices - b).norm() / b.norm(), 1e-3);
 }
 
+// A vertex no face uses lies on no piece. The tracked basis made a stencil for it anyway: at the
+// sphere's centre (in no active cell) it threw, near the surface it moved the vertex with the
+// flow. Every basis now keeps such a vertex where it is, and the used vertices flow exactly as
+// they do without it.
+TEST(OctreeFlows, UnusedVerticesKeepTheirPositions) {
+  const MeshSource plain = load_mesh_spec("icosphere:level=3");
+  MeshSource extra = plain;
+  const Eigen::Index n = plain.mesh.num_vertices();
+  extra.mesh.vertices.conservativeResize(n + 2, 3);
+  extra.mesh.vertices.row(n) = Eigen::RowVector3d(0, 0, 0);          // inside, in no active cell
+  extra.mesh.vertices.row(n + 1) = 0.999 * plain.mesh.vertices.row(0);  // beside the surface
+  extra.report.unreferenced_vertices = 2;
+  for (const char* tracking : {"tracked", "rebuilt"}) {
+    for (const bool refine : {false, true}) {
+      if (refine && std::string(tracking) == "tracked") continue;
+      SCOPED_TRACE(std::string(tracking) + (refine ? " refine_input" : ""));
+      json j = octree(plain.spec, tracking, 5, {{"name", "cholmod"}});
+      j["steps"] = 3;
+      j["octree"]["refine_input"] = refine;
+      const FlowConfig c = flow_config_from_json(j, "test");
+      const FlowOutcome a = run_flow(c, plain), b = run_flow(c, extra);
+      ASSERT_EQ(b.result["status"], "ok") << b.result["stop"].dump();
+      EXPECT_EQ(b.final_mesh.vertices.topRows(n), a.final_mesh.vertices);
+      EXPECT_EQ(b.final_mesh.vertices.bottomRows(2), extra.mesh.vertices.bottomRows(2));
+    }
+  }
+}
+
 TEST(OctreeFlows, OpenSurfaceKeepsItsBoundary) {
   json j = octree("open_cylinder:n_around=32,n_along=16", "tracked", 6, {{"name", "multigrid"}, {"cycles", 3}});
   j["dt"] = 1e-2;
