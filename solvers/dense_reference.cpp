@@ -51,7 +51,9 @@ SolveReport DenseLltSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X)
   for (Eigen::Index c = 0; c < B.cols(); ++c) {
     const double bn = B.col(c).norm();
     const double rel = bn > 0.0 ? R.col(c).norm() / bn : R.col(c).norm();
-    worst = std::isfinite(rel) && std::isfinite(worst) ? std::max(worst, rel) : rel;
+    // A non-finite column is kept: a later finite one must not report the solve converged.
+    if (!std::isfinite(rel)) worst = rel;
+    else if (std::isfinite(worst)) worst = std::max(worst, rel);
   }
   rep.iterations = 1;
   rep.relative_residual = worst;

@@ -207,6 +207,23 @@ TEST(CholmodSolver, RejectsNonFiniteAndBadShapes) {
   EXPECT_EQ(s.solve(random_rhs(63), X).status, SolveStatus::failed);
 }
 
+// A right-hand side whose first column holds a NaN and whose second is finite: the solve's
+// report is a numerical issue for both direct solvers (the dense reference let the finite column
+// overwrite the NaN's residual and reported it converged at 2e-16).
+TEST(CholmodSolver, ANonFiniteColumnBeforeAFiniteOneIsANumericalIssue) {
+  const SparseMatrix A = laplacian3d(4, 4, 4);
+  Eigen::MatrixXd B = random_rhs(A.rows(), 2);
+  B(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  Eigen::MatrixXd X;
+  CholmodSolver cholmod;
+  ASSERT_EQ(cholmod.set_matrix(A).status, SolveStatus::converged);
+  EXPECT_EQ(cholmod.solve(B, X).status, SolveStatus::numerical_issue);
+  EXPECT_EQ(dense_llt_solve(A, B, X).status, SolveStatus::numerical_issue);
+  B.col(0).swap(B.col(1));  // finite first, then the NaN: both saw this one
+  EXPECT_EQ(cholmod.solve(B, X).status, SolveStatus::numerical_issue);
+  EXPECT_EQ(dense_llt_solve(A, B, X).status, SolveStatus::numerical_issue);
+}
+
 TEST(CholmodSolver, AcceptsUncompressedInput) {
   SparseMatrix A = laplacian3d(5, 5, 5);
   SparseMatrix U = A;
