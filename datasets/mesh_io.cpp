@@ -327,12 +327,23 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
                    " but the file has " + std::to_string(vertices) + " vertices");
 }
 
+// Whether word is the keyword (given in lowercase) in any case: STL's keywords are lowercase, but
+// files in capitals ("SOLID", "OUTER LOOP", "VERTEX") exist.
+bool is_keyword(std::string_view word, std::string_view keyword) {
+  return word.size() == keyword.size() && std::equal(word.begin(), word.end(), keyword.begin(), [](char w, char k) {
+           return std::tolower(static_cast<unsigned char>(w)) == k;
+         });
+}
+
 // The lines of an ASCII STL as OpenMesh 9's reader takes them (STLReader.cc, read_stla): a line
 // containing "outer" (or "OUTER") opens a facet, and the next three lines are its corners, each
 // read as a word and three floats with `>>`, which on bad text keeps whatever the stream holds
 // (`vertex 0 1 zz` came out as (0, 1, 0), a missing coordinate as the last vertex's, `1e999` as
-// FLT_MAX). Fed the file's bytes in order, in pieces of any size; keeps only the current line
-// (at most 1 MiB). The first problem is kept as an error naming the line.
+// FLT_MAX). The corner's word is checked to be "vertex" in any case (`>>` skips it whatever it
+// is); a line starting with "outer" in mixed case ("Outer loop") opens no facet there, so it is
+// refused rather than let its facet be skipped. Fed the file's bytes in order, in pieces of any
+// size; keeps only the current line (at most 1 MiB). The first problem is kept as an error naming
+// the line.
 class AsciiStlLines {
  public:
   void feed(const char* p, std::size_t n) {
@@ -398,17 +409,20 @@ class AsciiStlLines {
     std::string_view rest = s;
     const std::string_view first = word(rest);
     if (corners_due_ == 0) {
-      if (first == "vertex")
+      if (is_keyword(first, "vertex"))
         return problem("a vertex line outside a facet's three corners (OpenMesh's reader skips it): " + quoted(s));
       if (s.find("outer") != std::string_view::npos || s.find("OUTER") != std::string_view::npos) {
         corners_due_ = 3;
         loop_line_ = number_;
         ++facets_;
+      } else if (is_keyword(first, "outer")) {
+        return problem(quoted(s) + ": OpenMesh's reader opens a facet only at 'outer' or 'OUTER' (STL's keywords "
+                       "are lowercase), and would skip this one");
       }
       return;
     }
     --corners_due_;
-    if (first != "vertex")
+    if (!is_keyword(first, "vertex"))
       return problem("expected 'vertex x y z', corner " + std::to_string(3 - corners_due_) +
                      " of the facet opened by 'outer' on line " + std::to_string(loop_line_) + ", found " + quoted(s));
     int count = 0;
@@ -506,11 +520,12 @@ struct StlLayout {
   long long triangles = 0;  // ASCII: the facets OpenMesh opens ('outer' lines, AsciiStlLines)
 };
 
-// A file is ASCII if it starts with "solid" and its first 84 + 1 MiB bytes are text: some binary
-// exporters start their header with "solid" too, and words like "facet" after it (until
-// 2026-11-25 the word "facet" anywhere in the file made it ASCII). An ASCII file is streamed in
-// an 84-byte head and then 1 MiB chunks, never held whole, and the same pass checks its lines
-// (AsciiStlLines) and counts its facets. Any other file is binary, and is not read here beyond
+// A file is ASCII if it starts with "solid", in any case (until 2026-11-25 a file in capitals was
+// taken for binary), and its first 84 + 1 MiB bytes are text: some binary exporters start their
+// header with "solid" too, and words like "facet" after it (until 2026-11-25 the word "facet"
+// anywhere in the file made it ASCII). An ASCII file is streamed in an 84-byte head and then
+// 1 MiB chunks, never held whole, and the same pass checks its lines (AsciiStlLines) and counts
+// its facets. Any other file is binary, and is not read here beyond
 // its header and its length (OpenMesh reads it next). Vertices are merged by OpenMesh (STL has no
 // shared vertices), so their count is unknown in advance.
 StlLayout scan_stl(const std::string& path) {
@@ -526,7 +541,7 @@ StlLayout scan_stl(const std::string& path) {
   read(head, 84);
   read(chunk, kChunk);
   const auto start = head.find_first_not_of(" \t\r\n");
-  if (start == std::string::npos || head.compare(start, 5, "solid") != 0)
+  if (start == std::string::npos || !is_keyword(std::string_view(head).substr(start, 5), "solid"))
     return {true, binary_stl_triangles(path, head, "it does not start with 'solid', so it is no ASCII STL")};
   std::size_t bad = first_non_text_byte(head);
   if (bad == std::string::npos && (bad = first_non_text_byte(chunk)) != std::string::npos) bad += head.size();

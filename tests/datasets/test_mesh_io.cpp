@@ -632,6 +632,45 @@ TEST(MeshIo, AsciiStlVertexLinesChecked) {
   }
 }
 
+// STL's keywords are lowercase, but files in capitals exist ("SOLID", "OUTER LOOP", "VERTEX"):
+// OpenMesh's reader opens a facet at "OUTER" as at "outer", so such a file is an ASCII STL here
+// too and loads as its lowercase twin does, coordinates exactly (as 32-bit floats, as STL holds
+// them). In mixed case ("Outer Loop"), which OpenMesh's reader opens no facet at, it is refused
+// naming the line.
+TEST(MeshIo, AsciiStlInCapitals) {
+  TempDir dir;
+  // kTetraStl's tetrahedron, with corners whose text is not their digits alone.
+  const std::string a = "0.5 0.25 -1", b = "2.75 0.25 -1", c = "0.5 3.125e0 -1", d = "0.1 0.25 1.5e1";
+  const auto facet = [](const std::string& p, const std::string& q, const std::string& r) {
+    return "facet normal 0 0 0\nouter loop\nvertex " + p + "\nvertex " + q + "\nvertex " + r + "\nendloop\nendfacet\n";
+  };
+  const std::string lower =
+      "solid t\n" + facet(a, c, b) + facet(a, b, d) + facet(a, d, c) + facet(b, c, d) + "endsolid t\n";
+  std::string upper = lower;
+  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char ch) { return std::toupper(ch); });
+  ASSERT_NE(upper.find("VERTEX 0.5 3.125E0 -1\n"), std::string::npos);
+  const TriangleMesh twin = read_mesh(dir.write("lower.stl", lower));
+  const TriangleMesh m = read_mesh(dir.write("upper.stl", upper));
+  ASSERT_EQ(m.num_vertices(), 4);
+  ASSERT_EQ(m.num_faces(), 4);
+  // Vertices in the order of their first corner: a, c, b, d.
+  Eigen::Matrix<double, 4, 3> points;
+  points << 0.5, 0.25, -1, 0.5, 3.125, -1, 2.75, 0.25, -1, static_cast<double>(0.1f), 0.25, 15;
+  EXPECT_TRUE(m.vertices == points) << m.vertices;
+  EXPECT_TRUE(m.vertices == twin.vertices);
+  EXPECT_TRUE(m.faces == twin.faces);
+  const MeshReport report = validate_mesh(m, "upper.stl");
+  EXPECT_TRUE(report.closed());
+
+  std::string mixed = lower;
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"solid", "Solid"}, {"facet normal", "Facet Normal"},
+                                 {"outer loop", "Outer Loop"}, {"vertex", "Vertex"}}) {
+    for (auto p = mixed.find(from); p != std::string::npos; p = mixed.find(from, p + 1)) mixed.replace(p, from.size(), to);
+  }
+  expect_error_naming(dir.write("mixed.stl", mixed),
+                      "line 3: 'Outer Loop': OpenMesh's reader opens a facet only at 'outer' or 'OUTER'");
+}
+
 // The lines are checked in the same 1 MiB chunks the facets are counted in, so a line, a keyword
 // or a number can straddle a chunk: each is put across the first boundary after the 84-byte head
 // (by widening the indentation of a vertex line), once valid (the file loads) and once bad (the
