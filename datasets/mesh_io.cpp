@@ -2,7 +2,8 @@
 // with errors that name the line; OpenMesh's half-edge insertion then checks the topology, which
 // its own readers would instead repair silently by dropping faces or duplicating vertices
 // (DESIGN.md, practical notes). Binary OFF is walked here too, in the layout OpenMesh reads. STL
-// is read by OpenMesh and checked by counts, after a streaming pass that checks its lines.
+// is read by OpenMesh, in the layout (ASCII or binary) decided here rather than by its guess from
+// the file's length, and checked by counts, after a streaming pass that checks its lines.
 
 #include "datasets/mesh_io.h"
 
@@ -376,12 +377,23 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
                    " but the file has " + std::to_string(vertices) + " vertices");
 }
 
+// Whether word is the keyword (given in lowercase) in any case: STL's keywords are lowercase, but
+// files in capitals ("SOLID", "OUTER LOOP", "VERTEX") exist.
+bool is_keyword(std::string_view word, std::string_view keyword) {
+  return word.size() == keyword.size() && std::equal(word.begin(), word.end(), keyword.begin(), [](char w, char k) {
+           return std::tolower(static_cast<unsigned char>(w)) == k;
+         });
+}
+
 // The lines of an ASCII STL as OpenMesh 9's reader takes them (STLReader.cc, read_stla): a line
 // containing "outer" (or "OUTER") opens a facet, and the next three lines are its corners, each
 // read as a word and three floats with `>>`, which on bad text keeps whatever the stream holds
 // (`vertex 0 1 zz` came out as (0, 1, 0), a missing coordinate as the last vertex's, `1e999` as
-// FLT_MAX). Fed the file's bytes in order, in pieces of any size; keeps only the current line
-// (at most 1 MiB). The first problem is kept as an error naming the line.
+// FLT_MAX). The corner's word is checked to be "vertex" in any case (`>>` skips it whatever it
+// is); a line starting with "outer" in mixed case ("Outer loop") opens no facet there, so it is
+// refused rather than let its facet be skipped. Fed the file's bytes in order, in pieces of any
+// size; keeps only the current line (at most 1 MiB). The first problem is kept as an error naming
+// the line.
 class AsciiStlLines {
  public:
   void feed(const char* p, std::size_t n) {
@@ -447,17 +459,20 @@ class AsciiStlLines {
     std::string_view rest = s;
     const std::string_view first = word(rest);
     if (corners_due_ == 0) {
-      if (first == "vertex")
+      if (is_keyword(first, "vertex"))
         return problem("a vertex line outside a facet's three corners (OpenMesh's reader skips it): " + quoted(s));
       if (s.find("outer") != std::string_view::npos || s.find("OUTER") != std::string_view::npos) {
         corners_due_ = 3;
         loop_line_ = number_;
         ++facets_;
+      } else if (is_keyword(first, "outer")) {
+        return problem(quoted(s) + ": OpenMesh's reader opens a facet only at 'outer' or 'OUTER' (STL's keywords "
+                       "are lowercase), and would skip this one");
       }
       return;
     }
     --corners_due_;
-    if (first != "vertex")
+    if (!is_keyword(first, "vertex"))
       return problem("expected 'vertex x y z', corner " + std::to_string(3 - corners_due_) +
                      " of the facet opened by 'outer' on line " + std::to_string(loop_line_) + ", found " + quoted(s));
     int count = 0;
@@ -496,54 +511,107 @@ class AsciiStlLines {
   std::string error_;
 };
 
-// STL: ASCII counts the facets OpenMesh opens ('outer' lines, AsciiStlLines), binary stores the
-// triangle count at byte 80. Vertices are
-// merged by OpenMesh (STL has no shared vertices), so their count is unknown in advance. A binary
-// file is not read here beyond its header (OpenMesh reads it next). A file that starts with
-// "solid" is ASCII if the word "facet" occurs in it (some binary exporters start their header
-// with "solid" too); it is streamed in chunks, never held whole, and the same pass checks its
-// lines (AsciiStlLines), whose error is raised once the file is known to be ASCII.
-long long count_stl_triangles(const std::string& path) {
+// The offset of the first byte no text holds (a control character other than a blank or a line
+// end), or npos. A binary STL's count and float records all but always hold one (0 is four NUL
+// bytes, 1.0f is 00 00 80 3f); an ASCII STL, UTF-8 names included, none.
+std::size_t first_non_text_byte(std::string_view bytes) {
+  const auto it = std::find_if(bytes.begin(), bytes.end(), [](char ch) {
+    const auto c = static_cast<unsigned char>(ch);
+    return (c < 0x20 && !std::isspace(c)) || c == 0x7f;
+  });
+  return it == bytes.end() ? std::string_view::npos : static_cast<std::size_t>(it - bytes.begin());
+}
+
+// Whether the file's bytes from offset `from` to its end are all zero.
+bool zeros_from(const std::string& path, unsigned long long from) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file");
-  std::string head(84, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<size_t>(in.gcount()));
-  const auto start = head.find_first_not_of(" \t\r\n");
-  if (start != std::string::npos && head.compare(start, 5, "solid") == 0) {
-    // Each chunk is searched for "facet" (which makes the file ASCII) behind the last 4 bytes of
-    // the one before, so a keyword across a boundary is found.
-    constexpr std::size_t kCarry = 4, kChunk = std::size_t(1) << 20;
-    std::string buffer = head.substr(start);
-    bool any = false;
-    AsciiStlLines lines;
-    lines.feed(head.data(), head.size());
-    std::string chunk(kChunk, '\0');
-    while (true) {
-      any = any || buffer.find("facet") != std::string::npos;
-      if (any && !lines.error().empty()) break;  // ASCII, with a bad line: no need to read on
-      if (!in) break;
-      in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-      const auto got = static_cast<std::size_t>(in.gcount());
-      if (got == 0) break;
-      lines.feed(chunk.data(), got);
-      buffer.erase(0, buffer.size() - std::min(kCarry, buffer.size()));
-      buffer.append(chunk, 0, got);
-    }
-    if (any) {
-      lines.finish();
-      if (!lines.error().empty()) fail(path, lines.error());
-      return lines.facets();
-    }
+  in.seekg(static_cast<std::streamoff>(from));
+  std::vector<char> chunk(std::size_t(1) << 16);
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    const auto end = chunk.begin() + in.gcount();
+    if (std::any_of(chunk.begin(), end, [](char c) { return c != 0; })) return false;
   }
-  if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header");
+  return in.eof();
+}
+
+// Binary STL: an 80-byte header, the triangle count N at byte 80, then 50 bytes a triangle.
+// OpenMesh reads exactly N (when told the file is binary: read_stl_through_openmesh), so bytes
+// after them are accepted as padding, as some exporters write, when they cannot hold a triangle
+// (fewer than 50) or are all zero (a zero record would be a degenerate triangle at the origin);
+// other bytes after them may be triangles a wrong count leaves out, and are refused, as is a
+// file too short for its count. `why` says why the file is not read as ASCII.
+long long binary_stl_triangles(const std::string& path, const std::string& head, const std::string& why) {
+  if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header (" + why + ")");
   std::uint32_t n = 0;
   std::memcpy(&n, head.data() + 80, 4);
   std::error_code ec;
-  const auto size = fs::file_size(path, ec);
+  const unsigned long long size = fs::file_size(path, ec);
   if (ec) fail(path, "cannot read the file's size: " + ec.message());
-  if (size < 84 + 50ull * n) fail(path, "binary STL truncated (" + std::to_string(n) + " triangles announced)");
+  const unsigned long long need = 84 + 50ull * n;
+  const std::string announced = "binary STL announces " + std::to_string(n) + " triangles (84 + 50 * " +
+                                std::to_string(n) + " = " + std::to_string(need) + " bytes) but the file has " +
+                                std::to_string(size) + " bytes";
+  if (size < need) fail(path, announced + " (" + why + ")");
+  if (size - need >= 50 && !zeros_from(path, need))
+    fail(path, announced + ": the " + std::to_string(size - need) +
+                   " bytes after its last triangle, too many for padding and not all zero, may be triangles "
+                   "its count leaves out");
   return n;
+}
+
+// STL: the layout OpenMesh is told to read, and the triangles the file holds, to compare with
+// those OpenMesh added. OpenMesh's own guess (OpenMesh 9, STLReader.cc, check_stl_type) takes a
+// file for binary only when its length is exactly 84 + 50 N, so a binary file with bytes after
+// its triangles was read as ASCII: as nothing, or as garbage.
+struct StlLayout {
+  bool binary = false;
+  long long triangles = 0;  // ASCII: the facets OpenMesh opens ('outer' lines, AsciiStlLines)
+};
+
+// A file is ASCII if it starts with "solid", in any case (until 2026-11-25 a file in capitals was
+// taken for binary), and its first 84 + 1 MiB bytes are text: some binary exporters start their
+// header with "solid" too, and words like "facet" after it (until 2026-11-25 the word "facet"
+// anywhere in the file made it ASCII). An ASCII file is streamed in an 84-byte head and then
+// 1 MiB chunks, never held whole, and the same pass checks its lines (AsciiStlLines) and counts
+// its facets. Any other file is binary, and is not read here beyond
+// its header and its length (OpenMesh reads it next). Vertices are merged by OpenMesh (STL has no
+// shared vertices), so their count is unknown in advance.
+StlLayout scan_stl(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file");
+  const auto read = [&](std::string& bytes, std::size_t n) {
+    bytes.resize(n);
+    in.read(bytes.data(), static_cast<std::streamsize>(n));
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
+  };
+  constexpr std::size_t kChunk = std::size_t(1) << 20;
+  std::string head, chunk;
+  read(head, 84);
+  read(chunk, kChunk);
+  const auto start = head.find_first_not_of(" \t\r\n");
+  if (start == std::string::npos || !is_keyword(std::string_view(head).substr(start, 5), "solid"))
+    return {true, binary_stl_triangles(path, head, "it does not start with 'solid', so it is no ASCII STL")};
+  std::size_t bad = first_non_text_byte(head);
+  if (bad == std::string::npos && (bad = first_non_text_byte(chunk)) != std::string::npos) bad += head.size();
+  if (bad != std::string::npos) {
+    const auto c = static_cast<unsigned char>(bad < head.size() ? head[bad] : chunk[bad - head.size()]);
+    char byte[8];
+    std::snprintf(byte, sizeof byte, "0x%02x", c);
+    return {true, binary_stl_triangles(path, head,
+                                       "it starts with 'solid', as some binary headers do, but its byte " +
+                                           std::to_string(bad) + " is " + byte + ", which no ASCII STL holds")};
+  }
+  AsciiStlLines lines;
+  lines.feed(head.data(), head.size());
+  while (!chunk.empty() && lines.error().empty()) {  // after a bad line, no need to read on
+    lines.feed(chunk.data(), chunk.size());
+    read(chunk, kChunk);
+  }
+  lines.finish();
+  if (!lines.error().empty()) fail(path, lines.error());
+  return {false, lines.facets()};
 }
 
 // Adds the faces to an OpenMesh half-edge mesh in order, as its readers do. A face it cannot add
@@ -590,12 +658,17 @@ IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const 
   return om;
 }
 
-// STL: OpenMesh reads it, merging the file's corners into vertices; what it dropped or
-// duplicated is detected by counts.
-TriangleMesh read_stl_through_openmesh(const std::string& path, long long file_triangles) {
+// STL: OpenMesh reads it in the layout scan_stl found (from a stream, whose reader takes the
+// layout from the Binary option, not from the file's length), merging the file's corners into
+// vertices; what it dropped or duplicated is detected by counts.
+TriangleMesh read_stl_through_openmesh(const std::string& path, const StlLayout& layout) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file");
   IoMesh om;
   OpenMesh::IO::Options opt;
-  if (!OpenMesh::IO::read_mesh(om, path, opt)) fail(path, "OpenMesh could not parse the file");
+  if (layout.binary) opt += OpenMesh::IO::Options::Binary;
+  if (!OpenMesh::IO::read_mesh(om, in, ".stl", opt)) fail(path, "OpenMesh could not parse the file");
+  const long long file_triangles = layout.triangles;
   const long long nv = static_cast<long long>(om.n_vertices());
   const long long nf = static_cast<long long>(om.n_faces());
   {
@@ -651,7 +724,7 @@ TriangleMesh read_mesh(const std::string& path) {
   } else if (ext == ".ply") {
     walk = scan_ply(path);  // a full walk of header and body (ply_format.cpp)
   } else if (ext == ".stl") {
-    return read_stl_through_openmesh(path, count_stl_triangles(path));
+    return read_stl_through_openmesh(path, scan_stl(path));
   } else {
     fail(path, "unknown mesh extension '" + ext + "' (supported: .off .ply .obj .stl)");
   }

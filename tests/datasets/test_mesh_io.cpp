@@ -575,7 +575,7 @@ std::string ascii_stl_past_the_first_chunk(TempDir& dir, const TriangleMesh& m) 
 }
 
 // An ASCII STL is counted in chunks of 1 MiB read after its 84-byte head (mesh_io.cpp: the
-// facets its lines open, and the word "facet" that makes it ASCII). The count is what notices a
+// facets its lines open; until 2026-11-25 the word "facet" made it ASCII). The count notices a
 // facet OpenMesh drops without an error (here a degenerate one), so a keyword missed or counted
 // twice at a chunk boundary would hide it or blame a wrong number.
 // One file per way a keyword can meet the first boundary, moved there by blanks ("fa|cet",
@@ -666,6 +666,45 @@ TEST(MeshIo, AsciiStlVertexLinesChecked) {
   }
 }
 
+// STL's keywords are lowercase, but files in capitals exist ("SOLID", "OUTER LOOP", "VERTEX"):
+// OpenMesh's reader opens a facet at "OUTER" as at "outer", so such a file is an ASCII STL here
+// too and loads as its lowercase twin does, coordinates exactly (as 32-bit floats, as STL holds
+// them). In mixed case ("Outer Loop"), which OpenMesh's reader opens no facet at, it is refused
+// naming the line.
+TEST(MeshIo, AsciiStlInCapitals) {
+  TempDir dir;
+  // kTetraStl's tetrahedron, with corners whose text is not their digits alone.
+  const std::string a = "0.5 0.25 -1", b = "2.75 0.25 -1", c = "0.5 3.125e0 -1", d = "0.1 0.25 1.5e1";
+  const auto facet = [](const std::string& p, const std::string& q, const std::string& r) {
+    return "facet normal 0 0 0\nouter loop\nvertex " + p + "\nvertex " + q + "\nvertex " + r + "\nendloop\nendfacet\n";
+  };
+  const std::string lower =
+      "solid t\n" + facet(a, c, b) + facet(a, b, d) + facet(a, d, c) + facet(b, c, d) + "endsolid t\n";
+  std::string upper = lower;
+  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char ch) { return std::toupper(ch); });
+  ASSERT_NE(upper.find("VERTEX 0.5 3.125E0 -1\n"), std::string::npos);
+  const TriangleMesh twin = read_mesh(dir.write("lower.stl", lower));
+  const TriangleMesh m = read_mesh(dir.write("upper.stl", upper));
+  ASSERT_EQ(m.num_vertices(), 4);
+  ASSERT_EQ(m.num_faces(), 4);
+  // Vertices in the order of their first corner: a, c, b, d.
+  Eigen::Matrix<double, 4, 3> points;
+  points << 0.5, 0.25, -1, 0.5, 3.125, -1, 2.75, 0.25, -1, static_cast<double>(0.1f), 0.25, 15;
+  EXPECT_TRUE(m.vertices == points) << m.vertices;
+  EXPECT_TRUE(m.vertices == twin.vertices);
+  EXPECT_TRUE(m.faces == twin.faces);
+  const MeshReport report = validate_mesh(m, "upper.stl");
+  EXPECT_TRUE(report.closed());
+
+  std::string mixed = lower;
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"solid", "Solid"}, {"facet normal", "Facet Normal"},
+                                 {"outer loop", "Outer Loop"}, {"vertex", "Vertex"}}) {
+    for (auto p = mixed.find(from); p != std::string::npos; p = mixed.find(from, p + 1)) mixed.replace(p, from.size(), to);
+  }
+  expect_error_naming(dir.write("mixed.stl", mixed),
+                      "line 3: 'Outer Loop': OpenMesh's reader opens a facet only at 'outer' or 'OUTER'");
+}
+
 // The lines are checked in the same 1 MiB chunks the facets are counted in, so a line, a keyword
 // or a number can straddle a chunk: each is put across the first boundary after the 84-byte head
 // (by widening the indentation of a vertex line), once valid (the file loads) and once bad (the
@@ -704,7 +743,7 @@ TEST(MeshIo, AsciiStlLinesCheckedAcrossReadChunks) {
 }
 
 // A binary STL is checked by its header's triangle count against the file's length; one whose
-// header starts with "solid" (as some exporters write) is still binary when it has no facet.
+// header starts with "solid" (as some exporters write) is still binary: it is not all text.
 TEST(MeshIo, BinaryStlHeaderAndLength) {
   TempDir dir;
   const TriangleMesh m = make_icosphere(1);
@@ -715,7 +754,7 @@ TEST(MeshIo, BinaryStlHeaderAndLength) {
   EXPECT_EQ(read_mesh(good).num_faces(), m.num_faces());
 
   expect_error_naming(dir.write("truncated.stl", bytes.substr(0, bytes.size() - 10)),
-                      "binary STL truncated (" + std::to_string(m.num_faces()) + " triangles announced)");
+                      "binary STL announces " + std::to_string(m.num_faces()) + " triangles");
   expect_error_naming(dir.write("short.stl", bytes.substr(0, 60)), "shorter than its 84-byte header");
 
   std::string solid = bytes;
@@ -723,6 +762,45 @@ TEST(MeshIo, BinaryStlHeaderAndLength) {
   const TriangleMesh r = read_mesh(dir.write("solid_header.stl", solid));
   EXPECT_EQ(r.num_faces(), m.num_faces());
   EXPECT_EQ(r.num_vertices(), m.num_vertices());
+}
+
+// OpenMesh takes an STL whose length is not 84 + 50 N (N the header's count) for ASCII and reads
+// nothing, or garbage, from a binary one; mesh_io.cpp decides the layout instead. Bytes after the
+// N triangles that cannot hold a triangle (fewer than 50) or are all zero are padding: the file
+// loads as without them, "solid" header or not. Other bytes after them (triangles the count may
+// leave out) and a file too short for them are refused, naming the count and both lengths.
+TEST(MeshIo, BinaryStlTrailingBytes) {
+  TempDir dir;
+  const TriangleMesh m = make_icosphere(1);
+  const std::string good = dir.file("good.stl");
+  write_mesh(good, m, true);
+  const std::string bytes = file_bytes(good);
+  const TriangleMesh expected = read_mesh(good);
+  ASSERT_EQ(expected.num_faces(), m.num_faces());
+  std::string solid = bytes;
+  solid.replace(0, 16, "solid facet_mesh");  // header words an ASCII STL would start with
+  for (const std::string& body : {bytes, solid}) {
+    for (const std::string& tail : {std::string("\n"), std::string(49, 'x'), std::string(4096, '\0')}) {
+      SCOPED_TRACE(body.substr(0, 5) + " header, " + std::to_string(tail.size()) + " bytes after");
+      const TriangleMesh r = read_mesh(dir.write("padded.stl", body + tail));
+      ASSERT_EQ(r.num_faces(), expected.num_faces());
+      ASSERT_EQ(r.num_vertices(), expected.num_vertices());
+      EXPECT_TRUE(r.vertices == expected.vertices);
+      EXPECT_TRUE(r.faces == expected.faces);
+    }
+  }
+  const std::string n = std::to_string(m.num_faces());
+  const std::string announced = "binary STL announces " + n + " triangles (84 + 50 * " + n + " = " +
+                                std::to_string(bytes.size()) + " bytes) but the file has ";
+  const std::string record = bytes.substr(84, 50);  // a triangle's, nonzero
+  expect_error_naming(dir.write("extra.stl", bytes + record),
+                      announced + std::to_string(bytes.size() + 50) + " bytes: the 50 bytes after its last triangle");
+  expect_error_naming(dir.write("extra.stl", bytes + std::string(60, '\0') + record),
+                      announced + std::to_string(bytes.size() + 110) + " bytes");
+  expect_error_naming(dir.write("truncated.stl", bytes.substr(0, bytes.size() - 10)),
+                      announced + std::to_string(bytes.size() - 10) + " bytes");
+  expect_error_naming(dir.write("truncated.stl", solid.substr(0, bytes.size() - 10)),
+                      announced + std::to_string(bytes.size() - 10) + " bytes (it starts with 'solid'");
 }
 
 // A binary OFF: its header line, then 32-bit words, little-endian (as OpenMesh writes it on
