@@ -50,6 +50,10 @@ class Basis {
   /// flow then calls rebuild(vertices) before each step and restarts from initial_coefficients().
   virtual bool rebuilds_every_step() const { return false; }
   virtual void rebuild(const Positions& /*vertices*/) {}
+  /// The flow moved the surface it evaluated last to a new frame, x -> (x - centroid) * scale
+  /// (unit-area normalisation). A basis that keeps positions of its own beside the coefficients
+  /// moves them alike (the rebuilt octree's refined midpoints); the others have nothing to do.
+  virtual void reframe(const Eigen::RowVector3d& /*centroid*/, double /*scale*/) {}
 
   /// Coefficients that reproduce the current (initial) embedding: vertex positions for the hat
   /// basis, x_0^I = c_I (grid-vertex positions) for the octree.

@@ -166,6 +166,13 @@ void RebuiltOctreeBasis::update(const Coefficients& x, bool, bool) {
     throw std::invalid_argument("RebuiltOctreeBasis::update: coefficient count does not match the dimension");
 }
 
+void RebuiltOctreeBasis::reframe(const Eigen::RowVector3d& centroid, double scale) {
+  // The same expression the flow applies to the vertices, so the top rows stay bitwise equal to
+  // the vertices rebuild() will be given.
+  if (options_.refine_input && last_evaluated_build_ == build_id_)
+    last_evaluated_ = (last_evaluated_.rowwise() - centroid) * scale;
+}
+
 Positions RebuiltOctreeBasis::evaluate_vertices(const Coefficients& x) const {
   if (x.rows() != dimension())
     throw std::invalid_argument("RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");

@@ -43,6 +43,9 @@ class RebuiltOctreeBasis : public Basis {
   /// vertex count). With refine_input the midpoint vertices come from the last
   /// evaluate_vertices call when there was one on the current basis, else from the edges' midpoints.
   void rebuild(const Positions& vertices) override;
+  /// With refine_input: moves the last evaluation's midpoints with the flow's normalisation, so
+  /// that rebuild() recognises the normalised vertices and keeps the flowed midpoints.
+  void reframe(const Eigen::RowVector3d& centroid, double scale) override;
   /// x_0^I = c_I, the grid-vertex positions of the finest functions.
   Coefficients initial_coefficients() const override;
   /// The matrices integrated by rebuild() are those of the identity metric, i.e. of x =

@@ -281,6 +281,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
       apply(n, V_new);
       apply(n, x_new);
       apply(n, x);  // becomes X_{n-1}: same frame as X_n for two-step schemes
+      basis->reframe(n.centroid, n.scale);  // with refine_input, the flowed midpoints follow
     }
     step_difference = (V_new - V).norm();
     previous_area = config.normalize_area ? 1.0 : area;

@@ -221,6 +221,32 @@ TEST(OctreeBasis, RefinedInput) {
   EXPECT_NEAR(refined.mass().sum(), test_mesh_area(mesh), 1e-12 * test_mesh_area(mesh));
 }
 
+// A normalising flow moves the surface to a new frame after each step; reframe() moves the
+// flowed midpoints alike, so the next rebuild keeps them. Without it rebuild() saw vertices that
+// differ from the last evaluation's and fell back to the flat edge midpoints: refine_input with
+// normalize_area flowed exactly as without refine_input.
+TEST(OctreeBasis, RefinedInputKeepsItsMidpointsThroughAReframe) {
+  const auto mesh = rotated_sphere(2);
+  const OctreeOptions o{.depth = 5, .refine_input = true};
+  RebuiltOctreeBasis kept(mesh, o), moved(mesh, o);
+  mcf::Coefficients x = kept.initial_coefficients();
+  x.col(0) += 0.05 * x.col(1).array().square().matrix();  // bends the edges: midpoints leave them
+  const mcf::Positions v = kept.evaluate_vertices(x);
+  ASSERT_EQ(moved.evaluate_vertices(x), v);
+  kept.rebuild(v);  // the midpoints of the evaluation
+  const mcf::Positions flowed = kept.working_mesh().vertices;
+  const Eigen::RowVector3d centroid(0.1, -0.2, 0.3);
+  const double scale = 1.7;
+  moved.reframe(centroid, scale);
+  moved.rebuild((v.rowwise() - centroid) * scale);
+  const mcf::Positions expected = (flowed.rowwise() - centroid) * scale;
+  EXPECT_EQ(moved.working_mesh().vertices, expected);
+  // The midpoints differ from the flat ones this test would see without reframe().
+  RebuiltOctreeBasis flat(mesh, o);
+  flat.rebuild((v.rowwise() - centroid) * scale);
+  EXPECT_GT((flat.working_mesh().vertices - expected).cwiseAbs().maxCoeff(), 1e-4);
+}
+
 // Sizes for comparison with the paper's Table 1 (unit sphere, 3.7e5 vertices, depth 8: 3.8e6
 // split triangles, dimension 5.1e5): a 40962-vertex sphere at depth 7.
 TEST(OctreeBasis, SizesOfA40kSphereAtDepth7) {

@@ -346,6 +346,24 @@ TEST(OctreeFlows, UnusedVerticesKeepTheirPositions) {
   }
 }
 
+// refine_input under normalize_area: the flow hands its normalisation to the basis (reframe), so
+// the refined midpoints flow too. With the degree-6 rule the flat 1-to-4 split integrates exactly
+// like the unsplit faces, so only flowed midpoints can tell the two runs apart; they agreed to
+// 1.4e-14 when each rebuild fell back to flat midpoints.
+TEST(OctreeFlows, RefinedInputFlowsItsMidpointsUnderNormalisation) {
+  json j = octree("torus:n_major=24,n_minor=8", "rebuilt", 5, {{"name", "cholmod"}});
+  j["octree"]["cubature"] = 6;
+  j["dt"] = 2e-3;
+  j["steps"] = 4;
+  j["normalize_area"] = true;
+  const auto plain = run(j);
+  j["octree"]["refine_input"] = true;
+  const auto refined = run(j);
+  ASSERT_EQ(plain.result["status"], "ok");
+  ASSERT_EQ(refined.result["status"], "ok");
+  EXPECT_GT((refined.final_mesh.vertices - plain.final_mesh.vertices).cwiseAbs().maxCoeff(), 1e-4);
+}
+
 TEST(OctreeFlows, OpenSurfaceKeepsItsBoundary) {
   json j = octree("open_cylinder:n_around=32,n_along=16", "tracked", 6, {{"name", "multigrid"}, {"cycles", 3}});
   j["dt"] = 1e-2;
