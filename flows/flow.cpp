@@ -10,7 +10,6 @@
 #include "flows/registry.h"
 #include "flows/sphere_reference.h"
 #include "solvers/blas_threads.h"
-#include "solvers/dense_reference.h"
 #include "solvers/symmetric_multiply.h"
 
 #include <tbb/global_control.h>
@@ -175,15 +174,14 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
   std::unique_ptr<Basis> basis = make_basis(config, mesh, source.analytic);
   const double build_seconds = seconds_since(setup_start);  // a rebuilt basis: its step 1's update
   std::unique_ptr<LinearSolver> solver = make_solver(config.solver);
-  if (config.solver.name == "dense") {
-    // The dense reference refuses a large system at its first factorization; say so now, as the
-    // configuration error it is, rather than stop the flow at step 1 as if it had turned singular.
-    const long long free = basis->dimension() - (long long)basis->locked_functions().size();
-    if (free > kDenseMaxDimension)
-      throw ConfigError(source.spec + ": solver: \"dense\" factorizes at most " + std::to_string(kDenseMaxDimension) +
-                        " functions and this basis has " + std::to_string(free) +
-                        " free ones; use \"cholmod\", \"pcg\" or \"multigrid\"");
-  }
+  // A solver that takes only small systems (the dense reference) would refuse this one at its
+  // first factorization: say so now, as the configuration error it is, rather than stop the
+  // flow at step 1 as if it had turned singular.
+  if (const Eigen::Index free = basis->dimension() - Eigen::Index(basis->locked_functions().size());
+      free > solver->max_dimension())
+    throw ConfigError(source.spec + ": solver: \"" + config.solver.name + "\" factorizes at most " +
+                      std::to_string(solver->max_dimension()) + " functions and this basis has " +
+                      std::to_string(free) + " free ones; use \"cholmod\", \"pcg\" or \"multigrid\"");
   std::unique_ptr<Integrator> integrator = make_integrator(config.integrator, config.extrapolate);
   result["system"] = stats_json(basis->stats());
   result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);

@@ -253,21 +253,7 @@ SolveReport CholmodSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) 
   double one[2] = {1.0, 0.0};
   cholmod_l_sdmult(lower_, 0, minus_one, one, x_, r_, &common_);
 
-  double worst = 0.0;
-  for (Long c = 0; c < k; ++c) {
-    const Eigen::Map<const Eigen::VectorXd> rc(rs + c * n, n);
-    const double bn = B.col(c).norm();
-    const double rn = rc.norm();
-    const double rel = bn > 0.0 ? rn / bn : rn;
-    if (!std::isfinite(rel)) worst = rel;
-    else if (std::isfinite(worst)) worst = std::max(worst, rel);
-  }
-  report.relative_residual = worst;
-  report.residuals = {worst};
-  if (!std::isfinite(worst)) {
-    report.status = SolveStatus::numerical_issue;
-    report.message = "solution has NaN/inf";
-  }
+  report_true_residual(B, Eigen::Map<const Eigen::MatrixXd>(rs, n, k), report);
   return report;
 }
 

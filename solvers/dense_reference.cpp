@@ -46,22 +46,8 @@ SolveReport DenseLltSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X)
     return rep;
   }
   X = llt_.solve(B);
-  const Eigen::MatrixXd R = B - A_ * X;
-  double worst = 0.0;
-  for (Eigen::Index c = 0; c < B.cols(); ++c) {
-    const double bn = B.col(c).norm();
-    const double rel = bn > 0.0 ? R.col(c).norm() / bn : R.col(c).norm();
-    // A non-finite column is kept: a later finite one must not report the solve converged.
-    if (!std::isfinite(rel)) worst = rel;
-    else if (std::isfinite(worst)) worst = std::max(worst, rel);
-  }
   rep.iterations = 1;
-  rep.relative_residual = worst;
-  rep.residuals = {worst};
-  if (!std::isfinite(worst)) {
-    rep.status = SolveStatus::numerical_issue;
-    rep.message = "solution has NaN/inf";
-  }
+  report_true_residual(B, B - A_ * X, rep);
   return rep;
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <string>
 
 namespace mcf {
@@ -69,6 +70,23 @@ SolveReport LinearSolver::set_matrix_sum(double a, const SparseRef& M, double b,
   sum_key_ = key;
   sum_on_pattern(a, M, b, K, sum_);
   return set_matrix(sum_, hierarchy);
+}
+
+void report_true_residual(const ConstMatrixRef& B, const ConstMatrixRef& R, SolveReport& report) {
+  double worst = 0.0;
+  for (Eigen::Index c = 0; c < B.cols(); ++c) {
+    const double bn = B.col(c).norm();
+    const double rn = R.col(c).norm();
+    const double rel = bn > 0.0 ? rn / bn : rn;
+    if (!std::isfinite(rel)) worst = rel;
+    else if (std::isfinite(worst)) worst = std::max(worst, rel);
+  }
+  report.relative_residual = worst;
+  report.residuals = {worst};
+  if (!std::isfinite(worst)) {
+    report.status = SolveStatus::numerical_issue;
+    report.message = "solution has NaN/inf";
+  }
 }
 
 SolveReport LinearSolver::solve(const ConstMatrixRef& B, MatrixRef X) {

@@ -7,6 +7,7 @@
 #include <Eigen/SparseCore>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -110,10 +111,18 @@ bool summable(const SparseRef& M, const SparseRef& K);
 using ConstMatrixRef = Eigen::Ref<const Eigen::MatrixXd>;
 using MatrixRef = Eigen::Ref<Eigen::MatrixXd>;
 
+/// A direct solve's true residual R = B - A X into its report: per column ||r|| / ||b|| (||r||
+/// when b = 0), the worst over the columns, and numerical_issue when that is not finite. A
+/// non-finite column is kept, so a later finite one cannot report the solve converged.
+void report_true_residual(const ConstMatrixRef& B, const ConstMatrixRef& R, SolveReport& report);
+
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
   virtual std::string name() const = 0;
+  /// The largest system this solver takes (the dense reference's n² storage); a flow refuses a
+  /// larger basis before its first step, as a configuration error.
+  virtual Eigen::Index max_dimension() const { return std::numeric_limits<Eigen::Index>::max(); }
 
   /// Sets (or updates) the matrix A (full symmetric storage, compressed). A solver detects
   /// whether the sparsity pattern is unchanged and then reuses its symbolic work.
