@@ -97,17 +97,16 @@ OffKeyword parse_off_keyword(const std::string& path, const std::string& magic) 
     fail(path, "not an OFF file (header '" + magic + "')");
   OffKeyword k;
   std::string_view prefix(magic.data(), magic.size() - 3);
-  auto take = [&](char c) {
-    if (prefix.empty() || prefix.front() != c) return false;
-    prefix.remove_prefix(1);
+  auto take = [&](std::string_view letters) {
+    if (!prefix.starts_with(letters)) return false;
+    prefix.remove_prefix(letters.size());
     return true;
   };
-  take('S');
-  take('T');
-  take('C');
-  take('N');
-  k.homogeneous = take('4');
-  k.dimension = take('n');
+  take("ST");  // texture coordinates, as one prefix (as walk_off_binary reads it too)
+  take("C");
+  take("N");
+  k.homogeneous = take("4");
+  k.dimension = take("n");
   if (!prefix.empty())
     fail(path, "not an OFF file (header '" + magic + "'; the keyword is [ST][C][N][4][n]OFF)");
   return k;
@@ -132,8 +131,12 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
   std::string rest;
   std::getline(hs, rest);
   if (rest.find("BINARY") != std::string::npos) return false;  // walk_off_binary's
-  rest = clean_line(rest);
-  while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
+  // The counts (after nOFF's dimension) may follow on the keyword's line or on a later one.
+  const auto skip_blank_lines = [&] {
+    rest = clean_line(rest);
+    while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
+  };
+  skip_blank_lines();
   if (keyword.dimension) {  // "nOFF": the dimension, then the counts (on the same line or the next)
     std::istringstream ds(rest);
     long long dim = -1;
@@ -142,8 +145,7 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
       fail(path, magic + " of dimension " + std::to_string(dim) + ": only surfaces in 3 dimensions are read");
     rest.clear();  // getline leaves it alone when the dimension ended the line
     std::getline(ds, rest);
-    rest = clean_line(rest);
-    while (rest.empty() && std::getline(in, line)) rest = clean_line(line);
+    skip_blank_lines();
   }
   long long nv = -1, nf = -1;
   {

@@ -87,7 +87,7 @@ TEST(MeshIo, OffKeywordPrefixes) {
     EXPECT_EQ(m.vertices.row(2), Eigen::RowVector3d(0, 1, 0));
     EXPECT_EQ(m.vertices.row(3), last);
   }
-  for (const char* header : {"nOFF\n3\n4 4 0\n", "nOFF 3 4 4 0\n", "CnOFF\n3 4 4 0\n"}) {
+  for (const char* header : {"nOFF\n3\n4 4 0\n", "nOFF 3 4 4 0\n", "CnOFF\n3 4 4 0\n", "STOFF\n4 4 0\n"}) {
     SCOPED_TRACE(header);
     const TriangleMesh m = read_mesh(dir.write("n.off", std::string(header) + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces));
     ASSERT_EQ(m.num_vertices(), 4);
@@ -101,6 +101,7 @@ TEST(MeshIo, OffKeywordPrefixes) {
   expect_error_naming(dir.write("w.off", "4OFF\n4 4 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1\n" + faces),
                       "vertex 3: cannot parse");
   expect_error_naming(dir.write("x.off", "XOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces), "[ST][C][N][4][n]OFF");
+  expect_error_naming(dir.write("s.off", "SOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces), "[ST][C][N][4][n]OFF");
 }
 
 TEST(MeshIo, MissingFile) { expect_error_naming("/nonexistent_dir_xyz/missing_mesh.off", "no such file"); }
