@@ -69,6 +69,14 @@ def main(argv):
     by_study = {}
     planned = {}  # study -> {cell identity: (quick, planned cell)}, merged over folders and shards
     problems = []  # what --require-complete refuses besides missing and errored cells
+
+    def results_of(study, folder):
+        """The study's result list, with `folder` recorded among its sources."""
+        entry = by_study.setdefault(study, ([], []))
+        if folder not in entry[1]:
+            entry[1].append(folder)
+        return entry[0]
+
     for folder in folders:
         if not os.path.isdir(folder):
             common.warn("no such results folder: %s" % folder)
@@ -78,9 +86,7 @@ def main(argv):
         problems += ["unreadable plan %s" % p for p in unreadable]
         for plan in plans:
             study, quick = str(plan.get("study") or "flow"), bool(plan.get("quick", False))
-            entry = by_study.setdefault(study, ([], []))
-            if folder not in entry[1]:
-                entry[1].append(folder)
+            results_of(study, folder)
             for c in plan["cells"]:
                 if isinstance(c, dict):
                     planned.setdefault(study, {}).setdefault(common.cell_identity(study, quick, c), (quick, c))
@@ -88,10 +94,7 @@ def main(argv):
         if not results and not plans:
             problems.append("%s: no results and no run plan" % folder)
         for r in results:
-            entry = by_study.setdefault(common.study_of(r), ([], []))
-            entry[0].append(r)
-            if folder not in entry[1]:
-                entry[1].append(folder)
+            results_of(common.study_of(r), folder).append(r)
     # Planned cells without a result: {study: {"have", "total", "missing": [cells], "quick_mixed"}}.
     gaps = {}
     for study, cells in planned.items():
