@@ -60,6 +60,17 @@ std::optional<json> read_or_list(const fs::path& path, json& unreadable, const c
   }
 }
 
+/// The `.json` files directly in `dir` (none if it is not a folder), but `index.json`, sorted.
+std::vector<fs::path> json_files(const fs::path& dir) {
+  std::vector<fs::path> paths;
+  if (fs::is_directory(dir))
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.is_regular_file() && entry.path().extension() == ".json" && entry.path().filename() != "index.json")
+        paths.push_back(entry.path());
+  std::sort(paths.begin(), paths.end());
+  return paths;
+}
+
 /// "#3 {"dt":0.001} rep 1 (ab12cd34ef56.json)": a cell named as a user can find it.
 std::string describe_cell(int index, const json& c) {
   std::string s = "#" + std::to_string(index);
@@ -86,12 +97,7 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder");
         size_t found = 0;  // cell results, unreadable files and plans in this folder
         // The plans `run` wrote before its first cell: the cells owed even if none finished.
-        std::vector<fs::path> plan_paths;
-        if (fs::is_directory(fs::path(dir) / kPlanFolder))
-          for (const auto& entry : fs::directory_iterator(fs::path(dir) / kPlanFolder))
-            if (entry.is_regular_file() && entry.path().extension() == ".json") plan_paths.push_back(entry.path());
-        std::sort(plan_paths.begin(), plan_paths.end());
-        for (const auto& path : plan_paths) {
+        for (const auto& path : json_files(fs::path(dir) / kPlanFolder)) {
           const std::optional<json> read = read_or_list(path, unreadable, "rerun `mcfbench run` to rewrite it");
           if (!read) {
             ++found;
@@ -115,12 +121,7 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
             if (known.is_null() || (!known.contains("hash") && c.contains("hash"))) known = c;
           }
         }
-        std::vector<fs::path> paths;
-        for (const auto& entry : fs::directory_iterator(dir))
-          if (entry.is_regular_file() && entry.path().extension() == ".json" && entry.path().filename() != "index.json")
-            paths.push_back(entry.path());
-        std::sort(paths.begin(), paths.end());
-        for (const auto& path : paths) {
+        for (const auto& path : json_files(dir)) {
           const std::optional<json> read = read_or_list(path, unreadable, "rerun `mcfbench run` to redo its cell");
           if (!read) {
             ++found;
