@@ -235,6 +235,9 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
                         {"relative_residual", worst.relative_residual},
                         {"status", to_string(worst.status)}};
     if (ctx.solves_ > 1) record["solver"]["residuals_per_solve"] = ctx.residuals_per_solve_;
+    // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
+    // Gauss-Seidel on a level), or why it failed.
+    if (!worst.message.empty()) record["solver"]["message"] = worst.message;
     if (ctx.fixed()) record["fixed_functions"] = ctx.fixed();
     if (basis->rebuilds_every_step()) {
       record["dimension"] = basis->dimension();

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iterator>
 #include <stdexcept>
+#include <string>
 
 namespace mcf {
 
@@ -64,7 +65,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
       report_ = solver_.set_matrix(sum_, view);
     }
     Coefficients X = warm;  // solved in place: no n x 3 copies in and out (31 MB each at depth 9)
-    if (report_.ok()) report_ = solver_.solve(R, X);
+    solve_after_set(R, X);
     return X;
   }
   if (shared) {
@@ -135,7 +136,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     reduction_valid_ = false;
     report_ = solver_.set_matrix(sum_, view);
     Coefficients X = std::move(warm_held);  // anchored is not empty here: fixed_ is
-    if (report_.ok()) report_ = solver_.solve(R_in, X);
+    solve_after_set(R_in, X);
     hold(X);
     return X;
   }
@@ -170,7 +171,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
   if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
   reduced_view.pattern_key = shared ? reduced_key_ : 0;
   report_ = solver_.set_matrix(reduced_, reduced_view);
-  if (report_.ok()) report_ = solver_.solve(Rf, Xf);
+  solve_after_set(Rf, Xf);
   Coefficients Y = Yfixed;
   for (Eigen::Index i = 0; i < nf; ++i) Y.row(free_[i]) = Xf.row(i);
   hold(Y);
@@ -228,6 +229,16 @@ void ReducedSystem::rebuild_reduction(const SparseMatrix& S) {
   }
   reduced_key_ = new_pattern_key();
   reduction_valid_ = true;
+}
+
+void ReducedSystem::solve_after_set(const ConstMatrixRef& R, MatrixRef X) {
+  if (!report_.ok()) return;
+  // set_matrix's note on a matrix it accepted (a semi-definite coarsest level solved by its
+  // pseudo-inverse, a level without a valid colouring) is kept in the solve's report: the flow
+  // records report().message, and the solve's own report used to replace the note unseen.
+  std::string note = std::move(report_.message);
+  report_ = solver_.solve(R, X);
+  if (!note.empty()) report_.message = report_.message.empty() ? std::move(note) : note + "; " + report_.message;
 }
 
 }  // namespace mcf

@@ -22,7 +22,8 @@ class ReducedSystem {
  public:
   ReducedSystem(const Basis& basis, LinearSolver& solver);
 
-  /// Solves; `report()` then holds the solver's report. Returns the full solution.
+  /// Solves; `report()` then holds the solver's report, its message also carrying set_matrix's
+  /// note on an accepted matrix. Returns the full solution.
   Coefficients solve(double a, double b, const Coefficients& R, const Coefficients& fixed_values,
                      const Coefficients& warm);
   const SolveReport& report() const { return report_; }
@@ -32,6 +33,8 @@ class ReducedSystem {
  private:
   void rebuild_reduction(const SparseMatrix& S);
   bool shares_pattern(const SparseRef& M, const SparseRef& K);
+  /// report_ holds set_matrix's report: when it is ok, solves into X and keeps its note.
+  void solve_after_set(const ConstMatrixRef& R, MatrixRef X);
 
   const Basis& basis_;
   LinearSolver& solver_;

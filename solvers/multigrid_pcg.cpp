@@ -1,5 +1,8 @@
 #include "solvers/multigrid_pcg.h"
 
+#include <string>
+#include <utility>
+
 namespace mcf {
 
 MultigridPcgSolver::MultigridPcgSolver(MultigridOptions cycle, PcgOptions pcg) : multigrid_(cycle), pcg_(pcg) {
@@ -12,17 +15,27 @@ MultigridPcgSolver::MultigridPcgSolver(MultigridOptions cycle, PcgOptions pcg) :
   pcg_.set_preconditioner([this](const Eigen::MatrixXd& r, Eigen::MatrixXd& z) { multigrid_.precondition(r, z); });
 }
 
+namespace {
+// PCG's report with the preconditioner's note on the matrix (a semi-definite coarsest level,
+// a level without colouring) in front of PCG's own: PCG's report alone dropped it.
+SolveReport with_note(SolveReport preconditioner, SolveReport pcg) {
+  if (!preconditioner.message.empty())
+    pcg.message = pcg.message.empty() ? preconditioner.message : preconditioner.message + "; " + pcg.message;
+  return pcg;
+}
+}  // namespace
+
 SolveReport MultigridPcgSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
   SolveReport r = multigrid_.set_matrix(A, hierarchy);
   if (!r.ok()) return r;
-  return pcg_.set_matrix(A, hierarchy);
+  return with_note(std::move(r), pcg_.set_matrix(A, hierarchy));
 }
 
 SolveReport MultigridPcgSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                                HierarchyView hierarchy) {
   SolveReport r = multigrid_.set_matrix_sum(a, M, b, K, hierarchy);
   if (!r.ok()) return r;
-  return pcg_.set_matrix_sum(a, M, b, K, hierarchy);
+  return with_note(std::move(r), pcg_.set_matrix_sum(a, M, b, K, hierarchy));
 }
 
 }  // namespace mcf

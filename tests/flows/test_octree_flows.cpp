@@ -316,6 +316,13 @@ TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
   const Positions& b = cg.final_mesh.vertices;
   EXPECT_LT((a - b).norm() / b.norm(), 1e-9);
   EXPECT_LT((one.final_mesh.vertices - b).norm() / b.norm(), 1e-3);
+  // Every step records the solver's note on the semi-definite coarsest level (the solve's report
+  // used to replace it); CG with Jacobi has no hierarchy and nothing to note.
+  for (const auto* o : {&mg, &one})
+    for (const json& step : o->result["steps"])
+      EXPECT_NE(step["solver"].value("message", "").find("coarsest level semi-definite"), std::string::npos)
+          << step["solver"].dump();
+  for (const json& step : cg.result["steps"]) EXPECT_FALSE(step["solver"].contains("message"));
 }
 
 // A vertex no face uses lies on no piece. The tracked basis made a stencil for it anyway: at the

@@ -500,6 +500,12 @@ TEST(Multigrid, SemiDefiniteCoarsestLevelIsSolvedByItsPseudoInverse) {
   EXPECT_LT(((A * X - B).colwise().norm().array() / B.colwise().norm().array()).maxCoeff(), 1e-11);
   EXPECT_EQ(X.row(dropped).norm(), 0.0);  // no component along a zero row's null direction
 
+  // Multigrid-preconditioned CG passes the preconditioner's note on (it returned PCG's report).
+  mcf::MultigridPcgSolver mg_pcg{MultigridOptions{}, mcf::PcgOptions{}};
+  const mcf::SolveReport pcg_set = mg_pcg.set_matrix(A, HierarchyView{&none, nullptr});
+  ASSERT_TRUE(pcg_set.ok()) << pcg_set.message;
+  EXPECT_EQ(pcg_set.message, set.message);
+
   // Indefinite: one negative eigenvalue, no generalized inverse makes it a flow's system.
   // Positive diagonal, a 2 x 2 principal minor < 0.
   SparseMatrix indefinite = A;
