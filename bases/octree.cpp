@@ -1,5 +1,7 @@
 #include "bases/octree.h"
 
+#include "datasets/bounds.h"
+
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
@@ -11,11 +13,11 @@
 
 namespace mcf {
 
-GridCube choose_cube(const Positions& vertices, int depth, OctreeCube cube) {
+GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube) {
   if (depth < 1 || depth > 20) throw std::invalid_argument("octree depth must be in [1,20], got " + std::to_string(depth));
-  if (vertices.rows() == 0) throw std::invalid_argument("choose_cube: empty mesh");
-  const Eigen::Vector3d lo = vertices.colwise().minCoeff().transpose();
-  const Eigen::Vector3d hi = vertices.colwise().maxCoeff().transpose();
+  if (mesh.num_vertices() == 0) throw std::invalid_argument("choose_cube: empty mesh");
+  const Bounds bounds = surface_bounds(mesh);
+  const Eigen::Vector3d lo = bounds.lo.transpose(), hi = bounds.hi.transpose();
   const bool fits = (lo.array() >= 0.0).all() && (hi.array() <= 1.0).all();
   GridCube g;
   g.depth = depth;

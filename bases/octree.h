@@ -32,9 +32,10 @@ struct GridCube {
   double cell_size() const { return cell_size(depth); }
 };
 
-/// Chooses the cube for a depth in [1, 20] (the basis accepts 4..10). Throws std::invalid_argument
-/// for `unit` when a vertex lies outside [0,1]^3, and for an empty or single-point mesh.
-GridCube choose_cube(const Positions& vertices, int depth, OctreeCube cube);
+/// Chooses the cube for a depth in [1, 20] (the basis accepts 4..10) from the surface's bounds
+/// (the vertices its faces use: datasets/bounds.h). Throws std::invalid_argument for `unit` when
+/// such a vertex lies outside [0,1]^3, and for an empty or single-point mesh.
+GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube);
 
 using GridKey = std::uint64_t;
 inline constexpr int kGridKeyBits = 21;

@@ -97,7 +97,7 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
   stats_ = BasisStats{};
 
   auto t0 = Clock::now();
-  const GridCube cube = choose_cube(mesh_.vertices, options_.depth, options_.cube);
+  const GridCube cube = choose_cube(mesh_, options_.depth, options_.cube);
   stats_.cube_origin = {cube.origin.x(), cube.origin.y(), cube.origin.z()};
   stats_.cube_side = cube.side;
   double t_octree = seconds_since(t0);

@@ -3,6 +3,8 @@
 
 #include "datasets/mesh_spec.h"
 
+#include "datasets/bounds.h"
+
 #include "datasets/catalogue.h"
 #include "datasets/generators.h"
 #include "datasets/mesh_io.h"
@@ -15,17 +17,25 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <string>
 #include <vector>
 
 namespace mcf {
 namespace {
 
+// The most faces a mesh spec may ask for, generated or by @faces (~10 GB of mesh and topology).
+constexpr long long kMaxFaces = 200'000'000;
+// Integer keys beyond this are refused before they reach an int (the counts that matter are far
+// smaller; kMaxFaces bounds their products).
+constexpr double kMaxInteger = 1e9;
+
 struct Param {
   std::string key;
   bool integer;
   double fallback;
   std::string help;
+  double max = kMaxInteger;  ///< integer keys: the largest value taken (in magnitude)
 };
 
 using Values = std::map<std::string, double>;
@@ -35,7 +45,11 @@ struct Generator {
   std::vector<Param> params;
   std::function<TriangleMesh(const Values&)> build;
   std::string help;
+  /// About how many faces `build` makes (an upper estimate, in double so that it cannot
+  /// overflow): checked against kMaxFaces before building, since the generators count in int.
+  std::function<double(const Values&)> faces;
 };
+
 
 int as_int(const Values& v, const std::string& k) { return static_cast<int>(v.at(k)); }
 
@@ -44,46 +58,59 @@ const std::vector<Generator>& generators() {
       {"sphere",
        {{"vertices", true, 10242, "target vertex count"}, {"radius", false, 1.0, "radius"}},
        [](const Values& v) { return make_sphere(static_cast<long long>(v.at("vertices")), v.at("radius")); },
-       "geodesic sphere with about `vertices` vertices, centred at the origin"},
+       "geodesic sphere with about `vertices` vertices, centred at the origin",
+       [](const Values& v) { return 2 * v.at("vertices"); }},
       {"icosphere",
-       {{"level", true, 5, "1-to-4 subdivisions of the icosahedron"}, {"radius", false, 1.0, "radius"}},
+       {{"level", true, 5, "1-to-4 subdivisions of the icosahedron", 12}, {"radius", false, 1.0, "radius"}},
        [](const Values& v) { return make_icosphere(as_int(v, "level"), v.at("radius")); },
-       "icosahedron subdivided `level` times (10*4^level+2 vertices)"},
+       "icosahedron subdivided `level` times (10*4^level+2 vertices)",
+       [](const Values& v) { return 20 * std::pow(4.0, v.at("level")); }},
       {"torus",
        {{"R", false, 1.0, "major radius"}, {"r", false, 0.3, "minor radius"},
         {"n_major", true, 96, "segments around the axis"}, {"n_minor", true, 32, "segments around the tube"}},
        [](const Values& v) { return make_torus(v.at("R"), v.at("r"), as_int(v, "n_major"), as_int(v, "n_minor")); },
-       "torus about z (genus 1)"},
+       "torus about z (genus 1)",
+       [](const Values& v) { return 2 * v.at("n_major") * v.at("n_minor"); }},
       {"spiral",
        {{"turns", true, 3, "turns"}, {"segments_per_turn", true, 128, "segments along one turn"},
         {"profile_segments", true, 8, "segments across the ribbon"}},
        [](const Values& v) {
          return make_cubical_spiral(as_int(v, "turns"), as_int(v, "segments_per_turn"), as_int(v, "profile_segments"));
        },
-       "cubical spiral: square-profile helical ribbon with boundary"},
+       "cubical spiral: square-profile helical ribbon with boundary",
+       [](const Values& v) {
+         return 2 * 4 * std::ceil(v.at("segments_per_turn") / 4) * v.at("turns") * v.at("profile_segments");
+       }},
       {"dumbbell",
        {{"resolution", true, 64, "vertices around"}},
        [](const Values& v) { return make_dumbbell(as_int(v, "resolution")); },
-       "two unit spheres joined by a thin neck (genus 0)"},
+       "two unit spheres joined by a thin neck (genus 0)",
+       [](const Values& v) { return 2 * v.at("resolution") * v.at("resolution"); }},
       {"rounded_cylinder",
        {{"radius", false, 0.5, "radius"}, {"length", false, 2.0, "length of the straight part"},
         {"resolution", true, 64, "vertices around"}},
        [](const Values& v) { return make_rounded_cylinder(v.at("radius"), v.at("length"), as_int(v, "resolution")); },
-       "closed capsule (cylinder with hemispherical caps)"},
+       "closed capsule (cylinder with hemispherical caps)",
+       [](const Values& v) {  // rings spaced as the widest ring's vertices along the profile
+         const double n = v.at("resolution"), r = v.at("radius"), l = v.at("length");
+         return 2 * n * (n * (std::numbers::pi * r + l) / (2 * std::numbers::pi * r) + 1);
+       }},
       {"open_cylinder",
        {{"radius", false, 0.5, "radius"}, {"length", false, 2.0, "length"},
         {"n_around", true, 64, "vertices around"}, {"n_along", true, 40, "segments along"}},
        [](const Values& v) {
          return make_open_cylinder(v.at("radius"), v.at("length"), as_int(v, "n_around"), as_int(v, "n_along"));
        },
-       "open cylinder (two boundary loops)"},
+       "open cylinder (two boundary loops)",
+       [](const Values& v) { return 2 * v.at("n_around") * v.at("n_along"); }},
       {"catenoid",
        {{"waist", false, 1.0, "waist radius"}, {"height", false, 1.0, "half height h (z in [-h, h])"},
         {"n_around", true, 64, "vertices around"}, {"n_along", true, 24, "segments along"}},
        [](const Values& v) {
          return make_catenoid(v.at("waist"), v.at("height"), as_int(v, "n_around"), as_int(v, "n_along"));
        },
-       "catenoid (minimal surface, two boundary loops)"},
+       "catenoid (minimal surface, two boundary loops)",
+       [](const Values& v) { return 2 * v.at("n_around") * v.at("n_along"); }},
   };
   return table;
 }
@@ -133,17 +160,22 @@ std::string param_list(const Generator& g) {
 
 void fit_unit_cube(TriangleMesh& mesh) {
   if (mesh.num_vertices() == 0) return;
-  const Eigen::RowVector3d lo = mesh.vertices.colwise().minCoeff();
-  const Eigen::RowVector3d hi = mesh.vertices.colwise().maxCoeff();
-  const Eigen::RowVector3d extent = hi - lo;
+  // The surface's box: a vertex no face uses is moved along but does not size the model (one
+  // stray vertex at 100 x the model's size shrank it 100-fold, seven octree levels).
+  const Bounds box = surface_bounds(mesh);
+  const Eigen::RowVector3d extent = box.extent();
   const double scale = extent.maxCoeff() > 0 ? 1.0 / extent.maxCoeff() : 1.0;
   // Uniform scale (shape kept); the shorter axes are centred in [0, 1].
   const Eigen::RowVector3d offset = 0.5 * (Eigen::RowVector3d::Ones() - scale * extent);
-  mesh.vertices = ((mesh.vertices.rowwise() - lo) * scale).rowwise() + offset;
+  mesh.vertices = ((mesh.vertices.rowwise() - box.lo) * scale).rowwise() + offset;
   // The long axis can round an ulp outside [0, 1] (cgal:bunny00's smallest x came out -2.1e-17),
   // and the octree's "auto" cube would then leave the unit cube for the tight one: clamp the
-  // rounding away (it moves no coordinate by more than a few ulps).
-  mesh.vertices = mesh.vertices.cwiseMax(0.0).cwiseMin(1.0);
+  // rounding away (it moves no coordinate by more than a few ulps). Unused vertices may lie
+  // anywhere and keep their place relative to the surface.
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+    auto p = mesh.vertices.row(v);
+    if ((p.array() >= -1e-12).all() && (p.array() <= 1.0 + 1e-12).all()) p = p.cwiseMax(0.0).cwiseMin(1.0);
+  }
 }
 
 MeshSource load_mesh_spec(const std::string& spec) {
@@ -161,8 +193,8 @@ MeshSource load_mesh_spec(const std::string& spec) {
     if (key != "faces" || eq == std::string::npos)
       fail(spec, "unknown modifier key '" + key + "' (only @faces=N)");
     target_faces = static_cast<long long>(parse_number(spec, "faces", mod.substr(eq + 1), true));
-    if (target_faces < 1 || target_faces > 200'000'000)
-      fail(spec, "key 'faces' must be in 1..200000000, got " + mod.substr(eq + 1));
+    if (target_faces < 1 || target_faces > kMaxFaces)
+      fail(spec, "key 'faces' must be in 1.." + std::to_string(kMaxFaces) + ", got " + mod.substr(eq + 1));
   }
   if (head.empty()) fail(spec, "empty mesh spec");
 
@@ -211,6 +243,21 @@ MeshSource load_mesh_spec(const std::string& spec) {
         if (std::find(seen.begin(), seen.end(), key) != seen.end()) fail(spec, "key '" + key + "' given twice");
         seen.push_back(key);
         values[key] = parse_number(spec, key, item.substr(eq + 1), p->integer);
+        if (p->integer && std::abs(values[key]) > p->max)
+          fail(spec, "key '" + key + "' is out of range (at most " + std::to_string(static_cast<long long>(p->max)) +
+                         "), got " + item.substr(eq + 1));
+      }
+      // Counts the generators refuse (negative, too few) are theirs to name; a size that would
+      // overflow their int counts or exhaust memory is refused here, before anything is built.
+      const bool counts_positive = std::all_of(g->params.begin(), g->params.end(),
+                                               [&](const Param& p) { return !p.integer || values.at(p.key) > 0; });
+      const bool sizes_positive = std::all_of(g->params.begin(), g->params.end(),
+                                              [&](const Param& p) { return p.integer || values.at(p.key) > 0; });
+      if (counts_positive && sizes_positive) {
+        const double faces = g->faces(values);
+        if (!(faces <= static_cast<double>(kMaxFaces)))
+          fail(spec, "these values make about " + std::to_string(static_cast<long long>(std::min(faces, 1e18))) +
+                         " faces, more than the " + std::to_string(kMaxFaces) + " a mesh may have");
       }
       src.kind = name;
       src.analytic = true;

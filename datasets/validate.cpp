@@ -3,6 +3,8 @@
 
 #include "datasets/validate.h"
 
+#include "datasets/bounds.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -94,7 +96,7 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
 
   // Degeneracy relative to the model's size: the studies mix unit-cube models and big analytic
   // shapes, so an absolute area threshold would be wrong for one of them.
-  const double diag2 = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).squaredNorm();
+  const double diag2 = surface_bounds(mesh).extent().squaredNorm();  // a stray vertex is not the model's size
   const double min_area = 1e-14 * diag2;
   MeshReport report;
   report.vertices = n;

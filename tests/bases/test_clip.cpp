@@ -51,7 +51,7 @@ TEST(Clip, RotatedSphereKeepsArea) {
   const Eigen::Matrix3d R = test_random_rotation(11);
   m.vertices = (m.vertices * R.transpose()).rowwise() + Eigen::RowVector3d(0.1, -0.2, 0.3);
   for (int depth : {4, 6}) {
-    const GridCube cube = mcf::choose_cube(m.vertices, depth, mcf::OctreeCube::tight);
+    const GridCube cube = mcf::choose_cube(m, depth, mcf::OctreeCube::tight);
     const auto pieces = mcf::clip_mesh(m.vertices, m.faces, cube);
     EXPECT_GT(pieces.size(), static_cast<std::size_t>(m.num_faces()));
     const double total = check_pieces(m, cube, pieces);
@@ -67,7 +67,7 @@ TEST(Clip, VerticesExactlyOnGridPlanes) {
   const double h = 1.0 / 32.0;
   for (Eigen::Index v = 0; v < m.num_vertices(); ++v)
     for (int a = 0; a < 3; ++a) m.vertices(v, a) = std::round(m.vertices(v, a) / h) * h;
-  const GridCube cube = mcf::choose_cube(m.vertices, depth, mcf::OctreeCube::unit);
+  const GridCube cube = mcf::choose_cube(m, depth, mcf::OctreeCube::unit);
   EXPECT_EQ(cube.side, 1.0);
   const auto pieces = mcf::clip_mesh(m.vertices, m.faces, cube);
   const double total = check_pieces(m, cube, pieces);
@@ -81,7 +81,7 @@ TEST(Clip, TrianglesInsideGridPlanesAreNotDoubled) {
   for (int c = 0; c < 8; ++c) m.vertices.row(c) << 0.25 + 0.5 * (c & 1), 0.25 + 0.5 * ((c >> 1) & 1), 0.25 + 0.5 * ((c >> 2) & 1);
   m.faces.resize(12, 3);
   m.faces << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5;
-  const GridCube cube = mcf::choose_cube(m.vertices, 4, mcf::OctreeCube::unit);
+  const GridCube cube = mcf::choose_cube(m, 4, mcf::OctreeCube::unit);
   const auto pieces = mcf::clip_mesh(m.vertices, m.faces, cube);
   const double total = check_pieces(m, cube, pieces);
   EXPECT_NEAR(total, 1.5, 1e-14);
@@ -95,7 +95,7 @@ TEST(Clip, SingleTriangleSpanningManyCells) {
   m.vertices << 0.01, 0.02, 0.03, 0.97, 0.11, 0.5, 0.3, 0.95, 0.9;
   m.faces.resize(1, 3);
   m.faces << 0, 1, 2;
-  const GridCube cube = mcf::choose_cube(m.vertices, 6, mcf::OctreeCube::unit);
+  const GridCube cube = mcf::choose_cube(m, 6, mcf::OctreeCube::unit);
   const auto pieces = mcf::clip_mesh(m.vertices, m.faces, cube);
   EXPECT_GT(pieces.size(), 2000u);
   const double total = check_pieces(m, cube, pieces);
@@ -121,7 +121,7 @@ TEST(Clip, DegenerateTriangleGivesNoPieces) {
 
 TEST(Clip, DeterministicAndEqualToSerial) {
   auto m = test_icosphere(3, 0.4, Eigen::Vector3d(0.5, 0.5, 0.5));
-  const GridCube cube = mcf::choose_cube(m.vertices, 6, mcf::OctreeCube::automatic);
+  const GridCube cube = mcf::choose_cube(m, 6, mcf::OctreeCube::automatic);
   const auto pieces = mcf::clip_mesh(m.vertices, m.faces, cube);
   std::vector<ClippedTriangle> serial;
   for (Eigen::Index f = 0; f < m.num_faces(); ++f)

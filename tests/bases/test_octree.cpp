@@ -29,7 +29,7 @@ Fixture make_fixture(int depth, mcf::OctreeCube cube_kind = mcf::OctreeCube::tig
   Fixture f;
   f.mesh = test_icosphere(level, 1.0);
   f.mesh.vertices = f.mesh.vertices * test_random_rotation(3).transpose();
-  const auto cube = mcf::choose_cube(f.mesh.vertices, depth, cube_kind);
+  const auto cube = mcf::choose_cube(f.mesh, depth, cube_kind);
   f.pieces = mcf::clip_mesh(f.mesh.vertices, f.mesh.faces, cube);
   f.octree = mcf::build_octree(cube, f.pieces, 2);
   f.piece_cells = mcf::locate_pieces(f.octree, f.pieces);
@@ -46,13 +46,13 @@ std::pair<mcf::SparseMatrix, mcf::SparseMatrix> assembled(const mcf::OctreeSyste
 
 TEST(Octree, CubeChoice) {
   auto inside = test_icosphere(2, 0.3, Eigen::Vector3d(0.5, 0.5, 0.5));
-  auto g = mcf::choose_cube(inside.vertices, 6, mcf::OctreeCube::automatic);
+  auto g = mcf::choose_cube(inside, 6, mcf::OctreeCube::automatic);
   EXPECT_EQ(g.origin, Eigen::Vector3d::Zero());
   EXPECT_EQ(g.side, 1.0);
   auto sphere = test_icosphere(2, 1.0);
-  EXPECT_THROW(mcf::choose_cube(sphere.vertices, 6, mcf::OctreeCube::unit), std::invalid_argument);
+  EXPECT_THROW(mcf::choose_cube(sphere, 6, mcf::OctreeCube::unit), std::invalid_argument);
   for (auto kind : {mcf::OctreeCube::automatic, mcf::OctreeCube::tight}) {
-    g = mcf::choose_cube(sphere.vertices, 6, kind);
+    g = mcf::choose_cube(sphere, 6, kind);
     const double h = g.cell_size();
     EXPECT_NEAR(g.cell_size(), g.side / 64.0, 1e-15);
     for (int a = 0; a < 3; ++a) {  // margin at least half a cell on each side
@@ -61,8 +61,23 @@ TEST(Octree, CubeChoice) {
     }
     EXPECT_LT(g.side, 2.1);
   }
-  g = mcf::choose_cube(inside.vertices, 6, mcf::OctreeCube::tight);
+  g = mcf::choose_cube(inside, 6, mcf::OctreeCube::tight);
   EXPECT_LT(g.side, 0.7);
+}
+
+// The cube is the surface's: a vertex no face uses, even far outside [0, 1]^3, neither makes
+// "auto" leave the unit cube nor "unit" refuse the mesh, nor sizes the tight cube.
+TEST(Octree, CubeChoiceIgnoresUnusedVertices) {
+  const auto inside = test_icosphere(2, 0.3, Eigen::Vector3d(0.5, 0.5, 0.5));
+  auto stray = inside;
+  stray.vertices.conservativeResize(inside.vertices.rows() + 1, 3);
+  stray.vertices.row(inside.vertices.rows()) = Eigen::RowVector3d(7, -3, 2);
+  for (auto kind : {mcf::OctreeCube::automatic, mcf::OctreeCube::unit, mcf::OctreeCube::tight}) {
+    const auto a = mcf::choose_cube(inside, 6, kind), b = mcf::choose_cube(stray, 6, kind);
+    EXPECT_EQ(a.origin, b.origin);
+    EXPECT_EQ(a.side, b.side);
+  }
+  EXPECT_EQ(mcf::choose_cube(stray, 6, mcf::OctreeCube::automatic).side, 1.0);
 }
 
 TEST(Octree, LevelsAreConsistent) {

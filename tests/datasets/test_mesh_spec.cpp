@@ -26,22 +26,46 @@ void expect_spec_error(const std::string& spec, const std::string& fragment) {
 }
 
 TEST(MeshSpec, Errors) {
+  // Fragments beyond the spec itself (the message always quotes the spec, so a key name alone
+  // would match any error).
   expect_spec_error("blob", "unknown generator 'blob'");
-  expect_spec_error("torus:foo=1", "'foo'");
-  expect_spec_error("torus:R=abc", "'R'");
-  expect_spec_error("torus:R=", "'R'");
-  expect_spec_error("torus:R=1x", "'R'");
-  expect_spec_error("torus:R=nan", "'R'");
-  expect_spec_error("icosphere:level=2.5", "'level'");
-  expect_spec_error("icosphere:level=99", "level");
-  expect_spec_error("sphere:vertices=1000,vertices=2000", "'vertices'");
-  expect_spec_error("sphere:radius", "radius");
-  expect_spec_error("sphere@faces=abc", "'faces'");
-  expect_spec_error("sphere@faces=0", "'faces'");
-  expect_spec_error("sphere@vertices=10", "'vertices'");
-  expect_spec_error("torus:R=0.1,r=0.3", "torus");
-  expect_spec_error("cgal:nonexistent_model", "nonexistent_model");
+  expect_spec_error("torus:foo=1", "unknown key 'foo'");
+  expect_spec_error("torus:R=abc", "key 'R' needs a number");
+  expect_spec_error("torus:R=", "key 'R' needs a number");
+  expect_spec_error("torus:R=1x", "key 'R' needs a number");
+  expect_spec_error("torus:R=nan", "key 'R' needs a number");
+  expect_spec_error("icosphere:level=2.5", "key 'level' needs an integer");
+  expect_spec_error("icosphere:level=99", "key 'level' is out of range (at most 12)");
+  expect_spec_error("icosphere:level=-1", "level must be in 0..12");
+  expect_spec_error("sphere:vertices=1000,vertices=2000", "key 'vertices' given twice");
+  expect_spec_error("sphere:radius", "expected key=value, got 'radius'");
+  expect_spec_error("sphere@faces=abc", "key 'faces' needs an integer");
+  expect_spec_error("sphere@faces=0", "key 'faces' must be in 1..200000000");
+  expect_spec_error("sphere@vertices=10", "unknown modifier key 'vertices'");
+  expect_spec_error("torus:R=0.1,r=0.3", "R > r > 0");
+  expect_spec_error("cgal:nonexistent_model", "unknown catalogue model");
   expect_spec_error("", "empty");
+}
+
+// Integer keys reached the generators' int counts unchecked: a spiral with 2^30 + 1 turns
+// wrapped to a valid one-turn spiral (exit 0), 2^30 turns crashed, "level=4294967299" was
+// reported as "got -2147483648", and a huge sphere ended in a bare std::bad_alloc. Each is now
+// refused before anything is built, naming the key or the face count.
+TEST(MeshSpec, SizesBeyondTheLimitsAreRefusedBeforeBuilding) {
+  expect_spec_error("spiral:turns=1073741825,segments_per_turn=4,profile_segments=1",
+                    "key 'turns' is out of range (at most 1000000000), got 1073741825");
+  expect_spec_error("icosphere:level=4294967299", "key 'level' is out of range (at most 12), got 4294967299");
+  expect_spec_error("sphere:vertices=9223372036854775807", "key 'vertices' is out of range");
+  expect_spec_error("sphere:vertices=-9223372036854775807", "key 'vertices' is out of range");
+  expect_spec_error("sphere:vertices=99999999999", "key 'vertices' is out of range");
+  expect_spec_error("sphere:vertices=300000000", "about 600000000 faces, more than the 200000000");
+  expect_spec_error("torus:n_major=100000,n_minor=100000", "about 20000000000 faces");
+  expect_spec_error("spiral:turns=100000,segments_per_turn=1000,profile_segments=8", "faces, more than the");
+  expect_spec_error("rounded_cylinder:radius=1e-9", "faces, more than the");
+  expect_spec_error("icosphere:level=12", "about 335544320 faces");
+  // Below the limit, and the generators' own lower bounds still name themselves.
+  EXPECT_EQ(load_mesh_spec("icosphere:level=4").mesh.num_faces(), 20 * 256);
+  expect_spec_error("torus:n_major=-20000,n_minor=-20000", "n_major, n_minor >= 3");
 }
 
 TEST(MeshSpec, Sphere) {
@@ -124,8 +148,8 @@ TEST(MeshSpec, FittedMeshesLieInTheClosedUnitCube) {
     const double scale = std::exp(u(rng) * 3.0);
     for (int i = 0; i < 4; ++i)
       for (int c = 0; c < 3; ++c) m.vertices(i, c) = scale * (u(rng) + 0.1 * trial);
-    m.faces.resize(1, 3);
-    m.faces << 0, 1, 2;
+    m.faces.resize(2, 3);
+    m.faces << 0, 1, 2, 0, 2, 3;  // every vertex used: the fit sizes the surface
     // What the fit computes before it clamps (kept here to show the test sees the rounding).
     const Eigen::RowVector3d lo = m.vertices.colwise().minCoeff(), hi = m.vertices.colwise().maxCoeff();
     const double s = 1.0 / (hi - lo).maxCoeff();
@@ -137,6 +161,30 @@ TEST(MeshSpec, FittedMeshesLieInTheClosedUnitCube) {
     ASSERT_LE(m.vertices.maxCoeff(), 1.0) << "trial " << trial;
   }
   EXPECT_GT(rounded_outside_before_clamping, 0);  // the case this test is about did occur
+}
+
+// A vertex no face uses (scans and exported files have them) is not part of the surface: one
+// stray vertex at 100 x the model's size made the fit shrink a sphere 101-fold (area 0.0012
+// instead of pi; octree dimension 26 instead of 38332 at depth 6). The surface is now fitted as
+// it is without the stray vertex, which moves along with it.
+TEST(MeshSpec, UnusedVerticesDoNotSizeTheModel) {
+  test::TempDir dir;
+  const TriangleMesh plain = make_icosphere(3, 1.0);
+  TriangleMesh stray = plain;
+  const Eigen::Index n = plain.num_vertices();
+  stray.vertices.conservativeResize(n + 1, 3);
+  stray.vertices.row(n) = Eigen::RowVector3d(100, 100, 100);
+  write_mesh(dir.file("plain.off"), plain);
+  write_mesh(dir.file("stray.off"), stray);
+  const MeshSource a = load_mesh_spec(dir.file("plain.off"));
+  const MeshSource b = load_mesh_spec(dir.file("stray.off"));
+  EXPECT_EQ(b.report.unreferenced_vertices, 1);
+  EXPECT_EQ(b.mesh.vertices.topRows(n), a.mesh.vertices);
+  EXPECT_NEAR(b.report.area, a.report.area, 1e-12 * a.report.area);
+  // The stray vertex keeps its place relative to the surface: the fit's scale and translation.
+  const double scale = 1.0 / (plain.vertices.colwise().maxCoeff() - plain.vertices.colwise().minCoeff()).maxCoeff();
+  const Eigen::RowVector3d expected = a.mesh.vertices.row(0) + scale * (stray.vertices.row(n) - plain.vertices.row(0));
+  EXPECT_LT((b.mesh.vertices.row(n) - expected).norm(), 1e-12 * expected.norm()) << b.mesh.vertices.row(n);
 }
 
 }  // namespace
