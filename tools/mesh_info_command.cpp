@@ -37,8 +37,11 @@ void add_mesh_info_command(CLI::App& app, std::function<int()>& run) {
                           {"bbox_min", {lo.x(), lo.y(), lo.z()}},
                           {"bbox_max", {hi.x(), hi.y(), hi.z()}}};
       if (m.sphere_radius) j["sphere_radius"] = *m.sphere_radius;
-      std::printf("%s\n", j.dump(2).c_str());
+      if (m.cylinder_radius) j["cylinder_radius"] = *m.cylinder_radius;
+      // Written before the report is printed: a --write that fails (an unknown extension, a
+      // missing folder) exits non-zero with nothing on stdout, not after a complete-looking report.
       if (!out->empty()) write_mesh(*out, m.mesh, true, FaceCheck::trusted);
+      std::printf("%s\n", j.dump(2).c_str());
       return 0;
     };
   });

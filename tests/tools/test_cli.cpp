@@ -82,6 +82,33 @@ TEST(Cli, BadMeshesAreRejectedNamingTheFile) {
   expect_rejected("nosuchshape", "nosuchshape");
 }
 
+// mesh-info printed its report and only then failed on --write (exit 1 after valid JSON on
+// stdout): a script reading the report could not tell. It now writes first.
+TEST(Cli, MeshInfoFailsOnABadWriteBeforePrinting) {
+  const fs::path out = temp_dir() / "mesh_info_stdout.txt";
+  const auto run = [&](const std::string& args) {
+    const std::string cmd = std::string(MCFBENCH_BINARY) + " mesh-info " + args + " >" + out.string() + " 2>/dev/null";
+    const int raw = std::system(cmd.c_str());
+    std::ifstream in(out);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return std::make_pair(WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, ss.str());
+  };
+  const auto bad = run("icosphere:level=1 --write " + (temp_dir() / "mesh.xyz").string());
+  EXPECT_NE(bad.first, 0);
+  EXPECT_EQ(bad.second, "");
+  const auto missing = run("icosphere:level=1 --write " + (temp_dir() / "no_such_folder" / "mesh.off").string());
+  EXPECT_NE(missing.first, 0);
+  EXPECT_EQ(missing.second, "");
+  const fs::path good = temp_dir() / "mesh_info.off";
+  const auto ok = run("open_cylinder --write " + good.string());
+  EXPECT_EQ(ok.first, 0);
+  EXPECT_TRUE(fs::exists(good));
+  const nlohmann::json j = nlohmann::json::parse(ok.second);
+  EXPECT_EQ(j["faces"], 2 * 64 * 40);
+  EXPECT_EQ(j["cylinder_radius"], 0.5);
+}
+
 TEST(Cli, BadConfigKeysAreNamed) {
   const fs::path cfg = write("bad.json", R"({"mesh": "icosphere:level=2", "solver": {"cycels": 3}})");
   const fs::path out = temp_dir() / "out_badcfg";
