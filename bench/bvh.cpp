@@ -5,12 +5,48 @@
 #include <stdexcept>
 
 namespace mcf {
+namespace {
+
+/// Closest point to p on the segment [s, e] (a zero-length one is its point).
+Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s, const Eigen::Vector3d& e) {
+  const Eigen::Vector3d d = e - s;
+  const double len2 = d.squaredNorm();
+  if (!(len2 > 0)) return s;
+  return s + std::clamp((p - s).dot(d) / len2, 0.0, 1.0) * d;
+}
+
+/// Nearest of the closest points on the three edges: the closest point of a degenerate
+/// triangle (a segment or a point), which its edges cover.
+Eigen::Vector3d closest_point_on_edges(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                       const Eigen::Vector3d& c) {
+  Eigen::Vector3d best = closest_point_on_segment(p, a, b);
+  for (const Eigen::Vector3d& q : {closest_point_on_segment(p, b, c), closest_point_on_segment(p, a, c)})
+    if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
+  return best;
+}
+
+/// A triangle is taken as degenerate when |ab×ac|² <= kFlat·|ab|²·|ac|², i.e. sin²θ <= kFlat
+/// for its angle θ at a (a zero-length edge and a NaN too). Its edges then stand for it: that
+/// overestimates the distance by at most its inradius, below sinθ/2 of the shorter edge at a
+/// (5e-7 of it here), while the region tests' rounding error grows like 2^-53/sin²θ (about 1e-6 of the
+/// edge at sin²θ = 1e-12 against an exact reference, 1e-3 at 1e-15, and O(1) on triangles
+/// collinear up to rounding, whose sin²θ is noise of 1e-32 to 1e-20).
+constexpr double kFlat = 1e-12;
+
+}  // namespace
 
 Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   // Ericson's region tests: every branch returns the exact closest point of its Voronoi region,
   // so no projection-then-clamp error appears near edges and vertices.
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const Eigen::Vector3d ab = b - a, ac = c - a;
+  // Degenerate (collinear, or with coincident corners) triangles first: the region tests below
+  // assume a proper triangle (with a == b they take edge AB with a zero denominator and return
+  // a; on a triangle collinear up to rounding their signs and the face's barycentric
+  // denominator are rounding noise, which placed the point far off the segment).
+  if (!(ab.cross(ac).squaredNorm() > kFlat * ab.squaredNorm() * ac.squaredNorm()))
+    return closest_point_on_edges(p, a, b, c);
+  const Eigen::Vector3d ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return a;  // vertex region A
 
@@ -40,21 +76,10 @@ Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen:
     return denom > 0 ? Eigen::Vector3d(b + ((d4 - d3) / denom) * (c - b)) : b;
   }
 
-  // Face region. A degenerate (collinear) triangle that reaches here has va+vb+vc == 0: fall
-  // back to the nearest of its three edges, which then covers the whole degenerate triangle.
+  // Face region. sum = |ab×ac|² up to rounding, so positive here; the check is a guard (a p that
+  // is not finite, or so far away that rounding swamps sum).
   const double sum = va + vb + vc;
-  if (!(sum > 0)) {
-    auto on_segment = [&p](const Eigen::Vector3d& s, const Eigen::Vector3d& e) -> Eigen::Vector3d {
-      const Eigen::Vector3d d = e - s;
-      const double len2 = d.squaredNorm();
-      if (!(len2 > 0)) return s;
-      return s + std::clamp((p - s).dot(d) / len2, 0.0, 1.0) * d;
-    };
-    Eigen::Vector3d best = on_segment(a, b);
-    for (const Eigen::Vector3d& q : {on_segment(b, c), on_segment(a, c)})
-      if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
-    return best;
-  }
+  if (!(sum > 0)) return closest_point_on_edges(p, a, b, c);
   const double v = vb / sum, w = vc / sum;
   return a + v * ab + w * ac;
 }

@@ -11,7 +11,9 @@ namespace mcf {
 
 /// Closest point to p on the triangle (a, b, c), exact up to rounding (Ericson, Real-Time
 /// Collision Detection §5.1.5: classify p against the Voronoi regions of the vertices, edges and
-/// face). Degenerate triangles are handled: the result is a point of the segment/vertex.
+/// face). A degenerate triangle (coincident corners, or collinear up to rounding: sin²θ <= 1e-12
+/// at a) is taken as its three edges, whose nearest point is returned: exact for a segment or a
+/// point, and off by at most the inradius (< 5e-7 of the shorter edge at a) for a thin sliver.
 Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 

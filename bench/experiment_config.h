@@ -28,7 +28,7 @@ namespace mcf {
 struct MetricsConfig {
   bool quasi_conformal = false;
   bool sphericity = false;
-  int every = 1;                  ///< per-step metrics every K steps (and at the last step)
+  int every = 1;                  ///< per-step metrics every K steps (and at the last step, or a stopped flow's last completed one)
   std::vector<int> frames;        ///< steps whose meshes are saved as frames/<hash>/frame_NNNNN.ply
   nlohmann::json reference;       ///< partial assignment {dotted key: value} of the reference cell; null = none
   long long distance_samples = 20000;  ///< samples per side for the distance to the reference

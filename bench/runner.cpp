@@ -99,6 +99,12 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
     const MeshSource& source = meshes.get(config.mesh);
     if (!frames.empty() || config.save_every > 0) fs::create_directories(frame_dir);  // write_mesh does not
     TriangleMesh initial;  // X_0 as the flow sees it (after area normalisation, if any)
+    auto measure = [&](int step, const Positions& V) {
+      json mj = json::object();
+      if (m.quasi_conformal) mj["quasi_conformal"] = hooks.quasi_conformal_error(initial, V);
+      if (m.sphericity) mj["sphericity"] = hooks.sphericity(V, source.mesh.faces);
+      step_metrics[step] = std::move(mj);
+    };
     FlowObserver observer;
     observer.on_step = [&](int step, double, const Positions& V) {
       if (step == 0) initial = TriangleMesh{V, source.mesh.faces};
@@ -107,16 +113,19 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
         written.push_back(step);
       }
       // Metrics at step 0 too (the initial sphericity is the baseline of the cMCF plots), then
-      // every `every` steps and at the last step.
-      if (per_step && (step % m.every == 0 || step == config.steps)) {
-        json mj = json::object();
-        if (m.quasi_conformal) mj["quasi_conformal"] = hooks.quasi_conformal_error(initial, V);
-        if (m.sphericity) mj["sphericity"] = hooks.sphericity(V, source.mesh.faces);
-        step_metrics[step] = std::move(mj);
-      }
+      // every `every` steps and at the last step (a stopped flow's last completed step: below).
+      if (per_step && (step % m.every == 0 || step == config.steps)) measure(step, V);
       if (on_step) on_step(step);  // after the step's frames and metrics: they are part of its time
     };
     FlowOutcome outcome = run_flow(config, source, observer);
+    // A flow that stopped early (singular, diverged) never reached config.steps: its last
+    // completed step is the one before the stop, whose state is the final mesh (the stopping
+    // step is recorded but its positions are dropped, and the observer does not see it).
+    // It gets metrics too, as the last step of a completed flow does.
+    const int last_ok = outcome.result["stop"].value("step", 0) - 1;
+    if (per_step && outcome.result["status"] == "singular" && last_ok >= 0 &&
+        !step_metrics.count(last_ok))
+      measure(last_ok, outcome.final_mesh.vertices);
     result = std::move(outcome.result);
     // The observer runs after the flow has recorded the step; attach the metrics by step number.
     if (step_metrics.count(0)) result["initial_metrics"] = step_metrics[0];

@@ -96,6 +96,38 @@ TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
   EXPECT_EQ(other["reference_cell"]["hash"], plans[0].hash);
 }
 
+TEST(Runner, AFlowThatStopsEarlyHasMetricsAtItsLastCompletedStep) {
+  // Explicit Euler beyond its stability limit: the area grows by more than 5% at step 6 and the
+  // flow stops there, so step 5 is its last state. With every=4 step 5 is neither a multiple of
+  // 4 nor config.steps; it gets metrics all the same, those of its positions (the every=1 run
+  // measures each step as the flow makes it), and the stopping step gets none.
+  HookGuard guard(fake_hooks());
+  auto run_every = [](int every) {
+    const fs::path out = fresh_dir("stopped_every_" + std::to_string(every));
+    const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"integrator", "explicit-euler"},
+                                  {"dt", 0.05}, {"steps", 50}}},
+                    {"metrics", {{"quasi_conformal", true}, {"sphericity", true}, {"every", every}}}};
+    const ExperimentConfig e = parse_experiment_config(j, "stop.json", false);
+    RunOptions o;
+    o.out_dir = out.string();
+    EXPECT_EQ(run_experiment(e, o).ran, 1);
+    MeshCache meshes;
+    return read_json(plan_cells(e, out.string(), meshes)[0].file);
+  };
+  const json r = run_every(4), all = run_every(1);
+  ASSERT_EQ(r["status"], "singular") << r["stop"].dump();
+  ASSERT_EQ(r["stop"]["step"], 6) << r["stop"].dump();
+  ASSERT_EQ(r["steps"].size(), 6u);
+  for (int i : {0, 1, 2, 5}) EXPECT_FALSE(r["steps"][size_t(i)].contains("metrics")) << "step " << i + 1;
+  ASSERT_TRUE(r["steps"][3].contains("metrics"));  // step 4: a multiple of every=4
+  ASSERT_TRUE(r["steps"][4].contains("metrics"));  // step 5: the last completed step
+  EXPECT_EQ(r["steps"][3]["metrics"], all["steps"][3]["metrics"]);
+  EXPECT_EQ(r["steps"][4]["metrics"], all["steps"][4]["metrics"]);
+  EXPECT_GT(r["steps"][4]["metrics"]["quasi_conformal"].get<double>(),
+            r["steps"][3]["metrics"]["quasi_conformal"].get<double>());  // not step 4's state again
+  EXPECT_FALSE(all["steps"][5].contains("metrics"));  // the stopping step's positions are dropped
+}
+
 TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
   HookGuard guard(fake_hooks());
   const fs::path out = fresh_dir("sharded_ref");
