@@ -146,6 +146,33 @@ done
 "$py" "$root/reports/make_report.py" $solo "$work/solo_out" >"$work/solo_log" 2>&1 \
   || { cat "$work/solo_log"; echo "FAIL: make_report.py on one-cell studies"; fail=1; }
 [ -s "$work/solo_out/index.md" ] || { echo "FAIL: no index for one-cell studies"; fail=1; }
+# Repetitions: a study run with "repetitions": 2 draws repetition 0 of each cell once (bench/cell_hash.cpp's
+# cell.key names the repetition; cell.config_key does not), so its figures and tables are those of the
+# same study run once: cubature's three curves, time_order's fits (each δ once, the counts of stable runs).
+"$py" "$root/reports/make_report.py" "$work/results/cubature" "$work/results/time_order" "$work/once" \
+  --references "$work/results/references" >"$work/once_log" 2>&1 || { cat "$work/once_log"; echo "FAIL: make_report.py, one repetition"; fail=1; }
+"$py" "$root/reports/make_report.py" "$work/results/repeated/cubature" "$work/results/repeated/time_order" "$work/twice" \
+  --references "$work/results/references" >"$work/twice_log" 2>&1 || { cat "$work/twice_log"; echo "FAIL: make_report.py, two repetitions"; fail=1; }
+for f in cubature.png time_order.png time_order.md; do
+  cmp -s "$work/once/$f" "$work/twice/$f" || { echo "FAIL: $f of a study run twice differs from its single run"; fail=1; }
+done
+[ "$(wc -l <"$work/twice/cubature.sources.txt")" = 3 ] || { echo "FAIL: cubature.png of two repetitions draws $(wc -l <"$work/twice/cubature.sources.txt") cells, not 3"; fail=1; }
+# Commits: a folder holding two commits' results of the same cells reports the newest commit's (by
+# file time: c0ffee's cells 0 and 1) and the older one's cell 2 that the newer did not run, says so on
+# stderr and in index.md, and table1 has a row per model and commit, each from its own commit's times.
+"$py" "$root/reports/make_report.py" "$work/results/commits/cubature" "$work/results/commits/table1" "$work/commits" \
+  >"$work/commits_log" 2>&1 || { cat "$work/commits_log"; echo "FAIL: make_report.py on two commits"; fail=1; }
+[ "$(xargs -n1 basename <"$work/commits/cubature.sources.txt" | sort | tr '\n' ' ')" = "a_old_002.json b_new_000.json b_new_001.json " ] ||
+  { cat "$work/commits/cubature.sources.txt"; echo "FAIL: cubature of two commits does not draw the newest commit's cells"; fail=1; }
+for s in cubature table1; do
+  grep -q "^warning: $s: results of 2 commits: c0ffee .*; 0ld0ld .*2 older result(s) of the same cells left out" "$work/commits_log" ||
+    { cat "$work/commits_log"; echo "FAIL: no warning that $s mixes commits"; fail=1; }
+  awk -v s="## $s" '$0 == s {on = 1; next} /^## / {on = 0} on' "$work/commits/index.md" |
+    grep -q '^\*\*Several commits:\*\* .*c0ffee.*0ld0ld' || { echo "FAIL: index.md does not name $s's commits"; fail=1; }
+done
+grep -F "| sphere:vertices=40000 @c0ffee |" "$work/commits/table1.md" | grep -qF "(+0.5) | 0.0103 + 0.002 |" ||
+  { cat "$work/commits/table1.md"; echo "FAIL: table1 does not time the newest commit alone"; fail=1; }
+grep -qF "| cgal:bunny00 @0ld0ld |" "$work/commits/table1.md" || { echo "FAIL: table1 lacks the older commit's model"; fail=1; }
 # Performance over commits: the history of two measured commits plots and tabulates a 2x change.
 printf '%s\n' '{"commit":"c1","benchmarks":{"BM_X":{"real_time":10}}}' '{"commit":"c2","benchmarks":{"BM_X":{"real_time":20}}}' \
   >"$work/history.jsonl"
