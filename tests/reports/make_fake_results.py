@@ -54,7 +54,7 @@ def step(n, dt, errscale=1e-4, extra=None, slow=1.0, residual=1e-2):
 
 
 def result(study, index, assignment, config, steps, status="ok", reason="completed", repetition=0, commit="fake",
-           **more):
+           quick=False, **more):
     """A result file's dict; cell.key names the repetition, cell.config_key does not (bench/cell_hash.cpp)."""
     r = {"schema": 1, "status": status, "stop": {"step": len(steps), "reason": reason},
          "config": config, "steps": steps,
@@ -64,7 +64,7 @@ def result(study, index, assignment, config, steps, status="ok", reason="complet
                     "levels": 5, "setup_seconds": {"octree": 0.3, "clip": 0.2, "total": 0.5}},
          "cell": {"index": index, "key": "%s-%d-rep%d" % (study, index, repetition),
                   "config_key": "%s-%d" % (study, index), "assignment": assignment,
-                  "repetition": repetition, "study": study},
+                  "repetition": repetition, "study": study, "quick": quick},
          "study_config": {"name": study}}
     r.update(more)
     return r
@@ -162,26 +162,28 @@ def cubature_cells(folder, repetition=0, commit="fake", scale=1.0, names="cell_%
                          repetition=repetition, commit=commit))
 
 
-def time_order_cells(folder, repetition=0, names="cell_%03d"):
+def time_order_cells(folder, repetition=0, names="cell_%03d", first=0, mesh="icosphere:level=3", quick=False,
+                     offset=0.0, scale=1.0):
     """time_order: two integrators × dts and one unstable explicit run, each to t = 0.01, their
     mean radius sqrt(1 - 4t) + 0.3 δ^order (orders 1, 2, 1), and a Crank–Nicolson run at δ = 1.25e-4
     (cell 9) whose mean radius is sqrt(1 - 4t) exactly: the temporal reference. The RMS error against
     the continuous radius is a flat 1e-3 (the mesh's floor), so only errors measured as
-    |mean radius − reference| fit the orders 1 and 2."""
+    |mean radius − reference| fit the orders 1 and 2. Cells numbered from `first`; every radius plus
+    `offset` (another mesh's spatial error), every temporal error times `scale`."""
     s = "time_order"
     end = 0.01
     runs = [(integ, order, dt) for integ, order in (("semi-implicit", 1), ("bdf2", 2), ("explicit", 1))
             for dt in (1e-3, 5e-4, 2.5e-4)] + [("crank-nicolson", None, 1.25e-4)]
     for i, (integ, order, dt) in enumerate(runs):
-        err = 0.3 * dt ** order if order else 0.0
+        err = scale * 0.3 * dt ** order if order else 0.0
         status = "error" if (integ == "explicit" and dt == 1e-3) else "ok"
         radius = lambda n, e=err, dt=dt: {"radial_error": {  # noqa: E731
-            "rms_continuous": 1e-3, "mean_radius": math.sqrt(1 - 4 * n * dt) + e * n * dt / end}}
-        write(folder, names % i,
-              result(s, i, {"integrator": integ, "dt": dt}, config(integrator=integ, dt=dt),
+            "rms_continuous": 1e-3, "mean_radius": offset + math.sqrt(1 - 4 * n * dt) + e * n * dt / end}}
+        write(folder, names % (first + i),
+              result(s, first + i, {"integrator": integ, "dt": dt}, config(integrator=integ, dt=dt, mesh=mesh),
                      [step(n, dt, extra=radius) for n in (1, round(end / dt))],
                      status=status, reason="diverged" if status != "ok" else "completed",
-                     repetition=repetition))
+                     repetition=repetition, quick=quick))
 
 
 def set_time(folder, pattern, when):
@@ -215,6 +217,28 @@ def repetitions_and_commits(root):
         cells(folder, commit="c0ffee", names="b_new_%03d", cells=(0, 1))
         set_time(folder, "a_old_", 1767225600)  # 2026-01-01
         set_time(folder, "b_new_", 1769904000)  # 2026-02-01
+
+
+def several_meshes(root):
+    """ROOT/meshes/time_order: the time_order cells on icosphere:level=3 (cells 0-9), on
+    icosphere:level=2 (10-19: radii 0.01 larger, temporal errors doubled) and a quick run on
+    icosphere:level=3 (20-29: radii 0.02 larger); each set has its own reference, so each fits
+    orders 1 and 2. ROOT/meshes/depth_cycles: depths 5, 6 × cycles 1, 2 on two meshes."""
+    folder = os.path.join(root, "meshes", "time_order")
+    time_order_cells(folder)
+    time_order_cells(folder, first=10, mesh="icosphere:level=2", offset=0.01, scale=2.0)
+    time_order_cells(folder, first=20, quick=True, offset=0.02)
+    s = "depth_cycles"
+    i = 0
+    for mesh, worse in (("icosphere:level=3", 1), ("icosphere:level=2", 4)):
+        for depth in (5, 6):
+            for cyc in (1, 2):
+                write(os.path.join(root, "meshes", s), "cell_%03d" % i,
+                      result(s, i, {"mesh": mesh, "octree.depth": depth, "solver.cycles": cyc},
+                             config(mesh=mesh, octree__depth=depth, solver__cycles=cyc),
+                             [step(n, 1e-3, worse * 1e-3 / (depth * cyc), residual=worse * 0.1 ** (cyc + depth - 3))
+                              for n in range(1, 6)]))
+                i += 1
 
 
 def main(root):
@@ -292,6 +316,7 @@ def main(root):
     write_plan(os.path.join(root, "depth_cycles"), "depth_cycles", shard=(0, 2))
     write_plan(os.path.join(root, "depth_cycles"), "depth_cycles", shard=(1, 2))
     repetitions_and_commits(root)
+    several_meshes(root)
     # Paper references.
     refs = os.path.join(root, "references")
     os.makedirs(refs, exist_ok=True)

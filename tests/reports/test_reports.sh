@@ -179,6 +179,32 @@ done
 grep -F "| sphere:vertices=40000 @c0ffee |" "$work/commits/table1.md" | grep -qF "(+0.5) | 0.0103 + 0.002 |" ||
   { cat "$work/commits/table1.md"; echo "FAIL: table1 does not time the newest commit alone"; fail=1; }
 grep -qF "| cgal:bunny00 @0ld0ld |" "$work/commits/table1.md" || { echo "FAIL: table1 lacks the older commit's model"; fail=1; }
+# Several meshes in one study: time_order measures each mesh's runs (and a quick run's) against the
+# reference run on that mesh (of that quick flag) and fits them apart, each at its true order; depth_cycles
+# draws a line per mesh and depth (residuals) and per mesh and number of cycles (Hausdorff distance).
+"$py" "$root/reports/make_report.py" "$work/results/meshes/time_order" "$work/meshes" --references "$work/results/references" \
+  >"$work/meshes_log" 2>&1 || { cat "$work/meshes_log"; echo "FAIL: make_report.py on several meshes"; fail=1; }
+for where in "icosphere:level=3 (full)" "icosphere:level=2 (full)" "icosphere:level=3 (quick)"; do
+  for want in "semi-implicit | 1.00 | 3 | 0.001 | — | 1" "bdf2 | 2.00 | 3 | 0.001 | — | 2" "explicit | 1.00 | 2 | 0.0005 | 0.001 | —"; do
+    grep -qF "| mcf on $where: $want |" "$work/meshes/time_order.md" ||
+      { cat "$work/meshes/time_order.md"; echo "FAIL: time_order on several meshes lacks: mcf on $where: $want"; fail=1; }
+  done
+done
+[ "$(grep -c '^| mcf' "$work/meshes/time_order.md")" = 9 ] || { echo "FAIL: time_order on several meshes: not 9 rows"; fail=1; }
+"$py" - "$root/reports" "$work/results/meshes/depth_cycles" >"$work/dc_log" 2>&1 <<'PY' || { cat "$work/dc_log"; echo "FAIL: depth_cycles on two meshes"; fail=1; }
+import sys
+sys.path.insert(0, sys.argv[1])
+import common, depth_cycles
+figures = []
+common.save_figure = lambda fig, *args: figures.append(fig)
+depth_cycles.make(common.load_results(sys.argv[2]), "unused", None, [])
+residual, hausdorff = figures[0].axes
+lines = lambda ax: {l.get_label(): list(l.get_xdata()) for l in ax.get_lines()}  # noqa: E731
+want = {"icosphere:level=%d, depth %d" % (m, d): [1, 2] for m in (3, 2) for d in (5, 6)}
+assert lines(residual) == want, lines(residual)
+want = {"icosphere:level=%d, %d W-cycle%s" % (m, c, "s" if c > 1 else ""): [5, 6] for m in (3, 2) for c in (1, 2)}
+assert lines(hausdorff) == want, lines(hausdorff)
+PY
 # Performance over commits: the history of two measured commits plots and tabulates a 2x change.
 printf '%s\n' '{"commit":"c1","benchmarks":{"BM_X":{"real_time":10}}}' '{"commit":"c2","benchmarks":{"BM_X":{"real_time":20}}}' \
   >"$work/history.jsonl"
