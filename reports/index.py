@@ -45,7 +45,8 @@ def make(out_dir, sections):
     """sections: [(study, results folder(s), [{"path", "title", "kind"}], [errored results],
     gap, commits)], gap None or {"have", "total", "missing": [planned cells], "quick_mixed"} for
     a study whose planned cells do not all have a result, commits None or a line naming the
-    commits whose results the study mixed (common.commits_note). Returns the index path."""
+    commits whose results the study mixed (common.commits_note). A written item of kind "note"
+    is a line of text ("text"), not a file. Returns the index path."""
     lines = ["# mcfbench report", "",
              "Generated from result files only (reports/make_report.py); each item's sources are in "
              "its `.sources.txt` sidecar.", ""]
@@ -65,9 +66,12 @@ def make(out_dir, sections):
                       "(a rerun of `mcfbench run` retries them):" % len(errored), ""]
             lines += [errored_cell_line(r) for r in sorted(errored, key=lambda r: (r.get("cell", {}) or {}).get("index", 0))]
             lines += [""]
-        if not written:
+        if not [w for w in written if w["kind"] != "note"]:
             lines += ["(nothing could be drawn from these results)", ""]
         for w in written:
+            if w["kind"] == "note":
+                lines += [w["text"], ""]
+                continue
             rel = os.path.relpath(w["path"], out_dir)
             side = os.path.splitext(rel)[0] + ".sources.txt"
             if w["kind"] == "figure":

@@ -241,6 +241,22 @@ def several_meshes(root):
                 i += 1
 
 
+def many_frames(root):
+    """ROOT/strips/cmcf: three flows × seven meshes, flow-major as `mcfbench run` numbers them,
+    every cell with frames: more cells than frames.py draws strips for (MAX_CELLS = 8)."""
+    s = "cmcf"
+    folder = os.path.join(root, "strips", s)
+    metrics = lambda n: {"metrics": {"quasi_conformal": 1 + 0.5 / n, "sphericity": 0.2 / n}}  # noqa: E731
+    i = 0
+    for flow in ("mcf", "heat", "cmcf"):
+        for m in range(7):
+            mesh = "torus:n_major=%d" % (10 + m)
+            write(folder, "cell_%03d" % i, result(s, i, {"flow": flow, "mesh": mesh}, config(mesh=mesh, flow=flow),
+                                                  [step(n, 1e-3, extra=metrics) for n in (1, 2)]))
+            frames(folder, "cell_%03d" % i, 2, 4, 8)
+            i += 1
+
+
 def main(root):
     # table1: one model, tracked + rebuilt; a second model with tracked only (missing variant).
     s = "table1"
@@ -317,6 +333,7 @@ def main(root):
     write_plan(os.path.join(root, "depth_cycles"), "depth_cycles", shard=(1, 2))
     repetitions_and_commits(root)
     several_meshes(root)
+    many_frames(root)
     # Paper references.
     refs = os.path.join(root, "references")
     os.makedirs(refs, exist_ok=True)
