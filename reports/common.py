@@ -11,6 +11,7 @@ import json
 import math
 import os
 import sys
+import time
 
 import matplotlib
 
@@ -84,6 +85,7 @@ def load_results(folder):
             stem = os.path.basename(os.path.dirname(p))
         r["_stem"] = stem
         r["_folder"] = os.path.abspath(folder)
+        r["_mtime"] = os.path.getmtime(p)  # orders commits that share a folder (newest_commits)
         r.setdefault("steps", [])
         results.append(r)
     return results
@@ -116,7 +118,8 @@ def load_plans(folder):
 
 def cell_identity(study, quick, cell):
     """What makes a planned cell and a result the same cell: study, quick flag, index, repetition
-    and assignment (not the commit: the figures draw the cells of every commit in the folders)."""
+    and assignment (not the commit: a planned cell is there when any commit's result is; where
+    several commits ran a cell, the figures draw the newest one's, newest_commits)."""
     cell = cell if isinstance(cell, dict) else {}
     return (study, bool(quick), cell.get("index"), cell.get("repetition", 0) or 0,
             json.dumps(cell.get("assignment") or {}, sort_keys=True))
@@ -241,11 +244,82 @@ def group_by(results, keyfunc):
     return groups
 
 
-def first_repetition(results):
-    """One result per cell key (lowest repetition): curves are drawn once per variant."""
-    best = {}
+def commit_of(result):
+    """The commit that computed a result (environment.commit), "unknown" when it does not say."""
+    return str(get(result, "environment.commit") or "unknown")
+
+
+def config_identity(result):
+    """Which configuration a result ran, repetitions aside: cell.config_key (bench/cell_hash.cpp:
+    the full config and the mesh's fingerprint, without the repetition, as `mcfbench compare`
+    pools repetitions), else (results without it) the cell's study, quick flag, index and
+    assignment, else the file itself (a plain `mcfbench flow` run)."""
+    cell = result.get("cell")
+    if isinstance(cell, dict):
+        if cell.get("config_key"):
+            return ("config_key", str(cell["config_key"]))
+        return ("cell",) + cell_identity(study_of(result), cell.get("quick", False), dict(cell, repetition=0))
+    return ("file", result.get("_path", result.get("_stem")))
+
+
+def cell_slot(result):
+    """The cell a result fills in its study, whatever the commit: its quick flag and assignment
+    (a commit that changes a default key or a generated mesh changes config_key, not the cell);
+    a plain `mcfbench flow` run is its own slot."""
+    cell = result.get("cell")
+    if not isinstance(cell, dict):
+        return ("file", result.get("_path", result.get("_stem")))
+    return (study_of(result), bool(cell.get("quick", False)), json.dumps(cell.get("assignment") or {}, sort_keys=True))
+
+
+def newest_commits(results):
+    """Where results of several commits fill the same cell (a study rerun at a newer commit into
+    the same folder), keep the newest commit's results of that cell, all its repetitions: a
+    commit is as new as its newest result file (modification time; result.json records no date),
+    ties broken by the commit's name. Returns (kept results in their order, None) for results of
+    one commit, else (kept, {"commits": [(commit, newest file time, results kept, results left
+    out)], newest first, "left_out": number of results left out})."""
+    times = {}
     for r in results:
-        key = get(r, "cell.key") or r["_stem"]
+        c = commit_of(r)
+        times[c] = max(times.get(c, float("-inf")), r.get("_mtime", 0.0))
+    if len(times) <= 1:
+        return list(results), None
+    rank = {c: i for i, c in enumerate(sorted(times, key=lambda c: (times[c], c)))}
+    newest = {}
+    for r in results:
+        slot, c = cell_slot(r), commit_of(r)
+        if slot not in newest or rank[c] > rank[newest[slot]]:
+            newest[slot] = c
+    kept = [r for r in results if newest[cell_slot(r)] == commit_of(r)]
+    counts = {c: [0, 0] for c in times}
+    for r in results:
+        counts[commit_of(r)][0 if newest[cell_slot(r)] == commit_of(r) else 1] += 1
+    order = sorted(times, key=lambda c: -rank[c])
+    return kept, {"commits": [(c, times[c], counts[c][0], counts[c][1]) for c in order],
+                  "left_out": len(results) - len(kept)}
+
+
+def commits_note(study, info):
+    """One line on a study whose results came from several commits (newest_commits' info)."""
+    parts = []
+    for c, t, kept, left in info["commits"]:
+        when = time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime(t)) if finite(t) else "?"
+        parts.append("%s (newest file %s UTC: %d result(s) kept%s)" % (
+            c, when, kept, ", %d left out" % left if left else ""))
+    return ("%s: results of %d commits: %s. Per cell the newest commit's results are drawn (%d older "
+            "result(s) of the same cells left out)%s." % (
+                study, len(info["commits"]), "; ".join(parts), info["left_out"],
+                "; its figures and tables mix commits" if sum(1 for _, _, kept, _ in info["commits"] if kept) > 1 else ""))
+
+
+def first_repetition(results):
+    """One result per configuration (config_identity) and commit, its lowest repetition: curves
+    are drawn once per variant. Of cells run by several commits only the newest commit's results
+    count (newest_commits; make_report warns about them)."""
+    best = {}
+    for r in newest_commits(results)[0]:
+        key = (config_identity(r), commit_of(r))
         rep = get(r, "cell.repetition", 0) or 0
         if key not in best or rep < (get(best[key], "cell.repetition", 0) or 0):
             best[key] = r

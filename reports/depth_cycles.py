@@ -43,12 +43,28 @@ def cycles(r):
     return common.get(r, "config.solver.cycles")
 
 
+def mesh(r):
+    return common.get(r, "config.mesh")
+
+
+def line_order(kv):
+    """Lines by mesh (first seen) then by their number (depth or cycles), missing ones last."""
+    (m, n), _ = kv
+    return (n is None, n or 0)
+
+
+def named(m, text, cells):
+    """A line's label: `text`, after the mesh where the panel has several ("icosphere:level=5, depth 6")."""
+    return "%s, %s" % (common.short_value(m), text) if len({mesh(r) for r in cells}) > 1 else text
+
+
 def plot_residuals(ax, cells):
-    """Residual vs cycles, one line per depth. With one cycles value only, the per-cycle residual
-    history of the first step stands in (same quantity, read inside a single solve)."""
-    by_depth = common.group_by(cells, depth)
+    """Residual vs cycles, one line per mesh and depth. With one cycles value only, the per-cycle
+    residual history of the first step stands in (same quantity, read inside a single solve)."""
+    by_depth = common.group_by(cells, lambda r: (mesh(r), depth(r)))
+    meshes = list(dict.fromkeys(mesh(r) for r in cells))
     distinct_cycles = {cycles(r) for r in cells}
-    for d, rs in sorted(by_depth.items(), key=lambda kv: (kv[0] is None, kv[0] or 0)):
+    for (m, d), rs in sorted(by_depth.items(), key=lambda kv: (meshes.index(kv[0][0]),) + line_order(kv)):
         if len(distinct_cycles) > 1:
             pts = sorted((cycles(r), final_residual(r)) for r in rs
                          if cycles(r) is not None and common.finite(final_residual(r)))
@@ -56,7 +72,7 @@ def plot_residuals(ax, cells):
             res = common.get((rs[0].get("steps") or [{}])[0], "solver.residuals") or []
             pts = [(i + 1, v) for i, v in enumerate(res) if common.finite(v)]
         if pts:
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label="depth %s" % d)
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label=named(m, "depth %s" % d, cells))
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("W-cycles")
     ax.set_ylabel("relative residual")
@@ -65,11 +81,14 @@ def plot_residuals(ax, cells):
 
 
 def plot_hausdorff(ax, cells):
-    """Hausdorff distance vs depth, one line per number of cycles."""
-    for c, rs in sorted(common.group_by(cells, cycles).items(), key=lambda kv: (kv[0] is None, kv[0] or 0)):
+    """Hausdorff distance vs depth, one line per mesh and number of cycles."""
+    meshes = list(dict.fromkeys(mesh(r) for r in cells))
+    by_cycles = common.group_by(cells, lambda r: (mesh(r), cycles(r)))
+    for (m, c), rs in sorted(by_cycles.items(), key=lambda kv: (meshes.index(kv[0][0]),) + line_order(kv)):
         pts = sorted((depth(r), hausdorff(r)) for r in rs if depth(r) is not None and common.finite(hausdorff(r)))
         if pts:
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label="%s W-cycle%s" % (c, "" if c == 1 else "s"))
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3,
+                    label=named(m, "%s W-cycle%s" % (c, "" if c == 1 else "s"), cells))
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("octree depth")
     ax.set_ylabel("Hausdorff distance")

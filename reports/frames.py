@@ -4,6 +4,7 @@ Kazhdan 2011 and Figs. 2–6 of the cMCF paper. Orthographic projection, per-fac
 with a fixed light, painter's algorithm (faces drawn far to near) through a PolyCollection."""
 
 import glob
+import json
 import os
 import re
 
@@ -16,7 +17,8 @@ import plyio
 
 MAX_FACES = 30000      # above this, meshes are decimated (vertex clustering) for speed
 MAX_FRAMES = 6         # frames per strip (evenly spaced, first and last included)
-MAX_CELLS = 8          # strips per study
+MAX_CELLS = 8          # strips per study (spread over the cells: spread())
+SPREAD_FIRST = ("flow", "mesh")  # keys spread() balances first, in this order
 LIGHT = np.array([0.3, 0.5, 1.0]) / np.linalg.norm([0.3, 0.5, 1.0])
 # A fixed three-quarter view: rotate about y then x, so flat-on axis-aligned shapes still show depth.
 _a, _b = np.radians(25), np.radians(-20)
@@ -113,10 +115,50 @@ def strip(result, files, number, out_dir, written, index, keys):
     common.save_figure(fig, out_dir, name, [result], title, written)
 
 
+def spread(cells, keys, n):
+    """The indices (sorted) of up to n of `cells` spread over the values of `keys` (the keys that
+    vary): flow first, then mesh, then the others sorted. Each pick is the cell whose flow has
+    the fewest strips so far, among those the one whose mesh has the fewest, and so on, the
+    earliest cell on a tie, so every flow, then every mesh, gets a strip before any gets a
+    second (as far as n allows). Deterministic: it depends on the cells' order only."""
+    if len(cells) <= n:
+        return list(range(len(cells)))
+    order = [k for k in SPREAD_FIRST if k in keys] + [k for k in keys if k not in SPREAD_FIRST]
+    values = [[(k, json.dumps(common.assignment(c).get(k), sort_keys=True)) for k in order] for c in cells]
+    counts, chosen, left = {}, [], list(range(len(cells)))
+    while len(chosen) < n:
+        best = min(left, key=lambda i: tuple(counts.get(v, 0) for v in values[i]) + (i,))
+        chosen.append(best)
+        left.remove(best)
+        for v in values[best]:
+            counts[v] = counts.get(v, 0) + 1
+    return sorted(chosen)
+
+
+def cell_name(result):
+    """'cell 3 `flow=mcf mesh=dumbbell`' (index.cell_words) for a result."""
+    import index
+    return index.cell_words(result.get("cell") or {"index": result["_stem"], "assignment": common.assignment(result)})
+
+
 def make(results, out_dir, reference, written):
-    """Write frames_<study>_NN.png for up to MAX_CELLS cells that saved frames."""
+    """Write frames_<study>_NN.png for up to MAX_CELLS cells that saved frames, spread over the
+    flows, meshes and other varying keys (spread()); the cells left out are warned about and
+    listed in index.md (a "note" in `written`)."""
     cells = [(r, *frames_of(r)) for r in common.first_repetition(results)]
     cells = [c for c in cells if c[1]]
     keys = common.varying_keys([c[0] for c in cells])
-    for i, (r, files, number) in enumerate(cells[:MAX_CELLS]):
-        strip(r, files, number, out_dir, written, i, keys)
+    chosen = spread([c[0] for c in cells], keys, MAX_CELLS)
+    left_out = [c[0] for i, c in enumerate(cells) if i not in chosen]
+    if left_out:
+        study = common.study_of(cells[0][0])
+        over = [k for k in SPREAD_FIRST if k in keys] + [k for k in keys if k not in SPREAD_FIRST]
+        names = ", ".join(cell_name(r) for r in left_out)
+        common.warn("frames: %s: %d cells saved frames, strips for %d of them (at most %d, spread over %s); "
+                    "left out: %s" % (study, len(cells), len(chosen), MAX_CELLS, ", ".join(over) or "the cells", names))
+        written.append({"kind": "note", "text": "Frame strips for %d of the %d cells that saved frames (at most "
+                        "%d, spread over %s); left out: %s." % (len(chosen), len(cells), MAX_CELLS,
+                                                               ", ".join(over) or "the cells", names)})
+    for n, i in enumerate(chosen):
+        r, files, number = cells[i]
+        strip(r, files, number, out_dir, written, n, keys)

@@ -43,18 +43,22 @@ def gap_lines(gap):
 
 def make(out_dir, sections):
     """sections: [(study, results folder(s), [{"path", "title", "kind"}], [errored results],
-    gap)], gap None or {"have", "total", "missing": [planned cells], "quick_mixed"} for a study
-    whose planned cells do not all have a result. Returns the index path."""
+    gap, commits)], gap None or {"have", "total", "missing": [planned cells], "quick_mixed"} for
+    a study whose planned cells do not all have a result, commits None or a line naming the
+    commits whose results the study mixed (common.commits_note). A written item of kind "note"
+    is a line of text ("text"), not a file. Returns the index path."""
     lines = ["# mcfbench report", "",
              "Generated from result files only (reports/make_report.py); each item's sources are in "
              "its `.sources.txt` sidecar.", ""]
-    gaps = [(study, gap) for study, _, _, _, gap in sections if gap]
+    gaps = [(study, gap) for study, _, _, _, gap, _ in sections if gap]
     if gaps:
         lines += ["**Incomplete report:** planned cells have no result yet in %s; each study's section "
                   "lists them, and its figures and tables say \"incomplete\"." % ", ".join(
                       "%s (%d of %d)" % (study, gap["have"], gap["total"]) for study, gap in gaps), ""]
-    for study, folders, written, errored, gap in sections:
+    for study, folders, written, errored, gap, commits in sections:
         lines += ["## %s" % study, "", "Results: " + ", ".join("`%s`" % f for f in folders), ""]
+        if commits:
+            lines += ["**Several commits:** " + commits, ""]
         if gap:
             lines += gap_lines(gap)
         if errored:
@@ -62,9 +66,12 @@ def make(out_dir, sections):
                       "(a rerun of `mcfbench run` retries them):" % len(errored), ""]
             lines += [errored_cell_line(r) for r in sorted(errored, key=lambda r: (r.get("cell", {}) or {}).get("index", 0))]
             lines += [""]
-        if not written:
+        if not [w for w in written if w["kind"] != "note"]:
             lines += ["(nothing could be drawn from these results)", ""]
         for w in written:
+            if w["kind"] == "note":
+                lines += [w["text"], ""]
+                continue
             rel = os.path.relpath(w["path"], out_dir)
             side = os.path.splitext(rel)[0] + ".sources.txt"
             if w["kind"] == "figure":

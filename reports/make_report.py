@@ -14,6 +14,9 @@ still going) is warned about ("k of N cells have results"), its missing cells ar
 index.md and its figures and tables are marked "incomplete: k of N cells". Folders without plans
 are reported as before. --require-complete writes nothing and exits 1 instead when a planned
 cell has no result or a cell errored.
+
+Where results of several commits fill the same cell, the newest commit's (by file time) are
+reported and the others left out, with a warning and a note in index.md naming the commits.
 """
 
 import argparse
@@ -102,6 +105,14 @@ def main(argv):
         if missing:
             gaps[study] = {"have": len(cells) - len(missing), "total": len(cells), "missing": missing,
                            "quick_mixed": len({q for q, _ in cells.values()}) > 1}
+    # Cells run by several commits (a rerun at a newer commit into the same folder): the newest
+    # commit's results of each cell are reported, the others left out and named.
+    commits = {}
+    for study, (results, _) in by_study.items():
+        kept, info = common.newest_commits(results)
+        if info:
+            results[:] = kept
+            commits[study] = common.commits_note(study, info)
     if args.require_complete:
         for study in sorted(by_study):
             if study in gaps:
@@ -124,6 +135,8 @@ def main(argv):
         reference = common.load_reference(study, args.references)
         gap = gaps.get(study)
         print("%s: %d result file(s)%s" % (study, len(results), "" if reference is None else ", paper reference found"))
+        if study in commits:
+            common.warn(commits[study])
         if gap:
             common.warn("%s: %d of %d cells have results; its figures and tables lack the %d other planned "
                         "cell(s) (listed in index.md; `mcfbench run` computes them)"
@@ -152,7 +165,7 @@ def main(argv):
         if errored:
             common.warn("%s: %d cell(s) errored and are missing from its figures (listed in index.md)"
                         % (study, len(errored)))
-        sections.append((study, src, written, errored, gap))
+        sections.append((study, src, written, errored, gap, commits.get(study)))
     index.make(out_dir, sections)
     return 0 if ok else 1
 

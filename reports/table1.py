@@ -57,7 +57,9 @@ def tracking(r):
 
 
 def model_key(r):
-    return (common.get(r, "config.mesh", r["_stem"]), common.get(r, "config.octree.depth"))
+    """A row: the model, its depth and the commit that ran it (a speed-up never divides one
+    commit's times by another's)."""
+    return (common.get(r, "config.mesh", r["_stem"]), common.get(r, "config.octree.depth"), common.commit_of(r))
 
 
 def find_paper_row(reference, mesh, depth):
@@ -82,15 +84,19 @@ def paper_table(reference):
 
 def make(results, out_dir, reference, written):
     """Write table1.md."""
+    # Of a cell run by several commits, the newest commit's repetitions (as the figures draw).
+    results = common.newest_commits(results)[0]
+    several = len({common.commit_of(r) for r in results}) > 1
     rows, left_out = [], []
-    for (mesh, depth), all_rs in common.group_by(results, model_key).items():
+    for (mesh, depth, commit), all_rs in common.group_by(results, model_key).items():
+        name = common.short_value(mesh) + (" @%s" % commit if several else "")
         # A flow that stopped (singular, error) timed fewer or other steps than the flow asked
         # for: its means would pass for a speed-up, so it is named below the table instead.
         rs = [r for r in all_rs if r.get("status") == "ok"]
         for r in all_rs:
             if r.get("status") != "ok":
                 left_out.append("%s at depth %s, %s: %s (%s)" % (
-                    common.short_value(mesh), common.fmt(depth, "%d"), tracking(r), r.get("status", "?"),
+                    name, common.fmt(depth, "%d"), tracking(r), r.get("status", "?"),
                     common.get(r, "stop.reason", "?")))
         by_mode = common.group_by(rs, tracking)
         tr, rb = by_mode.get("tracked", []), by_mode.get("rebuilt", [])
@@ -102,7 +108,7 @@ def make(results, out_dir, reference, written):
         paper = find_paper_row(reference, mesh, depth)
         paper_cell = ("%s + %s" % (common.fmt(paper.get("update_seconds")), common.fmt(paper.get("solve_seconds")))
                       if paper else "—")
-        rows.append([common.short_value(mesh), common.fmt(depth, "%d"),
+        rows.append([name, common.fmt(depth, "%d"),
                      common.fmt(median_over(base, lambda r: common.get(r, "mesh.vertices")), "%.3g"),
                      common.fmt(median_over(base, lambda r: common.get(r, "system.split_triangles")), "%.3g"),
                      common.fmt(median_over(base, lambda r: common.get(r, "system.dimension")), "%.3g"),
@@ -118,6 +124,10 @@ def make(results, out_dir, reference, written):
     text += ("\n\nTimes are medians over repetitions of the mean per-step seconds of steps 2 on. Step 1 also "
              "builds the solver's pattern and hierarchy, the paper's \"+system\": shown beside the set-up as "
              "the tracked step 1's time beyond the later steps' mean (a rebuilt step builds them every step).")
+    if several:
+        text += ("\n\nThe results come from several commits: a row per model and commit (\"@commit\"), its "
+                 "times the medians over that commit's repetitions; of a cell several commits ran, the newest "
+                 "commit's results only (index.md names the commits).")
     if left_out:
         text += ("\n\nLeft out of the times (the flow stopped):\n\n" +
                  "\n".join("- " + line for line in left_out))

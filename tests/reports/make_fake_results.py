@@ -53,15 +53,18 @@ def step(n, dt, errscale=1e-4, extra=None, slow=1.0, residual=1e-2):
     return s
 
 
-def result(study, index, assignment, config, steps, status="ok", reason="completed", **more):
+def result(study, index, assignment, config, steps, status="ok", reason="completed", repetition=0, commit="fake",
+           quick=False, **more):
+    """A result file's dict; cell.key names the repetition, cell.config_key does not (bench/cell_hash.cpp)."""
     r = {"schema": 1, "status": status, "stop": {"step": len(steps), "reason": reason},
          "config": config, "steps": steps,
-         "environment": {"commit": "fake", "cpu": "fake", "cores": 2, "threads": 2, "libraries": {}},
+         "environment": {"commit": commit, "cpu": "fake", "cores": 2, "threads": 2, "libraries": {}},
          "mesh": {"spec": config.get("mesh"), "vertices": 642, "faces": 1280, "boundary_loops": 0, "genus": 0},
          "system": {"dimension": 5000 + 100 * index, "split_triangles": 20000, "cubature_points": 60000,
                     "levels": 5, "setup_seconds": {"octree": 0.3, "clip": 0.2, "total": 0.5}},
-         "cell": {"index": index, "key": "%s-%d" % (study, index), "assignment": assignment,
-                  "repetition": 0, "study": study},
+         "cell": {"index": index, "key": "%s-%d-rep%d" % (study, index, repetition),
+                  "config_key": "%s-%d" % (study, index), "assignment": assignment,
+                  "repetition": repetition, "study": study, "quick": quick},
          "study_config": {"name": study}}
     r.update(more)
     return r
@@ -130,18 +133,134 @@ def frames(folder, stem, count, n_theta=12, n_phi=24, stretch=1.6):
         plyio.write_ply(os.path.join(d, "frame_%05d.ply" % (5 * k)), v * (1 - 0.05 * k), f, binary=(k % 2 == 0))
 
 
-def main(root):
-    # table1: one model, tracked + rebuilt; a second model with tracked only (missing variant).
+def table1_cells(folder, repetition=0, commit="fake", slow=1.0, names="cell_%03d", cells=(0, 1, 2)):
+    """table1: one model, tracked + rebuilt; a second model with tracked only (missing variant).
+    `slow` scales the per-step times."""
     s = "table1"
     for i, (mesh, mode, upd) in enumerate([("sphere:vertices=40000", "tracked", 0.01),
                                            ("sphere:vertices=40000", "rebuilt", 0.2),
                                            ("cgal:bunny00", "tracked", 0.02)]):
-        steps = [step(n, 1e-3, slow=upd / 0.01) for n in range(1, 4)]
+        if i not in cells:
+            continue
+        steps = [step(n, 1e-3, slow=slow * upd / 0.01) for n in range(1, 4)]
         if i == 0:  # the tracked step 1 also builds the solver's pattern: the paper's "+system"
             steps[0]["seconds"]["solve"] += 0.5
             steps[0]["seconds"]["total"] += 0.5
-        write(os.path.join(root, s), "cell_%03d" % i,
-              result(s, i, {"mesh": mesh, "octree.tracking": mode}, config(mesh=mesh, octree__tracking=mode), steps))
+        write(folder, names % i, result(s, i, {"mesh": mesh, "octree.tracking": mode},
+                                        config(mesh=mesh, octree__tracking=mode), steps,
+                                        repetition=repetition, commit=commit))
+
+
+def cubature_cells(folder, repetition=0, commit="fake", scale=1.0, names="cell_%03d", cells=(0, 1, 2)):
+    """cubature: three rules, their radial errors times `scale`."""
+    s = "cubature"
+    for i, rule in enumerate([1, 3, 6]):
+        if i in cells:
+            write(folder, names % i,
+                  result(s, i, {"octree.cubature": rule}, config(octree__cubature=rule),
+                         [step(n, 1e-3, scale * 1e-4 * (3 if rule == 1 else 1)) for n in range(1, 11)],
+                         repetition=repetition, commit=commit))
+
+
+def time_order_cells(folder, repetition=0, names="cell_%03d", first=0, mesh="icosphere:level=3", quick=False,
+                     offset=0.0, scale=1.0):
+    """time_order: two integrators × dts and one unstable explicit run, each to t = 0.01, their
+    mean radius sqrt(1 - 4t) + 0.3 δ^order (orders 1, 2, 1), and a Crank–Nicolson run at δ = 1.25e-4
+    (cell 9) whose mean radius is sqrt(1 - 4t) exactly: the temporal reference. The RMS error against
+    the continuous radius is a flat 1e-3 (the mesh's floor), so only errors measured as
+    |mean radius − reference| fit the orders 1 and 2. Cells numbered from `first`; every radius plus
+    `offset` (another mesh's spatial error), every temporal error times `scale`."""
+    s = "time_order"
+    end = 0.01
+    runs = [(integ, order, dt) for integ, order in (("semi-implicit", 1), ("bdf2", 2), ("explicit", 1))
+            for dt in (1e-3, 5e-4, 2.5e-4)] + [("crank-nicolson", None, 1.25e-4)]
+    for i, (integ, order, dt) in enumerate(runs):
+        err = scale * 0.3 * dt ** order if order else 0.0
+        status = "error" if (integ == "explicit" and dt == 1e-3) else "ok"
+        radius = lambda n, e=err, dt=dt: {"radial_error": {  # noqa: E731
+            "rms_continuous": 1e-3, "mean_radius": offset + math.sqrt(1 - 4 * n * dt) + e * n * dt / end}}
+        write(folder, names % (first + i),
+              result(s, first + i, {"integrator": integ, "dt": dt}, config(integrator=integ, dt=dt, mesh=mesh),
+                     [step(n, dt, extra=radius) for n in (1, round(end / dt))],
+                     status=status, reason="diverged" if status != "ok" else "completed",
+                     repetition=repetition, quick=quick))
+
+
+def set_time(folder, pattern, when):
+    """Give FOLDER's files whose names start with `pattern` the modification time `when` (seconds
+    since 1970): reports order commits by their newest result file."""
+    for name in os.listdir(folder):
+        if name.startswith(pattern):
+            os.utime(os.path.join(folder, name), (when, when))
+
+
+def repetitions_and_commits(root):
+    """ROOT/repeated/<study>: each cell twice, repetitions 0 (the files of ROOT/<study>) and 1
+    (cell_NNN_r1, other values): reports draw repetition 0 alone, so their figures and tables
+    equal those of ROOT/<study>. ROOT/commits/<study>: commit 0ld0ld's cells 0-2 (errors ×10,
+    times ×10, files a_old_NNN, 2026-01-01) and commit c0ffee's cells 0 and 1 (ROOT/<study>'s
+    values, files b_new_NNN, 2026-02-01): reports take c0ffee's cells 0 and 1 and 0ld0ld's cell 2."""
+    rep = os.path.join(root, "repeated")
+    cubature_cells(os.path.join(rep, "cubature"))
+    cubature_cells(os.path.join(rep, "cubature"), repetition=1, scale=5.0, names="cell_%03d_r1")
+    time_order_cells(os.path.join(rep, "time_order"))
+    time_order_cells(os.path.join(rep, "time_order"), repetition=1, names="cell_%03d_r1")
+    with open(os.path.join(rep, "time_order", "cell_003_r1.json")) as f:  # another value at bdf2's largest δ
+        r = json.load(f)
+    r["steps"][-1]["radial_error"]["mean_radius"] += 1e-6
+    write(os.path.join(rep, "time_order"), "cell_003_r1", r)
+    com = os.path.join(root, "commits")
+    for study, cells in (("cubature", cubature_cells), ("table1", table1_cells)):
+        folder = os.path.join(com, study)
+        more = {"scale": 10.0} if study == "cubature" else {"slow": 10.0}
+        cells(folder, commit="0ld0ld", names="a_old_%03d", **more)
+        cells(folder, commit="c0ffee", names="b_new_%03d", cells=(0, 1))
+        set_time(folder, "a_old_", 1767225600)  # 2026-01-01
+        set_time(folder, "b_new_", 1769904000)  # 2026-02-01
+
+
+def several_meshes(root):
+    """ROOT/meshes/time_order: the time_order cells on icosphere:level=3 (cells 0-9), on
+    icosphere:level=2 (10-19: radii 0.01 larger, temporal errors doubled) and a quick run on
+    icosphere:level=3 (20-29: radii 0.02 larger); each set has its own reference, so each fits
+    orders 1 and 2. ROOT/meshes/depth_cycles: depths 5, 6 × cycles 1, 2 on two meshes."""
+    folder = os.path.join(root, "meshes", "time_order")
+    time_order_cells(folder)
+    time_order_cells(folder, first=10, mesh="icosphere:level=2", offset=0.01, scale=2.0)
+    time_order_cells(folder, first=20, quick=True, offset=0.02)
+    s = "depth_cycles"
+    i = 0
+    for mesh, worse in (("icosphere:level=3", 1), ("icosphere:level=2", 4)):
+        for depth in (5, 6):
+            for cyc in (1, 2):
+                write(os.path.join(root, "meshes", s), "cell_%03d" % i,
+                      result(s, i, {"mesh": mesh, "octree.depth": depth, "solver.cycles": cyc},
+                             config(mesh=mesh, octree__depth=depth, solver__cycles=cyc),
+                             [step(n, 1e-3, worse * 1e-3 / (depth * cyc), residual=worse * 0.1 ** (cyc + depth - 3))
+                              for n in range(1, 6)]))
+                i += 1
+
+
+def many_frames(root):
+    """ROOT/strips/cmcf: three flows × seven meshes, flow-major as `mcfbench run` numbers them,
+    every cell with frames: more cells than frames.py draws strips for (MAX_CELLS = 8)."""
+    s = "cmcf"
+    folder = os.path.join(root, "strips", s)
+    metrics = lambda n: {"metrics": {"quasi_conformal": 1 + 0.5 / n, "sphericity": 0.2 / n}}  # noqa: E731
+    i = 0
+    for flow in ("mcf", "heat", "cmcf"):
+        for m in range(7):
+            mesh = "torus:n_major=%d" % (10 + m)
+            write(folder, "cell_%03d" % i, result(s, i, {"flow": flow, "mesh": mesh}, config(mesh=mesh, flow=flow),
+                                                  [step(n, 1e-3, extra=metrics) for n in (1, 2)]))
+            frames(folder, "cell_%03d" % i, 2, 4, 8)
+            i += 1
+
+
+def main(root):
+    # table1: one model, tracked + rebuilt; a second model with tracked only (missing variant).
+    s = "table1"
+    table1_cells(os.path.join(root, s))
     # A model whose tracked flow stopped at step 1: no speed-up from it, named below the table.
     for i, (mode, status) in enumerate([("tracked", "singular"), ("rebuilt", "ok")]):
         mesh = "spiral:turns=3"
@@ -177,11 +296,7 @@ def main(root):
                           for n in range(1, 6)]))
             i += 1
     # cubature: three rules.
-    s = "cubature"
-    for i, rule in enumerate([1, 3, 6]):
-        write(os.path.join(root, s), "cell_%03d" % i,
-              result(s, i, {"octree.cubature": rule}, config(octree__cubature=rule),
-                     [step(n, 1e-3, 1e-4 * (3 if rule == 1 else 1)) for n in range(1, 11)]))
+    cubature_cells(os.path.join(root, "cubature"))
     # cmcf: mcf stops singular, heat and cmcf converge; frames for cmcf.
     s = "cmcf"
     metrics = lambda n: {"metrics": {"quasi_conformal": 1 + 0.5 / n, "sphericity": 0.2 / n}}  # noqa: E731
@@ -199,17 +314,7 @@ def main(root):
     frames(os.path.join(root, s), "cell_002", 8, 60, 120)  # 14k faces × ... decimation exercised below
     frames(os.path.join(root, s), "cell_001", 3, 110, 220)  # ~48k faces: decimated
     # time_order: two integrators × dts (error ∝ dt and dt²), one unstable explicit run.
-    s = "time_order"
-    i = 0
-    for integ, order in (("semi-implicit", 1), ("bdf2", 2), ("explicit", 1)):
-        for dt in (1e-3, 5e-4, 2.5e-4):
-            err = 0.3 * dt ** order
-            status = "error" if (integ == "explicit" and dt == 1e-3) else "ok"
-            write(os.path.join(root, s), "cell_%03d" % i,
-                  result(s, i, {"integrator": integ, "dt": dt}, config(integrator=integ, dt=dt),
-                         [step(1, dt, extra=lambda n, e=err: {"radial_error": {"rms_continuous": e}})],
-                         status=status, reason="diverged" if status != "ok" else "completed"))
-            i += 1
+    time_order_cells(os.path.join(root, "time_order"))
     # A study with one cell and no steps at all.
     write(os.path.join(root, "single"), "only", result("cubature", 0, {"octree.cubature": 3}, config(), []))
     # Files a results folder may also hold: the runner's index, a truncated file, a non-result.
@@ -226,6 +331,9 @@ def main(root):
         write_plan(os.path.join(root, s), s)
     write_plan(os.path.join(root, "depth_cycles"), "depth_cycles", shard=(0, 2))
     write_plan(os.path.join(root, "depth_cycles"), "depth_cycles", shard=(1, 2))
+    repetitions_and_commits(root)
+    several_meshes(root)
+    many_frames(root)
     # Paper references.
     refs = os.path.join(root, "references")
     os.makedirs(refs, exist_ok=True)

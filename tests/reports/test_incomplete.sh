@@ -31,7 +31,7 @@ report $dirs "$work/noplans" --references "$r/references" >"$work/noplans.log" 2
 for s in $studies; do mv "$r/$s/plans.off" "$r/$s/plans"; done
 diff -r "$work/noplans" "$work/full" >"$work/diff" || { head -20 "$work/diff"; no "complete: the plans change the report"; }
 
-# --- Incomplete: sphere_error lacks cell 2, time_order cells 7 and 8 (cell 6 errored), cubature
+# --- Incomplete: sphere_error lacks cell 2, time_order cells 7, 8 and 9 (cell 6 errored), cubature
 # planned its cells and has none yet; an unreadable plan file is skipped with a warning. ---
 p=$work/partial
 mkdir -p "$p/sphere_error" "$p/time_order" "$p/cubature"
@@ -45,7 +45,7 @@ rc=$?
 cat "$work/part.log"
 [ $rc = 0 ] || no "incomplete: make_report exited $rc (partial results are a legitimate report)"
 grep -q "sphere_error: 2 of 3 cells have results" "$work/part.log" || no "no warning that sphere_error has 2 of 3 cells"
-grep -q "time_order: 7 of 9 cells have results" "$work/part.log" || no "no warning that time_order has 7 of 9 cells"
+grep -q "time_order: 7 of 10 cells have results" "$work/part.log" || no "no warning that time_order has 7 of 10 cells"
 grep -q "cubature: 0 of 3 cells have results" "$work/part.log" || no "no warning that cubature has 0 of 3 cells"
 grep -q "cut_short.json" "$work/part.log" || no "an unreadable plan file is not named"
 idx=$work/part/index.md
@@ -55,20 +55,21 @@ section "$idx" cubature >"$work/cu.md"
 grep -q '^\*\*Incomplete: 2 of 3 planned cells have results' "$work/se.md" || no "index.md: sphere_error not said incomplete"
 grep -qF -- '- cell 2 `basis=hat octree.tracking=tracked`' "$work/se.md" || no "index.md: sphere_error's missing cell 2 not listed"
 grep -qF -- '- cell 0 ' "$work/se.md" && no "index.md: a present cell listed as missing"
-grep -q '^\*\*Incomplete: 7 of 9 planned cells have results' "$work/to.md" || no "index.md: time_order not said incomplete"
+grep -q '^\*\*Incomplete: 7 of 10 planned cells have results' "$work/to.md" || no "index.md: time_order not said incomplete"
 grep -qF -- '- cell 7 `dt=0.0005 integrator=explicit`' "$work/to.md" || no "index.md: time_order's missing cell 7 not listed"
 grep -qF -- '- cell 8 `dt=0.00025 integrator=explicit`' "$work/to.md" || no "index.md: time_order's missing cell 8 not listed"
+grep -qF -- '- cell 9 `dt=0.000125 integrator=crank-nicolson`' "$work/to.md" || no "index.md: time_order's missing cell 9 not listed"
 grep -qF -- '- cell 6 `dt=0.001 integrator=explicit`: diverged' "$work/to.md" || no "index.md: the errored cell is no longer listed"
 grep -q '^\*\*Incomplete: 0 of 3 planned cells have results' "$work/cu.md" || no "index.md: a study with a plan and no results is left out"
 grep -q '^\*\*Incomplete report' "$idx" || no "index.md: no note at the top that the report is incomplete"
 # Figures and tables of the incomplete studies say so (title in index.md, a note on the figure,
 # which the PNG also carries as its Description); frame strips each show one cell and are not marked.
 grep -qF '(incomplete: 2 of 3 cells)](sphere_error.png)' "$idx" || no "index.md: sphere_error.png's title not marked"
-grep -qF '(incomplete: 7 of 9 cells)](time_order.png)' "$idx" || no "index.md: time_order.png's title not marked"
+grep -qF '(incomplete: 7 of 10 cells)](time_order.png)' "$idx" || no "index.md: time_order.png's title not marked"
 grep -aqF 'incomplete: 2 of 3 cells' "$work/part/sphere_error.png" || no "sphere_error.png carries no incomplete mark"
-grep -aqF 'incomplete: 7 of 9 cells' "$work/part/time_order.png" || no "time_order.png carries no incomplete mark"
+grep -aqF 'incomplete: 7 of 10 cells' "$work/part/time_order.png" || no "time_order.png carries no incomplete mark"
 grep -aqi 'incomplete' "$work/part/frames_sphere_error_00.png" && no "a frame strip (one cell) is marked incomplete"
-head -1 "$work/part/time_order.md" | grep -q '^\*\*Incomplete: 7 of 9 planned cells have results' || no "time_order.md not marked"
+head -1 "$work/part/time_order.md" | grep -q '^\*\*Incomplete: 7 of 10 planned cells have results' || no "time_order.md not marked"
 "$py" - "$root/reports" "$work/unit" >"$work/unit.log" 2>&1 <<'PY' || { cat "$work/unit.log"; no "the note drawn on a figure"; }
 import sys
 sys.path.insert(0, sys.argv[1])
