@@ -31,12 +31,19 @@ std::string label_of(const json& assignment, const std::string& key) {
 
 /// Accuracy of one result: the last distance to the reference flow when there is one (octree
 /// vs cotangent studies), else the final RMS radial error (spheres); NaN when neither exists.
-double accuracy_of(const json& r) {
-  if (r.contains("reference_distance") && r["reference_distance"].is_array() && !r["reference_distance"].empty())
-    return r["reference_distance"].back().value("rms", NAN);
-  if (r.contains("steps"))
+// The accuracy measures in the order compare prefers them: the distance to the reference flow
+// where a study computes one, else the radial error against the analytic sphere.
+constexpr const char* kAccuracyKinds[] = {"reference_distance", "radial_error"};
+
+/// A result's accuracy by measure (NaN when it does not record that one).
+double accuracy_of(const json& r, const std::string& kind) {
+  if (kind == "reference_distance") {
+    if (r.contains("reference_distance") && r["reference_distance"].is_array() && !r["reference_distance"].empty())
+      return r["reference_distance"].back().value("rms", NAN);
+  } else if (r.contains("steps")) {
     for (auto it = r["steps"].rbegin(); it != r["steps"].rend(); ++it)
       if (it->contains("radial_error")) return (*it)["radial_error"].value("rms", NAN);
+  }
   return NAN;
 }
 
@@ -152,8 +159,8 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
         const json* v = json_at_path(s, metric);
         if (v && v->is_number()) c.values.push_back(v->get<double>());
       }
-    const double err = accuracy_of(r);
-    if (std::isfinite(err)) c.errors.push_back(err);
+    for (const char* kind : kAccuracyKinds)
+      if (const double e = accuracy_of(r, kind); std::isfinite(e)) c.errors[kind].push_back(e);
     const json* run = json_at_path(r, "run_seconds");
     const json* steal = json_at_path(r, "steal_seconds");
     if (run && steal && run->is_number() && steal->is_number()) {
@@ -191,10 +198,29 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
     c.p_value = mann_whitney_p(old.values, n.values);
     c.slower = std::isfinite(c.ratio) && c.ratio > 1 + o.threshold && c.p_value < o.alpha;
     c.faster = std::isfinite(c.ratio) && c.ratio < 1 / (1 + o.threshold) && c.p_value < o.alpha;
-    if (!old.errors.empty() && !n.errors.empty()) {
+    c.failed = (n.failed > 0 && old.failed == 0) || (n.errored > 0 && old.errored == 0);
+    // The first measure OLD has decides: compared when NEW has it too, else NEW's accuracy is
+    // missing (reference distances not filled in after a sharded run, frames lost), where it
+    // used to pass unremarked. A measure only NEW has is new work, not a regression.
+    const std::vector<double>* old_errors = nullptr;
+    const std::vector<double>* new_errors = nullptr;
+    for (const char* kind : kAccuracyKinds) {
+      const auto o_it = old.errors.find(kind);
+      if (o_it == old.errors.end()) continue;
+      const auto n_it = n.errors.find(kind);
+      if (n_it == n.errors.end()) {
+        c.accuracy_missing = !c.failed;  // a failed NEW is flagged as that already
+        c.missing_accuracy = kind;
+      } else {
+        old_errors = &o_it->second;
+        new_errors = &n_it->second;
+      }
+      break;
+    }
+    if (old_errors && new_errors) {
       c.has_error = true;
-      c.old_error = median(old.errors);
-      c.new_error = median(n.errors);
+      c.old_error = median(*old_errors);
+      c.new_error = median(*new_errors);
       // Errors at round-off level are noise, not accuracy: a floor keeps 1e-16 vs 3e-16 quiet.
       const double floor = 1e-12;
       c.error_ratio = std::max(c.new_error, floor) / std::max(c.old_error, floor);
@@ -202,10 +228,9 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
     }
     c.old_steps = std::max(old.min_steps, 0);
     c.new_steps = std::max(n.min_steps, 0);
-    c.failed = (n.failed > 0 && old.failed == 0) || (n.errored > 0 && old.errored == 0);
     c.failure = n.failure;
     c.stopped_earlier = c.new_steps < c.old_steps;
-    rep.regression = rep.regression || c.slower || c.less_accurate || c.failed || c.stopped_earlier;
+    rep.regression = rep.regression || c.slower || c.less_accurate || c.failed || c.stopped_earlier || c.accuracy_missing;
     rep.cells.push_back(std::move(c));
   }
   for (const auto& [key, old] : old_set.cells)
@@ -243,6 +268,7 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, c
     if (c.less_accurate) verdict += "**less accurate** ";
     if (c.has_error && c.error_ratio < 1 / (1 + o.threshold)) verdict += "more accurate ";
     if (c.failed) verdict += "**failed** (" + c.failure + ") ";
+    if (c.accuracy_missing) verdict += "**accuracy missing** (no " + c.missing_accuracy + ") ";
     if (c.stopped_earlier)
       verdict += "**stopped earlier** (" + std::to_string(c.new_steps) + " of " + std::to_string(c.old_steps) + " steps) ";
     if (!verdict.empty()) ++changed;

@@ -14,7 +14,9 @@ namespace mcf {
 struct CellSamples {
   std::string label;                 ///< "basis=hat solver.name=cholmod" (the assignment)
   std::vector<double> values;        ///< the metric per step, all repetitions pooled
-  std::vector<double> errors;        ///< accuracy per repetition (final reference distance or radial rms)
+  /// Accuracy per repetition by measure: "reference_distance" (the final distance to the
+  /// reference flow, RMS) and "radial_error" (the last step's radial RMS), where recorded.
+  std::map<std::string, std::vector<double>> errors;
   int repetitions = 0;
   int failed = 0;                    ///< repetitions whose status is not "ok" (singular or error)
   int errored = 0;                   ///< of those, the ones with status "error" (the flow threw)
@@ -54,6 +56,11 @@ struct CellComparison {
   /// singular, or stopped earlier than OLD's fewest steps: a regression whatever the timings say
   /// (a cell that errors has no timings at all).
   bool failed = false, stopped_earlier = false;
+  /// OLD measured its accuracy in a way NEW did not (`missing_accuracy` names it): NEW's
+  /// accuracy cannot be vouched for (reference distances not filled in, frames lost), a
+  /// regression as a missing cell is.
+  bool accuracy_missing = false;
+  std::string missing_accuracy;
   std::string failure;
   int old_steps = 0, new_steps = 0;
 };

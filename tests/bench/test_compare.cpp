@@ -215,6 +215,20 @@ TEST(CompareCli, AccuracyIsTheReferenceDistanceWhereThereIsOne) {
   c = mcfbench("compare far near", dir);
   EXPECT_EQ(c.status, 0) << c.out << c.err;
   EXPECT_NE(c.out.find("more accurate"), std::string::npos) << c.out;
+  // NEW without the reference distances OLD has (not filled in after a sharded run, frames
+  // lost) was "no regression": it cannot be vouched for. Its radial error is another measure.
+  fs::create_directories(dir / "lost");
+  for (const auto& f : result_files(dir / "near")) {
+    json r = read_json(f);
+    r["environment"]["commit"] = "lost";
+    r.erase("reference_distance");
+    std::ofstream(dir / "lost" / f.filename()) << r.dump();
+  }
+  c = mcfbench("compare near lost", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("**accuracy missing** (no reference_distance)"), std::string::npos) << c.out;
+  c = mcfbench("compare lost near", dir);  // NEW measures more than OLD did: not a regression
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
 }
 
 TEST(CompareCli, InjectedSlowdownOnARealRun) {
