@@ -1,6 +1,6 @@
 #include "bases/octree.h"
 
-#include "datasets/bounds.h"
+#include "datasets/referenced_vertices.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>

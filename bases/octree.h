@@ -33,7 +33,7 @@ struct GridCube {
 };
 
 /// Chooses the cube for a depth in [1, 20] (the basis accepts 4..10) from the surface's bounds
-/// (the vertices its faces use: datasets/bounds.h). Throws std::invalid_argument for `unit` when
+/// (the vertices its faces use: datasets/referenced_vertices.h). Throws std::invalid_argument for `unit` when
 /// such a vertex lies outside [0,1]^3, and for an empty or single-point mesh.
 GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube);
 

@@ -1,6 +1,7 @@
 #include "bases/octree_system.h"
 
 #include "bases/cell_blocks.h"
+#include "datasets/referenced_vertices.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -339,9 +340,7 @@ Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coe
 }
 
 VertexStencils vertex_stencils(const Octree& octree, const Positions& vertices, const Triangles& faces) {
-  std::vector<char> used(static_cast<std::size_t>(vertices.rows()), 0);
-  for (Eigen::Index f = 0; f < faces.rows(); ++f)
-    for (int c = 0; c < 3; ++c) used[static_cast<std::size_t>(faces(f, c))] = 1;
+  const std::vector<char> used = referenced_vertices(vertices.rows(), faces);
   VertexStencils s;
   if (std::find(used.begin(), used.end(), 0) == used.end()) {
     s.used = point_stencils(octree, vertices);

@@ -29,13 +29,12 @@ std::string label_of(const json& assignment, const std::string& key) {
   return s;
 }
 
-/// Accuracy of one result: the last distance to the reference flow when there is one (octree
-/// vs cotangent studies), else the final RMS radial error (spheres); NaN when neither exists.
-// The accuracy measures in the order compare prefers them: the distance to the reference flow
-// where a study computes one, else the radial error against the analytic sphere.
+/// The accuracy measures in the order compare prefers them: the last distance to the reference
+/// flow where a study computes one (octree vs cotangent studies), else the final RMS radial
+/// error against the analytic sphere.
 constexpr const char* kAccuracyKinds[] = {"reference_distance", "radial_error"};
 
-/// A result's accuracy by measure (NaN when it does not record that one).
+/// A result's accuracy by one of kAccuracyKinds (NaN when it does not record that one).
 double accuracy_of(const json& r, const std::string& kind) {
   if (kind == "reference_distance") {
     if (r.contains("reference_distance") && r["reference_distance"].is_array() && !r["reference_distance"].empty())

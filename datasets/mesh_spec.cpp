@@ -3,7 +3,7 @@
 
 #include "datasets/mesh_spec.h"
 
-#include "datasets/bounds.h"
+#include "datasets/referenced_vertices.h"
 
 #include "datasets/catalogue.h"
 #include "datasets/generators.h"
@@ -49,7 +49,6 @@ struct Generator {
   /// overflow): checked against kMaxFaces before building, since the generators count in int.
   std::function<double(const Values&)> faces;
 };
-
 
 int as_int(const Values& v, const std::string& k) { return static_cast<int>(v.at(k)); }
 
@@ -247,13 +246,9 @@ MeshSource load_mesh_spec(const std::string& spec) {
           fail(spec, "key '" + key + "' is out of range (at most " + std::to_string(static_cast<long long>(p->max)) +
                          "), got " + item.substr(eq + 1));
       }
-      // Counts the generators refuse (negative, too few) are theirs to name; a size that would
+      // Values the generators refuse (a count or size <= 0) are theirs to name; a size that would
       // overflow their int counts or exhaust memory is refused here, before anything is built.
-      const bool counts_positive = std::all_of(g->params.begin(), g->params.end(),
-                                               [&](const Param& p) { return !p.integer || values.at(p.key) > 0; });
-      const bool sizes_positive = std::all_of(g->params.begin(), g->params.end(),
-                                              [&](const Param& p) { return p.integer || values.at(p.key) > 0; });
-      if (counts_positive && sizes_positive) {
+      if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second > 0; })) {
         const double faces = g->faces(values);
         if (!(faces <= static_cast<double>(kMaxFaces)))
           fail(spec, "these values make about " + std::to_string(static_cast<long long>(std::min(faces, 1e18))) +

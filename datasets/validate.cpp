@@ -3,7 +3,7 @@
 
 #include "datasets/validate.h"
 
-#include "datasets/bounds.h"
+#include "datasets/referenced_vertices.h"
 
 #include <Eigen/Geometry>
 
@@ -96,7 +96,8 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
 
   // Degeneracy relative to the model's size: the studies mix unit-cube models and big analytic
   // shapes, so an absolute area threshold would be wrong for one of them.
-  const double diag2 = surface_bounds(mesh).extent().squaredNorm();  // a stray vertex is not the model's size
+  const std::vector<char> referenced = referenced_vertices(n, mesh.faces);
+  const double diag2 = bounds_of(mesh.vertices, referenced).extent().squaredNorm();  // a stray vertex is not the model's size
   const double min_area = 1e-14 * diag2;
   MeshReport report;
   report.vertices = n;
@@ -139,9 +140,6 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
   }
 
   // Per component: referenced vertices, edges, faces, boundary loops -> χ_c and genus.
-  std::vector<char> referenced(n, 0);
-  for (Eigen::Index f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) referenced[mesh.faces(f, c)] = 1;
   std::vector<long long> verts_of_root(n, 0), faces_of_root(n, 0), loops_of_root(n, 0);
   for (Eigen::Index v = 0; v < n; ++v) {
     if (!referenced[v]) {

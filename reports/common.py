@@ -116,13 +116,17 @@ def load_plans(folder):
     return plans, unreadable
 
 
+def assignment_key(cell):
+    """A cell's assignment as a comparable string (keys sorted)."""
+    return json.dumps(cell.get("assignment") or {}, sort_keys=True)
+
+
 def cell_identity(study, quick, cell):
     """What makes a planned cell and a result the same cell: study, quick flag, index, repetition
     and assignment (not the commit: a planned cell is there when any commit's result is; where
     several commits ran a cell, the figures draw the newest one's, newest_commits)."""
     cell = cell if isinstance(cell, dict) else {}
-    return (study, bool(quick), cell.get("index"), cell.get("repetition", 0) or 0,
-            json.dumps(cell.get("assignment") or {}, sort_keys=True))
+    return (study, bool(quick), cell.get("index"), cell.get("repetition", 0) or 0, assignment_key(cell))
 
 
 def result_identity(result):
@@ -269,7 +273,7 @@ def cell_slot(result):
     cell = result.get("cell")
     if not isinstance(cell, dict):
         return ("file", result.get("_path", result.get("_stem")))
-    return (study_of(result), bool(cell.get("quick", False)), json.dumps(cell.get("assignment") or {}, sort_keys=True))
+    return (study_of(result), bool(cell.get("quick", False)), assignment_key(cell))
 
 
 def newest_commits(results):

@@ -85,7 +85,7 @@ def variant(result):
 
 def panel_of(key):
     """A variant() key's setting (flow, mesh, quick)."""
-    return (key[0],) + tuple(key[3:5])
+    return (key[0], key[3], key[4])
 
 
 def panel_name(panel, panels):
@@ -105,7 +105,7 @@ def variant_name(key, with_flow=True, panels=()):
     with the mesh and quick flag (panel_name) when `panels` lists several."""
     integrator, frozen = key[1], key[2]
     name = integrator + (" (frozen)" if frozen else "")
-    where = panel_name(panel_of(key), panels) if len(key) > 3 and panels else key[0]
+    where = panel_name(panel_of(key), panels) if panels else key[0]
     return where + ": " + name if with_flow else name
 
 
@@ -156,8 +156,7 @@ def styles(keys):
 
 def coinciding(curves, rel=0.02):
     """{key: earlier key} for each curve that lies on an earlier one of the same panel (flow,
-    mesh, quick flag; the flow alone for 3-tuple keys): at two or
-    more δs run by both, and at every such δ, errors within `rel` of each other (either may have
+    mesh, quick flag): at two or more δs run by both, and at every such δ, errors within `rel` of each other (either may have
     runs the other lacks). Where they share δs the later curve is drawn over the earlier one,
     so the legend says so. On the heat flow explicit Euler, semi-implicit Euler and Neumann-2
     have local errors of ±δ²/2 A²X, so their errors agree to leading order."""
