@@ -4,6 +4,8 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <cstring>
+#include <fcntl.h>
 #include <fstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -35,6 +37,36 @@ int remove_stale_temporaries(const std::string& path) {
   return removed;
 }
 
+void sync_to_disk(const fs::path& path) {
+  // fsync on a read-only descriptor flushes the file's (or folder's) data all the same: it acts on
+  // the inode, so a file another stream wrote and closed needs no descriptor of its writer.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(path.string() + ": cannot open to sync: " + std::strerror(errno));
+  int rc;
+  do rc = ::fsync(fd);
+  while (rc != 0 && errno == EINTR);
+  const int sync_errno = errno;
+  ::close(fd);
+  if (rc != 0 && !(sync_errno == EINVAL && fs::is_directory(path)))
+    throw std::runtime_error(path.string() + ": sync to disk failed: " + std::strerror(sync_errno));
+}
+
+void publish_durably(const fs::path& tmp, const fs::path& target) {
+  std::error_code ec;
+  try {
+    sync_to_disk(tmp);
+  } catch (const std::exception& e) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error(target.string() + ": " + e.what());
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error(target.string() + ": cannot rename temporary file: " + ec.message());
+  }
+  sync_to_disk(target.has_parent_path() ? target.parent_path() : fs::path("."));
+}
+
 void write_file_atomic(const std::string& path, const std::string& content) {
   const fs::path target(path);
   if (target.has_parent_path()) fs::create_directories(target.parent_path());
@@ -51,12 +83,7 @@ void write_file_atomic(const std::string& path, const std::string& content) {
       throw std::runtime_error(path + ": write failed");
     }
   }
-  std::error_code ec;
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot rename temporary file: " + ec.message());
-  }
+  publish_durably(tmp, target);
 }
 
 }  // namespace mcf

@@ -1,7 +1,11 @@
 #pragma once
 // Results are never half-written: write to a temporary file beside the target, then rename
-// (atomic on POSIX within one file system).
+// (atomic on POSIX within one file system). Neither are they lost to a crash of the machine (power
+// loss, kernel panic, a cluster node going down): the temporary file's data reach the disk before
+// the rename, and the folder's entry after it (fsync both; rename alone orders nothing on disk, so
+// ext4 or XFS could keep the new name of an empty file).
 
+#include <filesystem>
 #include <string>
 
 namespace mcf {
@@ -10,6 +14,15 @@ namespace mcf {
 /// naming the path on failure. The temporary file is `PATH.tmp.PID`; one a killed writer left
 /// (its process no longer exists on this machine) is removed by the next write of `path`.
 void write_file_atomic(const std::string& path, const std::string& content);
+
+/// Flushes a file's data, or a folder's entries, to the disk (fsync). Throws std::runtime_error
+/// naming the path if the file cannot be opened or the disk reports an error; a file system that
+/// cannot sync a folder (EINVAL, as some network and FUSE file systems answer) is not an error.
+void sync_to_disk(const std::filesystem::path& path);
+
+/// Moves the written temporary file `tmp` onto `target` durably: syncs `tmp`, renames it, syncs the
+/// folder. On failure removes `tmp` and throws std::runtime_error naming `target`.
+void publish_durably(const std::filesystem::path& tmp, const std::filesystem::path& target);
 
 /// Removes `PATH.tmp.PID` files beside `path` whose PID is not a live process on this machine
 /// (left by a writer that was killed between writing and renaming). Temporary files of other

@@ -7,6 +7,7 @@
 
 #include "datasets/mesh_io.h"
 
+#include "datasets/atomic_file.h"
 #include "datasets/ply_format.h"
 #include "datasets/walked_mesh.h"
 
@@ -832,11 +833,10 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary, 
     fs::remove(tmp, ec);
     fail(path, "could not write the file (folder missing or not writable?)");
   }
-  std::error_code ec;
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    fail(path, "cannot rename the temporary file into place: " + ec.message());
+  try {
+    publish_durably(tmp, target);  // a frame or final.ply survives a crash of the machine too
+  } catch (const std::runtime_error& e) {
+    throw MeshError(e.what());
   }
 }
 
