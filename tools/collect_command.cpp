@@ -71,6 +71,14 @@ std::vector<fs::path> json_files(const fs::path& dir) {
   return paths;
 }
 
+/// A plan's temporary file (`NAME.json.tmp.PID`, see write_file_atomic) in `plans`, if any.
+std::optional<fs::path> temporary_plan(const fs::path& plans) {
+  if (!fs::is_directory(plans)) return std::nullopt;
+  for (const auto& entry : fs::directory_iterator(plans))
+    if (entry.path().filename().string().find(".json.tmp.") != std::string::npos) return entry.path();
+  return std::nullopt;
+}
+
 /// "#3 {"dt":0.001} rep 1 (ab12cd34ef56.json)": a cell named as a user can find it.
 std::string describe_cell(int index, const json& c) {
   std::string s = "#" + std::to_string(index);
@@ -162,10 +170,17 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         }
         if (found == 0) {
           // A mistyped shard folder, or a run killed before it planned anything: nothing here
-          // says which cells were meant, so nothing here can vouch that they are all there.
+          // says which cells were meant, so nothing here can vouch that they are all there. A
+          // plan's temporary file alone means the run was stopped while publishing its plan.
           empty_dirs.push_back(dir);
-          std::printf("%s: no cell results and no run plan (%s/): not a folder `mcfbench run` wrote into\n",
-                      dir.c_str(), kPlanFolder);
+          const std::optional<fs::path> partial = temporary_plan(fs::path(dir) / kPlanFolder);
+          if (partial)
+            std::printf("%s: no cell results, and the run plan was never published (%s is its unfinished temporary "
+                        "file): the run was stopped while planning; rerun `mcfbench run` into this folder\n",
+                        dir.c_str(), partial->string().c_str());
+          else
+            std::printf("%s: no cell results and no run plan (%s/): not a folder `mcfbench run` wrote into\n",
+                        dir.c_str(), kPlanFolder);
         }
       }
       json studies = json::array();

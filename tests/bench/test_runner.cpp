@@ -413,7 +413,13 @@ TEST(RunnerCli, CollectAfterAKillBeforeAnyCellFinishedNamesTheMissingCells) {
   ASSERT_GT(pid, 0);
   // Kill it as soon as it has planned (before its first cell can finish, on any machine but a
   // very fast one).
-  auto planned = [&] { return fs::is_directory(dir / "out" / "plans") && !fs::is_empty(dir / "out" / "plans"); };
+  // Planned means published: the plan's temporary file appears first and is renamed into place.
+  auto planned = [&] {
+    if (!fs::is_directory(dir / "out" / "plans")) return false;
+    for (const auto& entry : fs::directory_iterator(dir / "out" / "plans"))
+      if (entry.path().extension() == ".json") return true;
+    return false;
+  };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (!planned() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   ::kill(pid, SIGKILL);
@@ -430,6 +436,18 @@ TEST(RunnerCli, CollectAfterAKillBeforeAnyCellFinishedNamesTheMissingCells) {
   if (7 - finished > 5) {  // the first five are named, the rest counted
     EXPECT_NE(c.out.find("... and " + std::to_string(7 - finished - 5) + " more"), std::string::npos) << c.out;
   }
+}
+
+TEST(RunnerCli, CollectNamesAPlanThatWasNeverPublished) {
+  // A run stopped between writing its plan and renaming it leaves only the temporary file.
+  const fs::path dir = fresh_dir("collect_unpublished_plan");
+  fs::create_directories(dir / "out" / "plans");
+  write_text(dir / "out" / "plans" / "slow.json.tmp.999999", "{\"study\": \"slow\", \"cel");
+  const Command c = mcfbench("collect out", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("the run plan was never published"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("slow.json.tmp.999999"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("rerun `mcfbench run`"), std::string::npos) << c.out;
 }
 
 TEST(RunnerCli, ShardsThenCollect) {
