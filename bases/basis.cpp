@@ -7,10 +7,12 @@ namespace mcf {
 
 SparseView view_of(const SparseMatrix& A) {
   if (!A.isCompressed()) throw std::invalid_argument("view_of: the matrix is not compressed");
-  return SparseView(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(), A.valuePtr());
+  return SparseView(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(),
+                    A.valuePtr());
 }
 
-SparseView view_of(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values) {
+SparseView view_of(const std::vector<int>& outer, const std::vector<int>& inner,
+                   const std::vector<double>& values) {
   // One column start of 0 for the empty pattern: a map needs an outer array even with no columns.
   static const int kEmptyOuter[1] = {0};
   if (outer.empty()) return SparseView(0, 0, 0, kEmptyOuter, nullptr, nullptr);
@@ -19,7 +21,8 @@ SparseView view_of(const std::vector<int>& outer, const std::vector<int>& inner,
     throw std::invalid_argument("view_of: " + std::to_string(values.size()) + " values and " +
                                 std::to_string(inner.size()) + " row indices for a pattern of " +
                                 std::to_string(outer.back()) + " nonzeros");
-  return SparseView(n, n, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(), values.data());
+  return SparseView(n, n, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(),
+                    values.data());
 }
 
 }  // namespace mcf

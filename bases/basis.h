@@ -27,7 +27,7 @@ using Coefficients = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 /// What a basis reports about its construction (result.json "system").
 struct BasisStats {
   long long dimension = 0;
-  long long split_triangles = 0;   ///< clipped pieces (octree); faces (hat)
+  long long split_triangles = 0;  ///< clipped pieces (octree); faces (hat)
   long long cubature_points = 0;
   int levels = 1;
   double bytes_per_cubature_point = 0.0;
@@ -85,6 +85,7 @@ class Basis {
 SparseView view_of(const SparseMatrix& A);
 /// The view of values on a pattern given by its column starts (columns + 1) and row indices; an
 /// empty pattern (no column starts) gives an empty matrix.
-SparseView view_of(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values);
+SparseView view_of(const std::vector<int>& outer, const std::vector<int>& inner,
+                   const std::vector<double>& values);
 
 }  // namespace mcf

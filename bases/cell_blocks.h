@@ -30,13 +30,15 @@ inline double piece_frame(const double p0[3], const double p1[3], const double p
                           double f1[3], double f2[3]) {
   const double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
   const double v[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-  const double m[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double m[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                       u[0] * v[1] - u[1] * v[0]};
   const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
   const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
   if (!(len > 0.0) || !(ul > 0.0)) return 0.0;
   const double r = scale / (len * ul);  // f2 = r (m × u), f1 = (r len) u
   const double r1 = r * len;
-  const double w[3] = {m[1] * u[2] - m[2] * u[1], m[2] * u[0] - m[0] * u[2], m[0] * u[1] - m[1] * u[0]};
+  const double w[3] = {m[1] * u[2] - m[2] * u[1], m[2] * u[0] - m[0] * u[2],
+                       m[0] * u[1] - m[1] * u[0]};
   for (int a = 0; a < 3; ++a) {
     f1[a] = u[a] * r1;
     f2[a] = w[a] * r;
@@ -60,8 +62,8 @@ class CellBlocks {
   /// One cubature point at local cell coordinates t ∈ [0,1]^3. f1, f2 = e1/h, e2/h: the frame
   /// vectors divided by the cell size, so that η_a = f1 · ∇_t β_a (world units). wm weights the
   /// mass; (s11, s12, s22) is the symmetric 2x2 form S of the stiffness.
-  void add(const double t[3], const double f1[3], const double f2[3], double wm, double s11, double s12,
-           double s22) {
+  void add(const double t[3], const double f1[3], const double f2[3], double wm, double s11,
+           double s12, double s22) {
     // Corner c = x + 2y + 4z: lanes lo = corners 0..3 (z = 0), hi = corners 4..7 (z = 1).
     const double u = t[0], v = t[1], z = t[2];
     const v4 bx = {1 - u, u, 1 - u, u}, by = {1 - v, 1 - v, v, v};

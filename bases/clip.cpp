@@ -125,7 +125,8 @@ void clip_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
   k.run(p, 0, cell);
 }
 
-std::vector<ClippedTriangle> clip_mesh(const Positions& vertices, const Triangles& faces, const GridCube& cube) {
+std::vector<ClippedTriangle> clip_mesh(const Positions& vertices, const Triangles& faces,
+                                       const GridCube& cube) {
   const Eigen::Index m = faces.rows();
   constexpr Eigen::Index chunk = 512;
   const Eigen::Index nchunks = (m + chunk - 1) / chunk;
@@ -145,7 +146,8 @@ std::vector<ClippedTriangle> clip_mesh(const Positions& vertices, const Triangle
   for (std::size_t i = 0; i < parts.size(); ++i) offset[i + 1] = offset[i] + parts[i].size();
   std::vector<ClippedTriangle> all(offset.back());
   tbb::parallel_for(std::size_t(0), parts.size(), [&](std::size_t i) {
-    std::copy(parts[i].begin(), parts[i].end(), all.begin() + static_cast<std::ptrdiff_t>(offset[i]));
+    std::copy(parts[i].begin(), parts[i].end(),
+              all.begin() + static_cast<std::ptrdiff_t>(offset[i]));
     std::vector<ClippedTriangle>().swap(parts[i]);
   });
   return all;

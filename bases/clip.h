@@ -27,8 +27,10 @@ struct ClippedTriangle {
   Eigen::Vector3d centroid() const { return (corner(0) + corner(1) + corner(2)) / 3.0; }
   /// Unnormalised normal (p1-p0)x(p2-p0); its norm is twice the area.
   Eigen::Vector3d cross() const {
-    const double u[3] = {corners[1][0] - corners[0][0], corners[1][1] - corners[0][1], corners[1][2] - corners[0][2]};
-    const double v[3] = {corners[2][0] - corners[0][0], corners[2][1] - corners[0][1], corners[2][2] - corners[0][2]};
+    const double u[3] = {corners[1][0] - corners[0][0], corners[1][1] - corners[0][1],
+                         corners[1][2] - corners[0][2]};
+    const double v[3] = {corners[2][0] - corners[0][0], corners[2][1] - corners[0][1],
+                         corners[2][2] - corners[0][2]};
     return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
   }
   double area() const { return 0.5 * cross().norm(); }
@@ -40,6 +42,7 @@ void clip_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
 
 /// Pieces of all faces, parallel over triangles (TBB); output is the per-triangle output
 /// concatenated in triangle order (independent of the thread count).
-std::vector<ClippedTriangle> clip_mesh(const Positions& vertices, const Triangles& faces, const GridCube& cube);
+std::vector<ClippedTriangle> clip_mesh(const Positions& vertices, const Triangles& faces,
+                                       const GridCube& cube);
 
 }  // namespace mcf

@@ -45,7 +45,8 @@ CubatureRule make_rule(int order) {
       add_orbit6(r, 0.053145049844817, 0.310352451033784, 0.082851075618374);
       break;
     default:
-      throw std::invalid_argument("cubature_rule: order must be 1, 3 or 6, got " + std::to_string(order));
+      throw std::invalid_argument("cubature_rule: order must be 1, 3 or 6, got " +
+                                  std::to_string(order));
   }
   // Normalise so the weights sum to 1 exactly up to rounding (the tabulated values are given to
   // 15 digits).
@@ -60,11 +61,15 @@ CubatureRule make_rule(int order) {
 const CubatureRule& cubature_rule(int order) {
   static const CubatureRule r1 = make_rule(1), r3 = make_rule(3), r6 = make_rule(6);
   switch (order) {
-    case 1: return r1;
-    case 3: return r3;
-    case 6: return r6;
+    case 1:
+      return r1;
+    case 3:
+      return r3;
+    case 6:
+      return r6;
     default:
-      throw std::invalid_argument("cubature_rule: order must be 1, 3 or 6, got " + std::to_string(order));
+      throw std::invalid_argument("cubature_rule: order must be 1, 3 or 6, got " +
+                                  std::to_string(order));
   }
 }
 

@@ -8,8 +8,8 @@
 namespace mcf {
 
 struct CubatureRule {
-  int order = 0;    ///< number of points (the option value: 1, 3 or 6 selects the rule)
-  int degree = 0;   ///< polynomial degree integrated exactly
+  int order = 0;   ///< number of points (the option value: 1, 3 or 6 selects the rule)
+  int degree = 0;  ///< polynomial degree integrated exactly
   std::vector<std::array<double, 3>> points;  ///< barycentric coordinates, each summing to 1
   std::vector<double> weights;                ///< summing to 1
   int size() const { return static_cast<int>(weights.size()); }

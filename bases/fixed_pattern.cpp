@@ -8,8 +8,10 @@
 
 namespace mcf {
 
-FixedPattern::FixedPattern(Eigen::Index n, const std::vector<int>& rows, const std::vector<int>& cols) {
-  if (rows.size() != cols.size()) throw std::invalid_argument("FixedPattern: rows/cols size mismatch");
+FixedPattern::FixedPattern(Eigen::Index n, const std::vector<int>& rows,
+                           const std::vector<int>& cols) {
+  if (rows.size() != cols.size())
+    throw std::invalid_argument("FixedPattern: rows/cols size mismatch");
   const std::size_t slots = rows.size();
   // Sort slots by (col, row, slot) — column-major order of the target — to find the nonzeros.
   std::vector<std::int64_t> order(slots);

@@ -26,14 +26,16 @@ class FixedPattern {
 
   /// Values on this pattern (non_zeros() of them, in CSC order) seen as a matrix, so that several
   /// matrices on the pattern share its index arrays.
-  SparseView view(const std::vector<double>& values) const { return view_of(outer_, inner_, values); }
+  SparseView view(const std::vector<double>& values) const {
+    return view_of(outer_, inner_, values);
+  }
 
   std::size_t num_slots() const { return slot_of_.size(); }
 
  private:
-  std::vector<int> outer_, inner_;    // the pattern: column starts and row indices
-  std::vector<std::int64_t> first_;   // per nonzero: range into slot_of_
-  std::vector<std::int64_t> slot_of_; // slots grouped by nonzero, ascending slot order
+  std::vector<int> outer_, inner_;     // the pattern: column starts and row indices
+  std::vector<std::int64_t> first_;    // per nonzero: range into slot_of_
+  std::vector<std::int64_t> slot_of_;  // slots grouped by nonzero, ascending slot order
 };
 
 }  // namespace mcf

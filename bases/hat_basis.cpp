@@ -57,7 +57,8 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
   const bool lumped = mass_kind_ == MassKind::lumped;
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, m, 2048), [&](const auto& r) {
     for (Eigen::Index f = r.begin(); f != r.end(); ++f) {
-      const Eigen::Vector3d p[3] = {x.row(faces_(f, 0)).transpose(), x.row(faces_(f, 1)).transpose(),
+      const Eigen::Vector3d p[3] = {x.row(faces_(f, 0)).transpose(),
+                                    x.row(faces_(f, 1)).transpose(),
                                     x.row(faces_(f, 2)).transpose()};
       if (update_mass) {
         const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
@@ -67,7 +68,8 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
           for (int b = 0; b < 3; ++b) local_m[9 * f + 3 * a + b] = a == b ? diag : off;
       }
       if (update_stiffness) {
-        // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite edge.
+        // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite
+        // edge.
         const Eigen::Vector3d cot = corner_cotangents(p[0], p[1], p[2]);
         double* k = &local_k[9 * f];
         for (int c = 0; c < 3; ++c) {

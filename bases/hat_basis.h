@@ -29,8 +29,8 @@ class HatBasis final : public Basis {
   Positions vertices0_;
   Triangles faces_;
   MassKind mass_kind_;
-  FixedPattern pattern_;  // 9 slots per face, gathered per nonzero
-  std::vector<double> mass_, stiffness_;  // values on pattern_
+  FixedPattern pattern_;                              // 9 slots per face, gathered per nonzero
+  std::vector<double> mass_, stiffness_;              // values on pattern_
   std::vector<double> local_mass_, local_stiffness_;  // per-face 3x3 blocks, reused every step
   std::vector<int> boundary_;
   BasisStats stats_;

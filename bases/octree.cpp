@@ -14,7 +14,8 @@
 namespace mcf {
 
 GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube) {
-  if (depth < 1 || depth > 20) throw std::invalid_argument("octree depth must be in [1,20], got " + std::to_string(depth));
+  if (depth < 1 || depth > 20)
+    throw std::invalid_argument("octree depth must be in [1,20], got " + std::to_string(depth));
   if (mesh.num_vertices() == 0) throw std::invalid_argument("choose_cube: empty mesh");
   const Bounds bounds = surface_bounds(mesh);
   const Eigen::Vector3d lo = bounds.lo.transpose(), hi = bounds.hi.transpose();
@@ -24,8 +25,9 @@ GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube) {
   if (cube == OctreeCube::unit || (cube == OctreeCube::automatic && fits)) {
     if (!fits) {
       std::ostringstream what;
-      what << "octree cube \"unit\" (octree.cube, --cube): the mesh's bounding box [" << lo.transpose() << "] - ["
-           << hi.transpose() << "] does not lie inside the unit cube [0, 1]^3; use \"auto\" or \"tight\"";
+      what << "octree cube \"unit\" (octree.cube, --cube): the mesh's bounding box ["
+           << lo.transpose() << "] - [" << hi.transpose()
+           << "] does not lie inside the unit cube [0, 1]^3; use \"auto\" or \"tight\"";
       throw std::invalid_argument(what.str());
     }
     g.origin.setZero();
@@ -33,7 +35,8 @@ GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube) {
     return g;
   }
   const double extent = (hi - lo).maxCoeff();
-  if (!(extent > 0.0) || !std::isfinite(extent)) throw std::invalid_argument("choose_cube: degenerate or non-finite mesh extent");
+  if (!(extent > 0.0) || !std::isfinite(extent))
+    throw std::invalid_argument("choose_cube: degenerate or non-finite mesh extent");
   // side = 1.01 extent + one cell (half a cell of margin on each side beyond the 0.5% per side).
   const double side = 1.01 * extent / (1.0 - 1.0 / static_cast<double>(1 << depth));
   g.side = side;
@@ -44,10 +47,12 @@ GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube) {
 namespace {
 
 // res = largest valid index; rows has (res+1)^2 + 1 entries.
-int find_key(const std::vector<GridKey>& keys, const std::vector<int>& rows, int i, int j, int k, int res) {
+int find_key(const std::vector<GridKey>& keys, const std::vector<int>& rows, int i, int j, int k,
+             int res) {
   if (i < 0 || j < 0 || k < 0 || i > res || j > res || k > res) return -1;
   const GridKey key = grid_key(i, j, k);
-  const std::size_t row = static_cast<std::size_t>(k) * static_cast<std::size_t>(res + 1) + static_cast<std::size_t>(j);
+  const std::size_t row =
+      static_cast<std::size_t>(k) * static_cast<std::size_t>(res + 1) + static_cast<std::size_t>(j);
   const auto b = keys.begin() + rows[row], e = keys.begin() + rows[row + 1];
   auto it = e - b <= 8 ? std::find(b, e, key) : std::lower_bound(b, e, key);
   return (it != e && *it == key) ? static_cast<int>(it - keys.begin()) : -1;
@@ -58,7 +63,8 @@ void fill_rows(const std::vector<GridKey>& keys, int n, std::vector<int>& rows) 
   rows.assign(nrows + 1, 0);
   for (GridKey key : keys) {
     const auto ijk = grid_index(key);
-    ++rows[static_cast<std::size_t>(ijk[2]) * static_cast<std::size_t>(n) + static_cast<std::size_t>(ijk[1]) + 1];
+    ++rows[static_cast<std::size_t>(ijk[2]) * static_cast<std::size_t>(n) +
+           static_cast<std::size_t>(ijk[1]) + 1];
   }
   for (std::size_t r = 0; r < nrows; ++r) rows[r + 1] += rows[r];
 }
@@ -71,28 +77,30 @@ void sort_unique(std::vector<GridKey>& keys) {
 void fill_functions(OctreeLevel& L) {
   const std::size_t nc = L.cells.size();
   std::vector<GridKey> corners(8 * nc);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      const auto ijk = grid_index(L.cells[c]);
-      for (int q = 0; q < 8; ++q) {
-        const auto o = corner_offset(q);
-        corners[8 * c + q] = grid_key(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
-      }
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c) {
+          const auto ijk = grid_index(L.cells[c]);
+          for (int q = 0; q < 8; ++q) {
+            const auto o = corner_offset(q);
+            corners[8 * c + q] = grid_key(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
+          }
+        }
+      });
   sort_unique(corners);
   L.functions = std::move(corners);
   fill_rows(L.functions, (1 << L.depth) + 1, L.function_row_start);
   L.cell_functions.resize(nc);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      const auto ijk = grid_index(L.cells[c]);
-      for (int q = 0; q < 8; ++q) {
-        const auto o = corner_offset(q);
-        L.cell_functions[c][q] = L.find_function(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
-      }
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c) {
+          const auto ijk = grid_index(L.cells[c]);
+          for (int q = 0; q < 8; ++q) {
+            const auto o = corner_offset(q);
+            L.cell_functions[c][q] = L.find_function(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
+          }
+        }
+      });
 }
 
 }  // namespace

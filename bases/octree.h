@@ -33,15 +33,15 @@ struct GridCube {
 };
 
 /// Chooses the cube for a depth in [1, 20] (the basis accepts 4..10) from the surface's bounds
-/// (the vertices its faces use: datasets/referenced_vertices.h). Throws std::invalid_argument for `unit` when
-/// such a vertex lies outside [0,1]^3, and for an empty or single-point mesh.
+/// (the vertices its faces use: datasets/referenced_vertices.h). Throws std::invalid_argument for
+/// `unit` when such a vertex lies outside [0,1]^3, and for an empty or single-point mesh.
 GridCube choose_cube(const TriangleMesh& mesh, int depth, OctreeCube cube);
 
 using GridKey = std::uint64_t;
 inline constexpr int kGridKeyBits = 21;
 inline GridKey grid_key(int i, int j, int k) {
-  return (static_cast<GridKey>(k) << (2 * kGridKeyBits)) | (static_cast<GridKey>(j) << kGridKeyBits) |
-         static_cast<GridKey>(i);
+  return (static_cast<GridKey>(k) << (2 * kGridKeyBits)) |
+         (static_cast<GridKey>(j) << kGridKeyBits) | static_cast<GridKey>(i);
 }
 inline std::array<int, 3> grid_index(GridKey key) {
   constexpr GridKey mask = (GridKey(1) << kGridKeyBits) - 1;
@@ -49,14 +49,16 @@ inline std::array<int, 3> grid_index(GridKey key) {
           static_cast<int>(key >> (2 * kGridKeyBits))};
 }
 /// Corner c of a cell is offset ((c&1), (c>>1)&1, (c>>2)&1) from the cell's index.
-inline std::array<int, 3> corner_offset(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
+inline std::array<int, 3> corner_offset(int c) {
+  return {c & 1, (c >> 1) & 1, (c >> 2) & 1};
+}
 
 struct OctreeLevel {
   int depth = 0;
-  std::vector<GridKey> cells;                     ///< active cells, sorted
-  std::vector<GridKey> functions;                 ///< corners of active cells, sorted
-  std::vector<std::array<int, 8>> cell_functions; ///< per cell: function index of corner c
-  std::vector<int> cell_parent;                   ///< per cell: index in the next coarser level (-1 on the coarsest)
+  std::vector<GridKey> cells;                      ///< active cells, sorted
+  std::vector<GridKey> functions;                  ///< corners of active cells, sorted
+  std::vector<std::array<int, 8>> cell_functions;  ///< per cell: function index of corner c
+  std::vector<int> cell_parent;  ///< per cell: index in the next coarser level (-1 on the coarsest)
   /// Row directories: entries of row (k,j) are [row_start[k*n+j], row_start[k*n+j+1]) with
   /// n = 2^depth (cells) or 2^depth+1 (functions); lookups search only inside one row.
   std::vector<int> cell_row_start, function_row_start;
@@ -82,6 +84,7 @@ struct Octree {
 
 /// Builds all levels from the active finest cells (any order, duplicates allowed). Levels run from
 /// depth min(coarsest_depth, cube.depth) up to cube.depth. Parallel (TBB sorts and loops).
-Octree build_octree(const GridCube& cube, std::vector<GridKey> finest_cells, int coarsest_depth = 2);
+Octree build_octree(const GridCube& cube, std::vector<GridKey> finest_cells,
+                    int coarsest_depth = 2);
 
 }  // namespace mcf

@@ -15,11 +15,14 @@ namespace mcf {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 }  // namespace
 
-std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices, const Triangles& faces) {
+std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices,
+                                    const Triangles& faces) {
   const OctreeLevel& L = octree.finest();
   const GridCube& cube = octree.cube;
   const double h = cube.cell_size();
@@ -41,7 +44,8 @@ std::vector<int> boundary_functions(const Octree& octree, const Positions& verti
     for (int ax = 0; ax < 3; ++ax) {
       const double ua = (a[ax] - cube.origin[ax]) / h, ub = (b[ax] - cube.origin[ax]) / h;
       if (ua == ub) continue;
-      for (int i = static_cast<int>(std::ceil(std::min(ua, ub))); i <= static_cast<int>(std::floor(std::max(ua, ub))); ++i) {
+      for (int i = static_cast<int>(std::ceil(std::min(ua, ub)));
+           i <= static_cast<int>(std::floor(std::max(ua, ub))); ++i) {
         const double t = (i - ua) / (ub - ua);
         if (t > 0.0 && t < 1.0) ts.push_back(t);
       }
@@ -57,10 +61,11 @@ std::vector<int> boundary_functions(const Octree& octree, const Positions& verti
   return out;
 }
 
-
-RebuiltOctreeBasis::RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions options) : options_(options) {
+RebuiltOctreeBasis::RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions options)
+    : options_(options) {
   if (options_.depth < 4 || options_.depth > 10)
-    throw std::invalid_argument("octree depth must be in 4..10, got " + std::to_string(options_.depth));
+    throw std::invalid_argument("octree depth must be in 4..10, got " +
+                                std::to_string(options_.depth));
   (void)cubature_rule(options_.cubature);  // validates
   if (mesh.num_faces() == 0) throw std::invalid_argument("RebuiltOctreeBasis: mesh has no faces");
   input_vertices_ = mesh.num_vertices();
@@ -68,11 +73,14 @@ RebuiltOctreeBasis::RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   rebuild(mesh.vertices);
 }
 
-Eigen::Index RebuiltOctreeBasis::dimension() const { return octree_.finest().num_functions(); }
+Eigen::Index RebuiltOctreeBasis::dimension() const {
+  return octree_.finest().num_functions();
+}
 
 void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
   if (vertices.rows() != input_vertices_)
-    throw std::invalid_argument("RebuiltOctreeBasis::rebuild: expected " + std::to_string(input_vertices_) + " vertices");
+    throw std::invalid_argument("RebuiltOctreeBasis::rebuild: expected " +
+                                std::to_string(input_vertices_) + " vertices");
   if (options_.refine_input) {
     const Eigen::Index n = input_vertices_;
     if (last_evaluated_build_ == build_id_ && last_evaluated_.rows() == mesh_.num_vertices() &&
@@ -83,8 +91,10 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
       // Midpoint vertices from the corner sub-faces of subdivide_midpoint:
       // 4f+0 = (v0, m01, m20), 4f+1 = (v1, m12, m01), 4f+2 = (v2, m20, m12).
       for (Eigen::Index f = 0; f < mesh_.num_faces() / 4; ++f) {
-        const int v0 = mesh_.faces(4 * f, 0), v1 = mesh_.faces(4 * f + 1, 0), v2 = mesh_.faces(4 * f + 2, 0);
-        const int e01 = mesh_.faces(4 * f, 1), e20 = mesh_.faces(4 * f, 2), e12 = mesh_.faces(4 * f + 1, 1);
+        const int v0 = mesh_.faces(4 * f, 0), v1 = mesh_.faces(4 * f + 1, 0),
+                  v2 = mesh_.faces(4 * f + 2, 0);
+        const int e01 = mesh_.faces(4 * f, 1), e20 = mesh_.faces(4 * f, 2),
+                  e12 = mesh_.faces(4 * f + 1, 1);
         mesh_.vertices.row(e01) = 0.5 * (vertices.row(v0) + vertices.row(v1));
         mesh_.vertices.row(e12) = 0.5 * (vertices.row(v1) + vertices.row(v2));
         mesh_.vertices.row(e20) = 0.5 * (vertices.row(v2) + vertices.row(v0));
@@ -115,7 +125,8 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
   stats_.setup_seconds["octree"] = t_octree + seconds_since(t0);
 
   t0 = Clock::now();
-  system_ = std::make_unique<OctreeSystem>(octree_, octree_.num_levels() - 1, pieces_, piece_cells_);
+  system_ =
+      std::make_unique<OctreeSystem>(octree_, octree_.num_levels() - 1, pieces_, piece_cells_);
   system_->assemble(cubature_rule(options_.cubature), mass_, stiffness_);
   stats_.setup_seconds["integrate"] = seconds_since(t0);
 
@@ -129,11 +140,12 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
   stats_.cubature_points = stats_.split_triangles * cubature_rule(options_.cubature).size();
   stats_.levels = octree_.num_levels();
   // Rebuilt: nothing is stored per cubature point beyond the piece (3 corners, cell, triangle).
-  stats_.bytes_per_cubature_point =
-      static_cast<double>(sizeof(ClippedTriangle) + sizeof(int)) / cubature_rule(options_.cubature).size();
+  stats_.bytes_per_cubature_point = static_cast<double>(sizeof(ClippedTriangle) + sizeof(int)) /
+                                    cubature_rule(options_.cubature).size();
 }
 
-void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass, std::vector<double>& stiffness) {
+void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass,
+                                          std::vector<double>& stiffness) {
   mass.swap(mass_);
   stiffness.swap(stiffness_);
   std::vector<double>().swap(mass_);
@@ -149,13 +161,18 @@ void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass, std::vector
 namespace {
 // What mass() and stiffness() show before assembly and after release_assembly.
 SparseView values_view(const OctreeSystem* system, const std::vector<double>& values) {
-  if (system && static_cast<Eigen::Index>(values.size()) == system->non_zeros()) return system->view(values);
+  if (system && static_cast<Eigen::Index>(values.size()) == system->non_zeros())
+    return system->view(values);
   return view_of(std::vector<int>{}, std::vector<int>{}, std::vector<double>{});
 }
 }  // namespace
 
-SparseView RebuiltOctreeBasis::mass() const { return values_view(system_.get(), mass_); }
-SparseView RebuiltOctreeBasis::stiffness() const { return values_view(system_.get(), stiffness_); }
+SparseView RebuiltOctreeBasis::mass() const {
+  return values_view(system_.get(), mass_);
+}
+SparseView RebuiltOctreeBasis::stiffness() const {
+  return values_view(system_.get(), stiffness_);
+}
 
 Coefficients RebuiltOctreeBasis::initial_coefficients() const {
   return octree_.function_positions(octree_.num_levels() - 1);
@@ -163,7 +180,8 @@ Coefficients RebuiltOctreeBasis::initial_coefficients() const {
 
 void RebuiltOctreeBasis::update(const Coefficients& x, bool, bool) {
   if (x.rows() != dimension())
-    throw std::invalid_argument("RebuiltOctreeBasis::update: coefficient count does not match the dimension");
+    throw std::invalid_argument(
+        "RebuiltOctreeBasis::update: coefficient count does not match the dimension");
 }
 
 void RebuiltOctreeBasis::reframe(const Eigen::RowVector3d& centroid, double scale) {
@@ -175,9 +193,11 @@ void RebuiltOctreeBasis::reframe(const Eigen::RowVector3d& centroid, double scal
 
 Positions RebuiltOctreeBasis::evaluate_vertices(const Coefficients& x) const {
   if (x.rows() != dimension())
-    throw std::invalid_argument("RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
+    throw std::invalid_argument(
+        "RebuiltOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
   if (system_->pieces_released())
-    throw std::logic_error("RebuiltOctreeBasis::evaluate_vertices: the stencils were released (release_assembly)");
+    throw std::logic_error(
+        "RebuiltOctreeBasis::evaluate_vertices: the stencils were released (release_assembly)");
   Positions all = mcf::evaluate_vertices(stencils_, x);
   if (!options_.refine_input) return all;
   last_evaluated_ = all;

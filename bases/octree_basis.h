@@ -18,16 +18,17 @@
 namespace mcf {
 
 struct OctreeOptions {
-  int depth = 8;                          ///< finest depth, 4..10
-  int cubature = 3;                       ///< 1, 3 or 6 (cubature_rule)
+  int depth = 8;     ///< finest depth, 4..10
+  int cubature = 3;  ///< 1, 3 or 6 (cubature_rule)
   OctreeCube cube = OctreeCube::automatic;
-  bool refine_input = false;              ///< 1-to-4 split of the initial mesh first
-  int coarsest_depth = 2;                 ///< coarsest multigrid level (clamped to depth)
+  bool refine_input = false;  ///< 1-to-4 split of the initial mesh first
+  int coarsest_depth = 2;     ///< coarsest multigrid level (clamped to depth)
 };
 
 /// Finest-level functions whose support meets a boundary edge (or a boundary vertex): the corners
 /// of every finest cell a boundary edge passes through. Sorted, unique.
-std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices, const Triangles& faces);
+std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices,
+                                    const Triangles& faces);
 
 class RebuiltOctreeBasis : public Basis {
  public:
@@ -41,7 +42,8 @@ class RebuiltOctreeBasis : public Basis {
   bool rebuilds_every_step() const override { return true; }
   /// Rebuilds octree, pieces, matrices and hierarchy on `vertices` (rows = the input mesh's
   /// vertex count). With refine_input the midpoint vertices come from the last
-  /// evaluate_vertices call when there was one on the current basis, else from the edges' midpoints.
+  /// evaluate_vertices call when there was one on the current basis, else from the edges'
+  /// midpoints.
   void rebuild(const Positions& vertices) override;
   /// With refine_input: moves the last evaluation's midpoints with the flow's normalisation, so
   /// that rebuild() recognises the normalised vertices and keeps the flowed midpoints.
@@ -55,8 +57,8 @@ class RebuiltOctreeBasis : public Basis {
   /// On the system's pattern (OctreeSystem::view): one copy of the index arrays for both.
   SparseView mass() const override;
   SparseView stiffness() const override;
-  /// v = Σ_I B_I(v) x^I for the input mesh's vertices (trilinear stencils in an active finest cell).
-  /// Vertices used by no face keep the position they had at the last rebuild.
+  /// v = Σ_I B_I(v) x^I for the input mesh's vertices (trilinear stencils in an active finest
+  /// cell). Vertices used by no face keep the position they had at the last rebuild.
   Positions evaluate_vertices(const Coefficients& x) const override;
   /// Open surfaces: finest functions whose support meets a boundary edge (see boundary_functions).
   std::vector<int> locked_functions() const override { return locked_; }
@@ -66,7 +68,9 @@ class RebuiltOctreeBasis : public Basis {
 
   // Internals, for tests and the tracked basis.
   const OctreeOptions& options() const { return options_; }
-  const TriangleMesh& working_mesh() const { return mesh_; }  ///< the (possibly 1-to-4 refined) mesh integrated
+  const TriangleMesh& working_mesh() const {
+    return mesh_;
+  }  ///< the (possibly 1-to-4 refined) mesh integrated
   const Octree& octree() const { return octree_; }
   const std::vector<ClippedTriangle>& pieces() const { return pieces_; }
   const std::vector<int>& piece_cells() const { return piece_cells_; }
@@ -98,7 +102,8 @@ class RebuiltOctreeBasis : public Basis {
   std::vector<int> locked_;
   BasisStats stats_;
   long long build_id_ = 0;
-  mutable Positions last_evaluated_;  ///< refine_input: all working-mesh vertices of the last evaluation
+  mutable Positions
+      last_evaluated_;  ///< refine_input: all working-mesh vertices of the last evaluation
   mutable long long last_evaluated_build_ = -1;
 };
 

@@ -2,9 +2,9 @@
 // Integration of trilinear B-splines over clipped pieces (DESIGN.md "Octree trilinear B-spline
 // basis"): per piece and cubature point the weight w = area·ω, the 8 values of the cell's corner
 // functions and their gradients in an orthonormal frame of the piece's plane (cell_blocks.h);
-// mass and stiffness are accumulated into a sparsity pattern built once per octree level. Also the multigrid hierarchy
-// (prolongations, parity colours) and vertex evaluation. The pieces are exposed so the tracked
-// basis can reuse them.
+// mass and stiffness are accumulated into a sparsity pattern built once per octree level. Also the
+// multigrid hierarchy (prolongations, parity colours) and vertex evaluation. The pieces are exposed
+// so the tracked basis can reuse them.
 
 #include "bases/basis.h"
 #include "bases/clip.h"
@@ -23,7 +23,8 @@ namespace mcf {
 
 /// Values and gradients of the 8 corner functions of a cell at local coordinates t ∈ [0,1]^3
 /// (t = (p - cell origin)/h). Corner c as in corner_offset(c). gradient[c] is in world units.
-inline void trilinear_values(const double t[3], double inv_h, double value[8], double gradient[8][3]) {
+inline void trilinear_values(const double t[3], double inv_h, double value[8],
+                             double gradient[8][3]) {
   const double w0[3] = {1.0 - t[0], 1.0 - t[1], 1.0 - t[2]};
   for (int c = 0; c < 8; ++c) {
     const int ox = c & 1, oy = (c >> 1) & 1, oz = (c >> 2) & 1;
@@ -39,7 +40,8 @@ inline void trilinear_values(const double t[3], double inv_h, double value[8], d
 /// Offset bit (0..26) of row function I relative to column function J, both corners of one cell:
 /// o = (dz+1)*9 + (dy+1)*3 + (dx+1) with d = corner(a) - corner(b).
 constexpr int neighbour_bit(int corner_row, int corner_col) {
-  const int dx = (corner_row & 1) - (corner_col & 1), dy = ((corner_row >> 1) & 1) - ((corner_col >> 1) & 1),
+  const int dx = (corner_row & 1) - (corner_col & 1),
+            dy = ((corner_row >> 1) & 1) - ((corner_col >> 1) & 1),
             dz = ((corner_row >> 2) & 1) - ((corner_col >> 2) & 1);
   return (dz + 1) * 9 + (dy + 1) * 3 + (dx + 1);
 }
@@ -65,8 +67,9 @@ inline constexpr CellBlockTables kCellBlockTables = make_cell_block_tables();
 ///   outer[J] + popcount(neighbour_mask[J] & ((1 << neighbour_bit(a,b)) - 1)).
 class OctreeSystem {
  public:
-  /// `level` indexes octree.levels. piece_finest_cell[p] = index of piece p's cell in the finest level.
-  /// Keeps pointers to `octree` and `pieces`: both must outlive the system and stay unchanged.
+  /// `level` indexes octree.levels. piece_finest_cell[p] = index of piece p's cell in the finest
+  /// level. Keeps pointers to `octree` and `pieces`: both must outlive the system and stay
+  /// unchanged.
   OctreeSystem(const Octree& octree, int level, const std::vector<ClippedTriangle>& pieces,
                const std::vector<int>& piece_finest_cell);
 
@@ -79,22 +82,27 @@ class OctreeSystem {
   /// Values on this pattern (non_zeros() of them, in CSC order) seen as a matrix: mass and
   /// stiffness share the system's index arrays instead of each carrying a copy (~100 MB each
   /// at depth 9). The view is valid while the system and `values` are alive and unresized.
-  SparseView view(const std::vector<double>& values) const { return view_of(outer_, inner_, values); }
+  SparseView view(const std::vector<double>& values) const {
+    return view_of(outer_, inner_, values);
+  }
   /// Column starts (dimension+1) and row indices of the pattern.
   const std::vector<int>& outer() const { return outer_; }
   const std::vector<int>& inner() const { return inner_; }
   int slot(int cell, int corner_row, int corner_col) const {
-    const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];
+    const auto& f = octree_->levels[static_cast<std::size_t>(level_)]
+                        .cell_functions[static_cast<std::size_t>(cell)];
     const int J = f[static_cast<std::size_t>(corner_col)];
     const std::uint32_t below = (1u << neighbour_bit(corner_row, corner_col)) - 1u;
-    return outer_[static_cast<std::size_t>(J)] + std::popcount(mask_[static_cast<std::size_t>(J)] & below);
+    return outer_[static_cast<std::size_t>(J)] +
+           std::popcount(mask_[static_cast<std::size_t>(J)] & below);
   }
   /// Adds a cell's summed blocks (blocks.mass(a,b), blocks.stiffness(a,b), read for a ≤ b) into
   /// the value arrays of this pattern, the upper triangle mirrored so both halves are equal
   /// (SetSystemMatrices). A null array is skipped.
   template <class Blocks>
   void add_cell_blocks(int cell, const Blocks& blocks, double* mass, double* stiffness) const {
-    const auto& f = octree_->levels[static_cast<std::size_t>(level_)].cell_functions[static_cast<std::size_t>(cell)];
+    const auto& f = octree_->levels[static_cast<std::size_t>(level_)]
+                        .cell_functions[static_cast<std::size_t>(cell)];
 #pragma GCC unroll 8
     for (int b = 0; b < 8; ++b) {
       const auto J = static_cast<std::size_t>(f[static_cast<std::size_t>(b)]);
@@ -110,8 +118,12 @@ class OctreeSystem {
     }
   }
   /// Pieces of cell c: piece_order()[cell_start()[c] .. cell_start()[c+1]).
-  const std::vector<int>& cell_start() const { return cell_start_; }
-  const std::vector<int>& piece_order() const { return piece_order_; }
+  const std::vector<int>& cell_start() const {
+    return cell_start_;
+  }
+  const std::vector<int>& piece_order() const {
+    return piece_order_;
+  }
   /// The lock-free accumulation order (SetSystemMatrices), shared by the rebuilt assembly and the
   /// tracked update: the level's cells cut into tiles of kTileSide³ cells, tiles grouped by the
   /// parity colour (I%2)+2(J%2)+4(K%2) of their tile index. Tiles of one colour are a whole tile
@@ -121,11 +133,14 @@ class OctreeSystem {
   /// rows, which stay in cache, while 8 passes of single-cell colours each swept both matrices.
   struct CellTiles {
     static constexpr int kTileSide = 8;
-    std::vector<int> cells;             ///< cell indices, grouped by colour, then tile, ascending inside a tile
+    std::vector<int>
+        cells;  ///< cell indices, grouped by colour, then tile, ascending inside a tile
     std::vector<int> tile_start;        ///< tile t: cells[tile_start[t] .. tile_start[t+1])
     std::array<int, 9> colour_start{};  ///< colour q: tiles [colour_start[q], colour_start[q+1])
   };
-  const CellTiles& tiles() const { return tiles_; }
+  const CellTiles& tiles() const {
+    return tiles_;
+  }
   /// Runs `count = f(cells, n)` on every tile (its n cell indices in accumulation order) in the
   /// order above: 8 colour passes, the tiles of a pass in parallel. Returns the sum of the counts.
   template <class F>
@@ -145,19 +160,24 @@ class OctreeSystem {
           [](long long a, long long b) { return a + b; });
     return total;
   }
-  const std::vector<int>& piece_cell() const { return piece_cell_; }
+  const std::vector<int>& piece_cell() const {
+    return piece_cell_;
+  }
 
   /// For the tracked basis, once it holds its own compact copy of the pieces: frees what only
   /// assemble() reads — the pieces' cells and order (~52 MB at depth 9). The pattern, the masks,
   /// the tiles and cell_start() stay, so add_cell_blocks() and view() still work; assemble()
   /// then throws.
   void release_pieces();
-  bool pieces_released() const { return released_; }
+  bool pieces_released() const {
+    return released_;
+  }
 
   /// Mass and stiffness with the identity metric (the pieces' own geometry), any cubature rule.
   /// `mass` and `stiffness` become values on this system's pattern (see view()); accumulation is
   /// lock-free (tiles(): 8 colour passes, parallel over the tiles of a pass) and deterministic.
-  void assemble(const CubatureRule& rule, std::vector<double>& mass, std::vector<double>& stiffness) const;
+  void assemble(const CubatureRule& rule, std::vector<double>& mass,
+                std::vector<double>& stiffness) const;
 
  private:
   const Octree* octree_;
@@ -171,11 +191,13 @@ class OctreeSystem {
   bool released_ = false;
 };
 
-/// Finest-cell index of every piece (binary search, parallel). Throws if a piece's cell is inactive.
+/// Finest-cell index of every piece (binary search, parallel). Throws if a piece's cell is
+/// inactive.
 std::vector<int> locate_pieces(const Octree& octree, const std::vector<ClippedTriangle>& pieces);
 
 /// Builds the octree over the pieces' cells (cube.depth = finest depth).
-Octree build_octree(const GridCube& cube, const std::vector<ClippedTriangle>& pieces, int coarsest_depth);
+Octree build_octree(const GridCube& cube, const std::vector<ClippedTriangle>& pieces,
+                    int coarsest_depth);
 
 /// P_l : level l -> l+1 (rows: fine functions, columns: coarse functions), coarsest first.
 std::vector<SparseMatrix> build_prolongations(const Octree& octree);
@@ -201,9 +223,10 @@ Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coe
 struct VertexStencils {
   std::vector<PointStencil> used;  ///< stencils of the vertices some face uses, in vertex order
   std::vector<int> used_index;     ///< their vertex numbers; empty when every vertex is used
-  Positions kept;                  ///< every vertex's position at construction; empty when all are used
+  Positions kept;  ///< every vertex's position at construction; empty when all are used
 };
-VertexStencils vertex_stencils(const Octree& octree, const Positions& vertices, const Triangles& faces);
+VertexStencils vertex_stencils(const Octree& octree, const Positions& vertices,
+                               const Triangles& faces);
 /// All vertices: the used ones evaluated from the coefficients, the others where they were.
 Positions evaluate_vertices(const VertexStencils& stencils, const Coefficients& x);
 

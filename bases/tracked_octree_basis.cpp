@@ -7,18 +7,20 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <limits>
-#include <algorithm>
-#include <cmath>
 #include <stdexcept>
 
 namespace mcf {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // A metric whose determinant falls this low is a pinch: the triangle has collapsed (area ratio
 // below 1e-12 of X_0's, where g = I) or flattened to a segment (the two tangent vectors parallel
@@ -29,7 +31,8 @@ constexpr double kDegenerateRelative = 1e-12;
 }  // namespace
 
 TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions options)
-    : initial_(std::make_unique<RebuiltOctreeBasis>(mesh, options)), rule_(&cubature_rule(options.cubature)) {
+    : initial_(std::make_unique<RebuiltOctreeBasis>(mesh, options)),
+      rule_(&cubature_rule(options.cubature)) {
   const auto t0 = Clock::now();
   const Octree& octree = initial_->octree();
   const OctreeLevel& L = octree.finest();
@@ -47,7 +50,8 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
     const auto ijk = grid_index(L.cells[c]);
     const ClippedTriangle& t = pieces[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
     for (int v = 0; v < 3; ++v)
-      for (int a = 0; a < 3; ++a) q[3 * v + a] = (t.corners[v][a] - cube.origin[a]) * inv_h - ijk[a];
+      for (int a = 0; a < 3; ++a)
+        q[3 * v + a] = (t.corners[v][a] - cube.origin[a]) * inv_h - ijk[a];
   };
   continues_.assign(order.size(), 0);
   point_start_.assign(nc + 1, 0);
@@ -137,10 +141,11 @@ inline void staged_metric(StagedPoints& P, const double (&edge)[3][4][3]) {
       // ∂X/∂t_a is the bilinear interpolation of the 4 edge differences along a.
       const v4 s1 = t[(a + 1) % 3], s2 = t[(a + 2) % 3];
       const v4 one = splat(1.0);
-      const v4 w0 = (one - s1) * (one - s2), w1 = s1 * (one - s2), w2 = (one - s1) * s2, w3 = s1 * s2;
+      const v4 w0 = (one - s1) * (one - s2), w1 = s1 * (one - s2), w2 = (one - s1) * s2,
+               w3 = s1 * s2;
       for (int d = 0; d < 3; ++d) {
-        const v4 D = w0 * splat(edge[a][0][d]) + w1 * splat(edge[a][1][d]) + w2 * splat(edge[a][2][d]) +
-                     w3 * splat(edge[a][3][d]);
+        const v4 D = w0 * splat(edge[a][0][d]) + w1 * splat(edge[a][1][d]) +
+                     w2 * splat(edge[a][2][d]) + w3 * splat(edge[a][3][d]);
         ju[d] += D * f1[a];
         jv[d] += D * f2[a];
       }
@@ -149,7 +154,8 @@ inline void staged_metric(StagedPoints& P, const double (&edge)[3][4][3]) {
     const v4 g12 = ju[0] * jv[0] + ju[1] * jv[1] + ju[2] * jv[2];
     const v4 g22 = jv[0] * jv[0] + jv[1] * jv[1] + jv[2] * jv[2];
     const v4 det = g11 * g22 - g12 * g12;
-    const m4 ok = (det > splat(kDegenerateDeterminant)) & (det > splat(kDegenerateRelative) * g11 * g22) &
+    const m4 ok = (det > splat(kDegenerateDeterminant)) &
+                  (det > splat(kDegenerateRelative) * g11 * g22) &
                   (det < splat(std::numeric_limits<double>::infinity()));
     const v4 safe = ok ? det : splat(1.0);
     const v4 wm = load4(&P.w[i0]) * sqrt4(safe);
@@ -185,8 +191,8 @@ struct FanCursor {
 /// its pieces (corners in cell-local coordinates, stored as fans: `points`, `continues`) goes into
 /// `blocks`. Returns the number of degenerate points, which contribute nothing.
 template <class Blocks>
-int integrate_cell(const double xc[8][3], const double* points, const std::uint8_t* continues, int pieces,
-                   const CubatureRule& rule, double h, Blocks& blocks) {
+int integrate_cell(const double xc[8][3], const double* points, const std::uint8_t* continues,
+                   int pieces, const CubatureRule& rule, double h, Blocks& blocks) {
   const double inv_h = 1.0 / h;
   // Edge differences of the trilinear map X(t) = Σ_c xc_c β_c(t) along each axis a, one per
   // cell edge: ∂X/∂t_a at t is their bilinear interpolation in the two other coordinates.
@@ -257,7 +263,8 @@ int integrate_cell(const double xc[8][3], const double* points, const std::uint8
 /// share no function, so the loop is lock-free and sums in the same order for any thread count.
 template <bool Mass, bool Stiffness>
 long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const Coefficients& x,
-                       const std::vector<double>& fan_points, const std::vector<std::uint8_t>& continues,
+                       const std::vector<double>& fan_points,
+                       const std::vector<std::uint8_t>& continues,
                        const std::vector<int>& cell_start, const std::vector<int>& point_start,
                        const CubatureRule& rule, double h, double* Mv, double* Kv) {
   const double* X = x.data();
@@ -274,8 +281,8 @@ long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const C
       blocks.clear();
       const int first = cell_start[std::size_t(c)];
       degenerate += integrate_cell(xc, &fan_points[3 * std::size_t(point_start[std::size_t(c)])],
-                                   &continues[std::size_t(first)], cell_start[std::size_t(c) + 1] - first, rule, h,
-                                   blocks);
+                                   &continues[std::size_t(first)],
+                                   cell_start[std::size_t(c) + 1] - first, rule, h, blocks);
       system.add_cell_blocks(c, blocks, Mass ? Mv : nullptr, Stiffness ? Kv : nullptr);
     }
     return degenerate;
@@ -287,20 +294,24 @@ long long update_cells(const OctreeSystem& system, const OctreeLevel& L, const C
 void TrackedOctreeBasis::update(const Coefficients& x, bool update_mass, bool update_stiffness) {
   if (!update_mass && !update_stiffness) return;
   if (x.rows() != dimension())
-    throw std::invalid_argument("TrackedOctreeBasis::update: coefficient count does not match the dimension");
+    throw std::invalid_argument(
+        "TrackedOctreeBasis::update: coefficient count does not match the dimension");
   const Octree& octree = initial_->octree();
   const OctreeLevel& L = octree.finest();
   const double h = octree.cube.cell_size(L.depth);
   const OctreeSystem& system = initial_->system();
   // The pattern never changes: only the values are reset (assign keeps the memory, so no
   // reallocation; the values live on the system's pattern, which both matrices share).
-  const auto reset = [&system](std::vector<double>& values) { values.assign(std::size_t(system.non_zeros()), 0.0); };
+  const auto reset = [&system](std::vector<double>& values) {
+    values.assign(std::size_t(system.non_zeros()), 0.0);
+  };
   if (update_mass) reset(mass_);
   if (update_stiffness) reset(stiffness_);
   double* Mv = update_mass ? mass_.data() : nullptr;
   double* Kv = update_stiffness ? stiffness_.data() : nullptr;
   const auto run = [&](auto kernel) {
-    return kernel(system, L, x, fan_points_, continues_, cell_start(), point_start_, *rule_, h, Mv, Kv);
+    return kernel(system, L, x, fan_points_, continues_, cell_start(), point_start_, *rule_, h, Mv,
+                  Kv);
   };
   const long long degenerate = update_mass && update_stiffness ? run(update_cells<true, true>)
                                : update_mass                   ? run(update_cells<true, false>)
@@ -324,7 +335,8 @@ double TrackedOctreeBasis::max_metric_deviation(const Coefficients& x) const {
       for (int q = 0; q < rule_->size(); ++q) {
         const auto& b = rule_->points[std::size_t(q)];
         double t[3], val[8], grad[8][3];
-        for (int a = 0; a < 3; ++a) t[a] = std::clamp(b[0] * p0[a] + b[1] * p1[a] + b[2] * p2[a], 0.0, 1.0);
+        for (int a = 0; a < 3; ++a)
+          t[a] = std::clamp(b[0] * p0[a] + b[1] * p1[a] + b[2] * p2[a], 0.0, 1.0);
         trilinear_values(t, inv_h, val, grad);
         Eigen::Matrix<double, 3, 2> J = Eigen::Matrix<double, 3, 2>::Zero();
         for (int a = 0; a < 8; ++a) {
@@ -332,7 +344,8 @@ double TrackedOctreeBasis::max_metric_deviation(const Coefficients& x) const {
           J.col(0) += g.dot(e1) * x.row(f[std::size_t(a)]).transpose();
           J.col(1) += g.dot(e2) * x.row(f[std::size_t(a)]).transpose();
         }
-        worst = std::max(worst, ((J.transpose() * J) - Eigen::Matrix2d::Identity()).cwiseAbs().maxCoeff());
+        worst = std::max(worst,
+                         ((J.transpose() * J) - Eigen::Matrix2d::Identity()).cwiseAbs().maxCoeff());
       }
     }
   }
@@ -352,7 +365,8 @@ std::vector<double> TrackedOctreeBasis::cell_local_corners(int c) const {
 
 Positions TrackedOctreeBasis::evaluate_vertices(const Coefficients& x) const {
   if (x.rows() != dimension())
-    throw std::invalid_argument("TrackedOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
+    throw std::invalid_argument(
+        "TrackedOctreeBasis::evaluate_vertices: coefficient count does not match the dimension");
   return mcf::evaluate_vertices(stencils_, x);
 }
 

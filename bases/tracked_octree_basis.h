@@ -47,8 +47,12 @@ class TrackedOctreeBasis final : public Basis {
   /// v = Σ_I β_v^I x^I with the 8 stencil weights of each original vertex on X_0.
   Positions evaluate_vertices(const Coefficients& x) const override;
   std::vector<int> locked_functions() const override { return initial_->locked_functions(); }
-  const std::vector<SparseMatrix>* prolongations() const override { return initial_->prolongations(); }
-  const std::vector<std::vector<std::uint8_t>>* colours() const override { return initial_->colours(); }
+  const std::vector<SparseMatrix>* prolongations() const override {
+    return initial_->prolongations();
+  }
+  const std::vector<std::vector<std::uint8_t>>* colours() const override {
+    return initial_->colours();
+  }
   const BasisStats& stats() const override { return stats_; }
 
   /// max over cubature points of |g - I| (entrywise) at coefficients x: 0 at x = identity up to
@@ -75,10 +79,11 @@ class TrackedOctreeBasis final : public Basis {
 
   std::unique_ptr<RebuiltOctreeBasis> initial_;  // octree, pieces, pattern, hierarchy on X_0
   const CubatureRule* rule_;
-  std::vector<double> fan_points_;     // fans' corners, cells in order, local coords in [0,1]
+  std::vector<double> fan_points_;       // fans' corners, cells in order, local coords in [0,1]
   std::vector<std::uint8_t> continues_;  // per piece (cell order): 1 = continues the previous fan
-  std::vector<int> point_start_;       // cell c's fan points: [point_start_[c], point_start_[c+1]), 3 doubles each
-  VertexStencils stencils_;            // original vertices
+  std::vector<int>
+      point_start_;  // cell c's fan points: [point_start_[c], point_start_[c+1]), 3 doubles each
+  VertexStencils stencils_;               // original vertices
   std::vector<double> mass_, stiffness_;  // values on initial_->system()'s pattern
   BasisStats stats_;
   long long degenerate_points_ = 0;

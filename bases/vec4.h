@@ -16,14 +16,18 @@ namespace mcf::vec4 {
 using v4 = double __attribute__((vector_size(32)));
 using m4 = long long __attribute__((vector_size(32)));  // lane masks of v4 comparisons
 
-inline v4 splat(double x) { return v4{x, x, x, x}; }
+inline v4 splat(double x) {
+  return v4{x, x, x, x};
+}
 /// Unaligned load and store (memcpy compiles to one vector move).
 inline v4 load4(const double* p) {
   v4 r;
   std::memcpy(&r, p, sizeof(r));
   return r;
 }
-inline void store4(double* p, v4 x) { std::memcpy(p, &x, sizeof(x)); }
+inline void store4(double* p, v4 x) {
+  std::memcpy(p, &x, sizeof(x));
+}
 /// x clamped to [0, 1] lane by lane as std::clamp does it (max, then min).
 inline v4 clamp01(v4 x) {
 #if defined(__AVX__)

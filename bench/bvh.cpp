@@ -8,7 +8,8 @@ namespace mcf {
 namespace {
 
 /// Closest point to p on the segment [s, e] (a zero-length one is its point).
-Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s, const Eigen::Vector3d& e) {
+Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
+                                         const Eigen::Vector3d& e) {
   const Eigen::Vector3d d = e - s;
   const double len2 = d.squaredNorm();
   if (!(len2 > 0)) return s;
@@ -17,10 +18,11 @@ Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& p, const Eigen::
 
 /// Nearest of the closest points on the three edges: the closest point of a degenerate
 /// triangle (a segment or a point), which its edges cover.
-Eigen::Vector3d closest_point_on_edges(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                       const Eigen::Vector3d& c) {
+Eigen::Vector3d closest_point_on_edges(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   Eigen::Vector3d best = closest_point_on_segment(p, a, b);
-  for (const Eigen::Vector3d& q : {closest_point_on_segment(p, b, c), closest_point_on_segment(p, a, c)})
+  for (const Eigen::Vector3d& q :
+       {closest_point_on_segment(p, b, c), closest_point_on_segment(p, a, c)})
     if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
   return best;
 }
@@ -28,8 +30,8 @@ Eigen::Vector3d closest_point_on_edges(const Eigen::Vector3d& p, const Eigen::Ve
 /// A triangle is taken as degenerate when |ab×ac|² <= kFlat·|ab|²·|ac|², i.e. sin²θ <= kFlat
 /// for its angle θ at a (a zero-length edge and a NaN too). Its edges then stand for it: that
 /// overestimates the distance by at most its inradius, below sinθ/2 of the shorter edge at a
-/// (5e-7 of it here), while the region tests' rounding error grows like 2^-53/sin²θ (about 1e-6 of the
-/// edge at sin²θ = 1e-12 against an exact reference, 1e-3 at 1e-15, and O(1) on triangles
+/// (5e-7 of it here), while the region tests' rounding error grows like 2^-53/sin²θ (about 1e-6 of
+/// the edge at sin²θ = 1e-12 against an exact reference, 1e-3 at 1e-15, and O(1) on triangles
 /// collinear up to rounding, whose sin²θ is noise of 1e-32 to 1e-20).
 constexpr double kFlat = 1e-12;
 
@@ -88,7 +90,8 @@ namespace {
 constexpr int kLeafSize = 4;
 
 /// Squared distance from p to the box [lo, hi] (0 inside): a lower bound for every triangle in it.
-double box_squared_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+double box_squared_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
+                            const Eigen::Vector3d& hi) {
   const Eigen::Vector3d d = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
   return d.squaredNorm();
 }
@@ -100,18 +103,22 @@ TriangleBvh::TriangleBvh(const Positions& vertices, const Triangles& faces) {
     throw std::invalid_argument("TriangleBvh: a face refers to a vertex that does not exist");
   std::vector<Eigen::Vector3d> centroids(m);
   for (int f = 0; f < m; ++f)
-    centroids[f] = (vertices.row(faces(f, 0)) + vertices.row(faces(f, 1)) + vertices.row(faces(f, 2))).transpose() / 3.0;
+    centroids[f] =
+        (vertices.row(faces(f, 0)) + vertices.row(faces(f, 1)) + vertices.row(faces(f, 2)))
+            .transpose() /
+        3.0;
   order_.resize(m);
   std::iota(order_.begin(), order_.end(), 0);
   nodes_.reserve(m > 0 ? 2 * (m / kLeafSize + 1) : 0);
   if (m > 0) build(0, m, 1, vertices, faces, centroids);
   corners_.resize(3 * std::size_t(m));
   for (int s = 0; s < m; ++s)
-    for (int k = 0; k < 3; ++k) corners_[3 * std::size_t(s) + k] = vertices.row(faces(order_[s], k)).transpose();
+    for (int k = 0; k < 3; ++k)
+      corners_[3 * std::size_t(s) + k] = vertices.row(faces(order_[s], k)).transpose();
 }
 
-int TriangleBvh::build(int begin, int end, int depth, const Positions& vertices, const Triangles& faces,
-                       const std::vector<Eigen::Vector3d>& centroids) {
+int TriangleBvh::build(int begin, int end, int depth, const Positions& vertices,
+                       const Triangles& faces, const std::vector<Eigen::Vector3d>& centroids) {
   depth_ = std::max(depth_, depth);
   const int index = int(nodes_.size());
   nodes_.emplace_back();
@@ -140,10 +147,11 @@ int TriangleBvh::build(int begin, int end, int depth, const Positions& vertices,
   int axis;
   (chi - clo).maxCoeff(&axis);
   const int mid = begin + (end - begin) / 2;
-  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](int x, int y) {
-    const double cx = centroids[x][axis], cy = centroids[y][axis];
-    return cx < cy || (cx == cy && x < y);
-  });
+  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                   [&](int x, int y) {
+                     const double cx = centroids[x][axis], cy = centroids[y][axis];
+                     return cx < cy || (cx == cy && x < y);
+                   });
   build(begin, mid, depth + 1, vertices, faces, centroids);  // left child = index + 1
   const int right = build(mid, end, depth + 1, vertices, faces, centroids);
   nodes_[index].first = right;

@@ -14,7 +14,9 @@ std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t seed) {
   return h;
 }
 
-std::uint64_t fnv1a64(const std::string& s, std::uint64_t seed) { return fnv1a64(s.data(), s.size(), seed); }
+std::uint64_t fnv1a64(const std::string& s, std::uint64_t seed) {
+  return fnv1a64(s.data(), s.size(), seed);
+}
 
 std::string hex16(std::uint64_t v) {
   char buf[17];
@@ -31,9 +33,11 @@ std::string mesh_fingerprint(const TriangleMesh& mesh) {
   return hex16(h);
 }
 
-std::string cell_key(const nlohmann::json& full_config, int repetition, const std::string& mesh_fp) {
+std::string cell_key(const nlohmann::json& full_config, int repetition,
+                     const std::string& mesh_fp) {
   // nlohmann::json objects are std::map-backed: dump() is already sorted and canonical.
-  return hex16(fnv1a64(full_config.dump() + "\nrepetition=" + std::to_string(repetition) + "\nmesh=" + mesh_fp));
+  return hex16(fnv1a64(full_config.dump() + "\nrepetition=" + std::to_string(repetition) +
+                       "\nmesh=" + mesh_fp));
 }
 
 std::string cell_hash(const std::string& key, const std::string& code_version) {

@@ -37,7 +37,8 @@ constexpr const char* kAccuracyKinds[] = {"reference_distance", "radial_error"};
 /// A result's accuracy by one of kAccuracyKinds (NaN when it does not record that one).
 double accuracy_of(const json& r, const std::string& kind) {
   if (kind == "reference_distance") {
-    if (r.contains("reference_distance") && r["reference_distance"].is_array() && !r["reference_distance"].empty())
+    if (r.contains("reference_distance") && r["reference_distance"].is_array() &&
+        !r["reference_distance"].empty())
       return r["reference_distance"].back().value("rms", NAN);
   } else if (r.contains("steps")) {
     for (auto it = r["steps"].rbegin(); it != r["steps"].rend(); ++it)
@@ -102,12 +103,14 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
       commit_filter = dir_at_commit.substr(at + 1);
     }
   }
-  if (!fs::is_directory(set.dir)) throw std::runtime_error(dir_at_commit + ": not a results folder");
+  if (!fs::is_directory(set.dir))
+    throw std::runtime_error(dir_at_commit + ": not a results folder");
   std::set<std::string> commits, studies;
   std::vector<json> results;
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(set.dir))
-    if (entry.is_regular_file() && entry.path().extension() == ".json" && entry.path().filename() != "index.json")
+    if (entry.is_regular_file() && entry.path().extension() == ".json" &&
+        entry.path().filename() != "index.json")
       files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   for (const auto& f : files) {
@@ -119,19 +122,22 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
       throw std::runtime_error(f.string() + ": JSON parse error: " + e.what());
     }
     if (!r.is_object() || !r.contains("cell")) continue;  // not a cell result
-    const std::string commit = r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
+    const std::string commit =
+        r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
     if (!commit_filter.empty() && commit.rfind(commit_filter, 0) != 0) continue;
     commits.insert(commit);
     studies.insert(r["cell"].value("study", ""));
     results.push_back(std::move(r));
   }
   if (results.empty())
-    throw std::runtime_error(dir_at_commit + ": no cell results" + (commit_filter.empty() ? "" : " of commit " + commit_filter));
+    throw std::runtime_error(dir_at_commit + ": no cell results" +
+                             (commit_filter.empty() ? "" : " of commit " + commit_filter));
   if (commits.size() > 1) {
     std::string list;
     for (const auto& c : commits) list += " " + c;
-    throw std::runtime_error(dir_at_commit + ": holds results of " + std::to_string(commits.size()) +
-                             " commits (" + list.substr(1) + "); pick one as " + set.dir + "@COMMIT");
+    throw std::runtime_error(dir_at_commit + ": holds results of " +
+                             std::to_string(commits.size()) + " commits (" + list.substr(1) +
+                             "); pick one as " + set.dir + "@COMMIT");
   }
   set.commit = *commits.begin();
   set.study = *studies.begin();
@@ -146,7 +152,8 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
     if (status == "error") ++c.errored;
     if (status != "ok") {
       if (c.failed++ == 0) {
-        std::string reason = r.contains("stop") && r["stop"].is_object() ? r["stop"].value("reason", "") : "";
+        std::string reason =
+            r.contains("stop") && r["stop"].is_object() ? r["stop"].value("reason", "") : "";
         c.failure = status + (reason.empty() ? "" : ": " + reason);
       }
     }
@@ -173,11 +180,13 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
   for (const auto& [key, c] : set.cells) any_value = any_value || !c.values.empty();
   if (any_steps && !any_value)
     throw std::runtime_error(dir_at_commit + ": no step of any cell has the metric \"" + metric +
-                             "\" (--metric is a dotted path in steps[], e.g. seconds.total, seconds.solve, radial_error.rms)");
+                             "\" (--metric is a dotted path in steps[], e.g. seconds.total, "
+                             "seconds.solve, radial_error.rms)");
   return set;
 }
 
-CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set, const CompareOptions& o) {
+CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set,
+                              const CompareOptions& o) {
   CompareReport rep;
   for (const auto& [key, n] : new_set.cells) {
     auto it = old_set.cells.find(key);
@@ -229,7 +238,8 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
     c.new_steps = std::max(n.min_steps, 0);
     c.failure = n.failure;
     c.stopped_earlier = c.new_steps < c.old_steps;
-    rep.regression = rep.regression || c.slower || c.less_accurate || c.failed || c.stopped_earlier || c.accuracy_missing;
+    rep.regression = rep.regression || c.slower || c.less_accurate || c.failed ||
+                     c.stopped_earlier || c.accuracy_missing;
     rep.cells.push_back(std::move(c));
   }
   for (const auto& [key, old] : old_set.cells)
@@ -239,11 +249,11 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
   return rep;
 }
 
-std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, const ResultSet& new_set,
-                             const CompareOptions& o) {
+std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
+                             const ResultSet& new_set, const CompareOptions& o) {
   std::ostringstream md;
-  md << "## compare " << old_set.dir << " (" << old_set.commit << ") → " << new_set.dir << " (" << new_set.commit
-     << ")\n\n";
+  md << "## compare " << old_set.dir << " (" << old_set.commit << ") → " << new_set.dir << " ("
+     << new_set.commit << ")\n\n";
   md << "Metric `" << o.metric << "` per step (median over steps and repetitions); Mann–Whitney U, "
      << "slower/faster when the ratio passes 1±" << o.threshold << " with p < " << o.alpha
      << "; accuracy = final reference distance or radial error (RMS).\n\n";
@@ -251,9 +261,11 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, c
     // Stolen time is CPU time of all vCPUs, run time is wall time: on a 2-vCPU guest the share
     // can reach 200%. A slower NEW with a much larger share may be the machine, not the code.
     const auto share = [](const ResultSet& s) {
-      return s.run_seconds > 0 ? fmt(100 * s.steal_seconds / s.run_seconds, "%.1f") + "%" : std::string("–");
+      return s.run_seconds > 0 ? fmt(100 * s.steal_seconds / s.run_seconds, "%.1f") + "%"
+                               : std::string("–");
     };
-    md << "Hypervisor steal (CPU time the host gave other guests, all vCPUs) per cell run time: OLD "
+    md << "Hypervisor steal (CPU time the host gave other guests, all vCPUs) per cell run time: "
+          "OLD "
        << share(old_set) << ", NEW " << share(new_set) << ".\n\n";
   }
   int changed = 0;
@@ -269,17 +281,20 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, c
     if (c.failed) verdict += "**failed** (" + c.failure + ") ";
     if (c.accuracy_missing) verdict += "**accuracy missing** (no " + c.missing_accuracy + ") ";
     if (c.stopped_earlier)
-      verdict += "**stopped earlier** (" + std::to_string(c.new_steps) + " of " + std::to_string(c.old_steps) + " steps) ";
+      verdict += "**stopped earlier** (" + std::to_string(c.new_steps) + " of " +
+                 std::to_string(c.old_steps) + " steps) ";
     if (!verdict.empty()) ++changed;
     if (verdict.empty() && !o.show_all) continue;
     table << "| " << c.label << " | " << fmt(c.old_median) << " | " << fmt(c.new_median) << " | "
           << fmt(c.ratio, "%.3f") << " | " << fmt(c.p_value, "%.2g") << " | "
-          << (c.has_error ? fmt(c.old_error) : "–") << " | " << (c.has_error ? fmt(c.new_error) : "–") << " | "
-          << (c.has_error ? fmt(c.error_ratio, "%.3f") : "–") << " | " << (verdict.empty() ? "same " : verdict) << "|\n";
+          << (c.has_error ? fmt(c.old_error) : "–") << " | "
+          << (c.has_error ? fmt(c.new_error) : "–") << " | "
+          << (c.has_error ? fmt(c.error_ratio, "%.3f") : "–") << " | "
+          << (verdict.empty() ? "same " : verdict) << "|\n";
   }
   if (changed || (o.show_all && !r.cells.empty())) md << table.str() << "\n";
-  md << r.cells.size() << " cells compared, " << changed << " changed, " << (r.cells.size() - size_t(changed))
-     << " unchanged.\n";
+  md << r.cells.size() << " cells compared, " << changed << " changed, "
+     << (r.cells.size() - size_t(changed)) << " unchanged.\n";
   if (!r.only_old.empty()) {
     md << r.only_old.size() << " cells only in OLD (missing from NEW: a regression):";
     for (size_t i = 0; i < r.only_old.size() && i < 5; ++i) md << " `" << r.only_old[i] << "`";
@@ -296,8 +311,10 @@ json history_entry(const ResultSet& set, const std::string& metric) {
   char date[32];
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   json cells = json::object();
-  for (const auto& [key, c] : set.cells) cells[key] = {{"label", c.label}, {"median", median(c.values)}};
-  return {{"commit", set.commit}, {"date", date}, {"study", set.study}, {"dir", set.dir}, {"metric", metric}, {"cells", cells}};
+  for (const auto& [key, c] : set.cells)
+    cells[key] = {{"label", c.label}, {"median", median(c.values)}};
+  return {{"commit", set.commit}, {"date", date},     {"study", set.study},
+          {"dir", set.dir},       {"metric", metric}, {"cells", cells}};
 }
 
 }  // namespace mcf

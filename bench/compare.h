@@ -12,16 +12,16 @@
 namespace mcf {
 
 struct CellSamples {
-  std::string label;                 ///< "basis=hat solver.name=cholmod" (the assignment)
-  std::vector<double> values;        ///< the metric per step, all repetitions pooled
+  std::string label;           ///< "basis=hat solver.name=cholmod" (the assignment)
+  std::vector<double> values;  ///< the metric per step, all repetitions pooled
   /// Accuracy per repetition by measure: "reference_distance" (the final distance to the
   /// reference flow, RMS) and "radial_error" (the last step's radial RMS), where recorded.
   std::map<std::string, std::vector<double>> errors;
   int repetitions = 0;
-  int failed = 0;                    ///< repetitions whose status is not "ok" (singular or error)
-  int errored = 0;                   ///< of those, the ones with status "error" (the flow threw)
-  std::string failure;               ///< the first such repetition's status and stop reason
-  int min_steps = -1;                ///< fewest steps any repetition recorded
+  int failed = 0;       ///< repetitions whose status is not "ok" (singular or error)
+  int errored = 0;      ///< of those, the ones with status "error" (the flow threw)
+  std::string failure;  ///< the first such repetition's status and stop reason
+  int min_steps = -1;   ///< fewest steps any repetition recorded
 };
 
 struct ResultSet {
@@ -72,8 +72,10 @@ struct CompareReport {
   bool regression = false;
 };
 
-CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set, const CompareOptions& o);
-std::string compare_markdown(const CompareReport& r, const ResultSet& old_set, const ResultSet& new_set, const CompareOptions& o);
+CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set,
+                              const CompareOptions& o);
+std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
+                             const ResultSet& new_set, const CompareOptions& o);
 /// One line for the history file: {commit, date, study, dir, metric, cells: {key: median}}.
 nlohmann::json history_entry(const ResultSet& set, const std::string& metric);
 

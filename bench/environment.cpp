@@ -2,19 +2,19 @@
 
 #include "build_info.h"
 
-#include <Eigen/Core>
 #include <OpenMesh/Core/System/config.h>
 #include <suitesparse/cholmod.h>
 #include <tbb/info.h>
 #include <tbb/version.h>
+#include <Eigen/Core>
 
+#include <sys/resource.h>
+#include <unistd.h>
 #include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/resource.h>
 #include <thread>
-#include <unistd.h>
 
 namespace mcf {
 namespace {
@@ -42,8 +42,11 @@ nlohmann::json environment_json(int threads) {
   // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the config
   // asked for (that request is in "config.threads"); the flow caps OpenBLAS, under CHOLMOD, at
   // the same count (solvers/blas_threads.h).
-  const int ran = threads > 0 ? std::min(threads, tbb::info::default_concurrency()) : tbb::info::default_concurrency();
-  const auto v = [](int a, int b, int c) { return std::to_string(a) + "." + std::to_string(b) + "." + std::to_string(c); };
+  const int ran = threads > 0 ? std::min(threads, tbb::info::default_concurrency())
+                              : tbb::info::default_concurrency();
+  const auto v = [](int a, int b, int c) {
+    return std::to_string(a) + "." + std::to_string(b) + "." + std::to_string(c);
+  };
   return {{"commit", MCFBENCH_GIT_COMMIT},
           {"version", MCFBENCH_VERSION},
           {"cpu", cpu_model()},
@@ -55,10 +58,13 @@ nlohmann::json environment_json(int threads) {
           {"libraries",
            {{"eigen", v(EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION)},
             {"cholmod", v(CHOLMOD_MAIN_VERSION, CHOLMOD_SUB_VERSION, CHOLMOD_SUBSUB_VERSION)},
-            {"suitesparse", v(SUITESPARSE_MAIN_VERSION, SUITESPARSE_SUB_VERSION, SUITESPARSE_SUBSUB_VERSION)},
+            {"suitesparse",
+             v(SUITESPARSE_MAIN_VERSION, SUITESPARSE_SUB_VERSION, SUITESPARSE_SUBSUB_VERSION)},
             {"tbb", TBB_VERSION_STRING},
-            {"openmesh", std::to_string((OM_VERSION >> 16) & 0xFF) + "." + std::to_string((OM_VERSION >> 8) & 0xFF)},
-            {"nlohmann_json", v(NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH)},
+            {"openmesh", std::to_string((OM_VERSION >> 16) & 0xFF) + "." +
+                             std::to_string((OM_VERSION >> 8) & 0xFF)},
+            {"nlohmann_json", v(NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR,
+                                NLOHMANN_JSON_VERSION_PATCH)},
             {"blas", "openblas"}}}};
 }
 

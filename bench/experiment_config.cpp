@@ -13,7 +13,8 @@ namespace {
 
 using nlohmann::json;
 
-[[noreturn]] void fail(const std::string& source, const std::string& path, const std::string& what) {
+[[noreturn]] void fail(const std::string& source, const std::string& path,
+                       const std::string& what) {
   throw ConfigError(source + ": " + path + ": " + what);
 }
 
@@ -36,7 +37,8 @@ std::string known_keys_hint() {
   return s + ")";
 }
 
-void require_config_key(const std::string& source, const std::string& where, const std::string& key) {
+void require_config_key(const std::string& source, const std::string& where,
+                        const std::string& key) {
   if (!is_config_key(key)) fail(source, where + key, "unknown config key" + known_keys_hint());
 }
 
@@ -44,7 +46,9 @@ void require_config_key(const std::string& source, const std::string& where, con
 /// before any cell is built, so a typo in `defaults` is named as such (not as a cell error).
 void check_config_object(const json& j, const std::string& source, const std::string& where,
                          const std::string& prefix = "") {
-  if (!j.is_object()) fail(source, where.empty() ? "config" : where.substr(0, where.size() - 1), "expected an object, got " + j.dump());
+  if (!j.is_object())
+    fail(source, where.empty() ? "config" : where.substr(0, where.size() - 1),
+         "expected an object, got " + j.dump());
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
     if (!is_config_key(key)) fail(source, where + key, "unknown key" + known_keys_hint());
@@ -77,31 +81,39 @@ const json& member(const json& j, const char* key) {
 
 void check_axes(const json& axes, const std::string& source, const std::string& where) {
   if (axes.is_null()) return;
-  if (!axes.is_object()) fail(source, where, "expected an object {dotted key: [values]}, got " + axes.dump());
+  if (!axes.is_object())
+    fail(source, where, "expected an object {dotted key: [values]}, got " + axes.dump());
   for (auto it = axes.begin(); it != axes.end(); ++it) {
     require_config_key(source, where + ".", it.key());
-    if (!it->is_array() || it->empty()) fail(source, where + "." + it.key(), "expected a non-empty list of values, got " + it->dump());
+    if (!it->is_array() || it->empty())
+      fail(source, where + "." + it.key(),
+           "expected a non-empty list of values, got " + it->dump());
   }
 }
 
 void check_zip(const json& zip, const std::string& source, const std::string& where) {
   if (zip.is_null()) return;
-  if (!zip.is_array()) fail(source, where, "expected a list of groups [{dotted key: [values]}, ...], got " + zip.dump());
+  if (!zip.is_array())
+    fail(source, where,
+         "expected a list of groups [{dotted key: [values]}, ...], got " + zip.dump());
   for (size_t g = 0; g < zip.size(); ++g) {
     const std::string gp = where + "[" + std::to_string(g) + "]";
     const json& group = zip[g];
-    if (!group.is_object() || group.empty()) fail(source, gp, "expected a non-empty object {dotted key: [values]}, got " + group.dump());
+    if (!group.is_object() || group.empty())
+      fail(source, gp, "expected a non-empty object {dotted key: [values]}, got " + group.dump());
     std::string first_key;
     size_t length = 0;
     for (auto it = group.begin(); it != group.end(); ++it) {
       require_config_key(source, gp + ".", it.key());
-      if (!it->is_array() || it->empty()) fail(source, gp + "." + it.key(), "expected a non-empty list of values, got " + it->dump());
+      if (!it->is_array() || it->empty())
+        fail(source, gp + "." + it.key(), "expected a non-empty list of values, got " + it->dump());
       if (first_key.empty()) {
         first_key = it.key();
         length = it->size();
       } else if (it->size() != length) {
         fail(source, gp + "." + it.key(),
-             std::to_string(it->size()) + " values, but " + gp + "." + first_key + " has " + std::to_string(length) +
+             std::to_string(it->size()) + " values, but " + gp + "." + first_key + " has " +
+                 std::to_string(length) +
                  " (the lists of a zip group vary together and must be equally long)");
       }
     }
@@ -110,11 +122,16 @@ void check_zip(const json& zip, const std::string& source, const std::string& wh
 
 void check_exclude(const json& exclude, const std::string& source, const std::string& where) {
   if (exclude.is_null()) return;
-  if (!exclude.is_array()) fail(source, where, "expected a list of partial assignments [{dotted key: value}, ...], got " + exclude.dump());
+  if (!exclude.is_array())
+    fail(
+        source, where,
+        "expected a list of partial assignments [{dotted key: value}, ...], got " + exclude.dump());
   for (size_t i = 0; i < exclude.size(); ++i) {
     const std::string ip = where + "[" + std::to_string(i) + "]";
-    if (!exclude[i].is_object() || exclude[i].empty()) fail(source, ip, "expected a non-empty object {dotted key: value}, got " + exclude[i].dump());
-    for (auto it = exclude[i].begin(); it != exclude[i].end(); ++it) require_config_key(source, ip + ".", it.key());
+    if (!exclude[i].is_object() || exclude[i].empty())
+      fail(source, ip, "expected a non-empty object {dotted key: value}, got " + exclude[i].dump());
+    for (auto it = exclude[i].begin(); it != exclude[i].end(); ++it)
+      require_config_key(source, ip + ".", it.key());
   }
 }
 
@@ -136,9 +153,11 @@ MetricsConfig read_metrics(const json& m, const std::string& source) {
   // Lists and partial assignments are not ConfigReader types, so the key set is checked here.
   for (auto it = m.begin(); it != m.end(); ++it) {
     const std::string& k = it.key();
-    if (k == "quasi_conformal" || k == "sphericity" || k == "every" || k == "distance_samples") continue;
+    if (k == "quasi_conformal" || k == "sphericity" || k == "every" || k == "distance_samples")
+      continue;
     if (k == "frames") {
-      if (!it->is_array()) fail(source, "metrics.frames", "expected a list of step numbers, got " + it->dump());
+      if (!it->is_array())
+        fail(source, "metrics.frames", "expected a list of step numbers, got " + it->dump());
       for (const auto& s : *it) {
         if (!s.is_number_integer() || s.get<long long>() < 0 || s.get<long long>() > 100000000)
           fail(source, "metrics.frames", "expected step numbers >= 0, got " + s.dump());
@@ -147,16 +166,21 @@ MetricsConfig read_metrics(const json& m, const std::string& source) {
       std::sort(out.frames.begin(), out.frames.end());
       out.frames.erase(std::unique(out.frames.begin(), out.frames.end()), out.frames.end());
     } else if (k == "reference") {
-      if (!it->is_object() || it->empty()) fail(source, "metrics.reference", "expected a non-empty object {dotted key: value}, got " + it->dump());
-      for (auto e = it->begin(); e != it->end(); ++e) require_config_key(source, "metrics.reference.", e.key());
+      if (!it->is_object() || it->empty())
+        fail(source, "metrics.reference",
+             "expected a non-empty object {dotted key: value}, got " + it->dump());
+      for (auto e = it->begin(); e != it->end(); ++e)
+        require_config_key(source, "metrics.reference.", e.key());
       out.reference = *it;
     } else {
       fail(source, "metrics." + k,
-           "unknown key (known: quasi_conformal, sphericity, every, frames, reference, distance_samples)");
+           "unknown key (known: quasi_conformal, sphericity, every, frames, reference, "
+           "distance_samples)");
     }
   }
   if (!out.reference.is_null() && out.frames.empty())
-    fail(source, "metrics.reference", "needs metrics.frames: distances are computed between saved frames");
+    fail(source, "metrics.reference",
+         "needs metrics.frames: distances are computed between saved frames");
   return out;
 }
 
@@ -199,7 +223,8 @@ const json* json_at_path(const json& j, const std::string& dotted) {
   size_t start = 0;
   while (true) {
     const size_t dot = dotted.find('.', start);
-    const std::string part = dotted.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    const std::string part =
+        dotted.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
     if (!node->is_object() || !node->contains(part)) return nullptr;
     node = &node->at(part);
     if (dot == std::string::npos) return node;
@@ -229,12 +254,14 @@ bool matches_assignment(const Cell& cell, const json& partial) {
 ExperimentConfig parse_experiment_config(const json& j, const std::string& source, bool quick,
                                          const std::string& default_name) {
   if (!j.is_object()) throw ConfigError(source + ": expected a JSON object at the top level");
-  static const std::set<std::string> top = {"name",    "description", "paper",   "comment", "defaults", "axes",
-                                            "zip",     "exclude",     "repetitions", "metrics", "quick"};
+  static const std::set<std::string> top = {"name",        "description", "paper", "comment",
+                                            "defaults",    "axes",        "zip",   "exclude",
+                                            "repetitions", "metrics",     "quick"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!top.count(it.key()))
       fail(source, it.key(),
-           "unknown key (known: name, description, paper, comment, defaults, axes, zip, exclude, repetitions, metrics, quick)");
+           "unknown key (known: name, description, paper, comment, defaults, axes, zip, exclude, "
+           "repetitions, metrics, quick)");
 
   ExperimentConfig e;
   e.source = source;
@@ -242,12 +269,15 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
   e.study_config = j;
   e.name = default_name;
   if (j.contains("name")) {
-    if (!j["name"].is_string() || j["name"].get<std::string>().empty()) fail(source, "name", "expected a non-empty string, got " + j["name"].dump());
+    if (!j["name"].is_string() || j["name"].get<std::string>().empty())
+      fail(source, "name", "expected a non-empty string, got " + j["name"].dump());
     e.name = j["name"].get<std::string>();
-    if (e.name.find('/') != std::string::npos) fail(source, "name", "must not contain '/' (it names the results folder)");
+    if (e.name.find('/') != std::string::npos)
+      fail(source, "name", "must not contain '/' (it names the results folder)");
   }
   if (j.contains("description")) {
-    if (!j["description"].is_string()) fail(source, "description", "expected a string, got " + j["description"].dump());
+    if (!j["description"].is_string())
+      fail(source, "description", "expected a string, got " + j["description"].dump());
     e.description = j["description"].get<std::string>();
   }
 
@@ -268,9 +298,10 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
   if (!q.is_null()) {
     if (!q.is_object()) fail(source, "quick", "expected an object, got " + q.dump());
     for (auto it = q.begin(); it != q.end(); ++it)
-      if (it.key() != "defaults" && it.key() != "axes" && it.key() != "zip" && it.key() != "exclude" &&
-          it.key() != "repetitions" && it.key() != "metrics")
-        fail(source, "quick." + it.key(), "unknown key (known: defaults, axes, zip, exclude, repetitions, metrics)");
+      if (it.key() != "defaults" && it.key() != "axes" && it.key() != "zip" &&
+          it.key() != "exclude" && it.key() != "repetitions" && it.key() != "metrics")
+        fail(source, "quick." + it.key(),
+             "unknown key (known: defaults, axes, zip, exclude, repetitions, metrics)");
     if (q.contains("defaults")) check_config_object(q["defaults"], source, "quick.defaults.");
     check_axes(member(q, "axes"), source, "quick.axes");
     check_zip(member(q, "zip"), source, "quick.zip");
@@ -312,7 +343,8 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
       size_t length = 0;
       for (auto it = zip[g].begin(); it != zip[g].end(); ++it) {
         if (!varied.insert(it.key()).second)
-          fail(source, "zip[" + std::to_string(g) + "]." + it.key(), "key varies twice (also in axes or another zip group)");
+          fail(source, "zip[" + std::to_string(g) + "]." + it.key(),
+               "key varies twice (also in axes or another zip group)");
         d.keys.push_back(it.key());
         length = it->size();
       }
@@ -326,7 +358,8 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
   for (const auto& k : varied)
     for (const auto& other : varied)
       if (k != other && other.rfind(k + ".", 0) == 0)
-        fail(source, axes_where, "keys \"" + k + "\" and \"" + other + "\" overlap (one contains the other)");
+        fail(source, axes_where,
+             "keys \"" + k + "\" and \"" + other + "\" overlap (one contains the other)");
 
   // Odometer over the dimensions, the last one fastest.
   std::vector<bool> exclude_used(exclude.is_array() ? exclude.size() : 0, false);
@@ -341,7 +374,8 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
         assignment[dims[d].keys[k]] = dims[d].rows[pos[d]][k];
       }
     if (!excluded(raw, exclude, exclude_used)) {
-      const std::string where = assignment.empty() ? source + " (defaults)" : source + " (cell " + assignment.dump() + ")";
+      const std::string where = assignment.empty() ? source + " (defaults)"
+                                                   : source + " (cell " + assignment.dump() + ")";
       const FlowConfig flow = flow_config_from_json(raw, where);
       for (int r = 0; r < e.repetitions; ++r) {
         Cell c;
@@ -378,19 +412,23 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
   for (int f : e.metrics.frames)
     if (own_frames && f > max_steps)
       fail(source, quick ? "quick.metrics.frames" : "metrics.frames",
-           "step " + std::to_string(f) + " is beyond every cell's steps (at most " + std::to_string(max_steps) + ")");
+           "step " + std::to_string(f) + " is beyond every cell's steps (at most " +
+               std::to_string(max_steps) + ")");
   // Two cells with the same full config would share one result file (same key): the second
   // would be "skipped" and `collect` would report it missing. Usually a duplicated axis value.
   std::map<std::string, const Cell*> seen;
   for (const Cell& c : e.cells) {
     auto [it, fresh] = seen.emplace(c.config.dump() + "#" + std::to_string(c.repetition), &c);
     if (!fresh)
-      fail(source, axes_where, "cells " + it->second->assignment.dump() + " and " + c.assignment.dump() +
-                                   " are the same flow config (duplicate values?)");
+      fail(source, axes_where,
+           "cells " + it->second->assignment.dump() + " and " + c.assignment.dump() +
+               " are the same flow config (duplicate values?)");
   }
   if (!e.metrics.reference.is_null() &&
-      std::none_of(e.cells.begin(), e.cells.end(), [&](const Cell& c) { return matches_assignment(c, e.metrics.reference); }))
-    fail(source, "metrics.reference", "matches no cell of the matrix: " + e.metrics.reference.dump());
+      std::none_of(e.cells.begin(), e.cells.end(),
+                   [&](const Cell& c) { return matches_assignment(c, e.metrics.reference); }))
+    fail(source, "metrics.reference",
+         "matches no cell of the matrix: " + e.metrics.reference.dump());
   return e;
 }
 
@@ -398,7 +436,8 @@ ExperimentConfig load_experiment_config(const std::string& path, bool quick) {
   const json j = read_config_file(path);
   // Without a "quick" section --quick would run the full matrix and label it quick.
   if (quick && !(j.is_object() && j.contains("quick")))
-    throw ConfigError(path + ": --quick: the config has no \"quick\" section (add one, or run without --quick)");
+    throw ConfigError(
+        path + ": --quick: the config has no \"quick\" section (add one, or run without --quick)");
   return parse_experiment_config(j, path, quick, std::filesystem::path(path).stem().string());
 }
 

@@ -24,8 +24,12 @@ MetricHooks default_metric_hooks() {
   return h;
 }
 
-const MetricHooks& metric_hooks() { return current(); }
+const MetricHooks& metric_hooks() {
+  return current();
+}
 
-void set_metric_hooks(MetricHooks hooks) { current() = std::move(hooks); }
+void set_metric_hooks(MetricHooks hooks) {
+  current() = std::move(hooks);
+}
 
 }  // namespace mcf

@@ -13,8 +13,10 @@
 namespace mcf {
 
 struct MetricHooks {
-  std::function<MeshDistance(const TriangleMesh& a, const TriangleMesh& b, long long samples)> mesh_distance;
-  std::function<double(const TriangleMesh& initial, const Positions& current)> quasi_conformal_error;
+  std::function<MeshDistance(const TriangleMesh& a, const TriangleMesh& b, long long samples)>
+      mesh_distance;
+  std::function<double(const TriangleMesh& initial, const Positions& current)>
+      quasi_conformal_error;
   std::function<double(const Positions& vertices, const Triangles& faces)> sphericity;
 };
 

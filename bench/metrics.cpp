@@ -35,36 +35,43 @@ double triangle_area(const Positions& v, const Triangles& f, Eigen::Index t) {
 }
 
 void check_mesh(const TriangleMesh& m, const char* name) {
-  if (m.num_faces() == 0) throw std::invalid_argument(std::string("mesh_distance: mesh ") + name + " has no faces");
+  if (m.num_faces() == 0)
+    throw std::invalid_argument(std::string("mesh_distance: mesh ") + name + " has no faces");
   if (m.faces.minCoeff() < 0 || m.faces.maxCoeff() >= m.num_vertices())
-    throw std::invalid_argument(std::string("mesh_distance: mesh ") + name + " refers to a missing vertex");
+    throw std::invalid_argument(std::string("mesh_distance: mesh ") + name +
+                                " refers to a missing vertex");
 }
 
 /// Squared distances from `samples` points drawn uniformly by area on `from` to the surface `to`.
 /// Uniform by area: pick a triangle with probability area/total (binary search in the prefix sums),
 /// then a uniform point in it with the square-root warp (Osada et al. 2002).
-std::vector<double> sampled_squared_distances(const TriangleMesh& from, const TriangleBvh& to, long long samples,
-                                              std::uint64_t seed) {
+std::vector<double> sampled_squared_distances(const TriangleMesh& from, const TriangleBvh& to,
+                                              long long samples, std::uint64_t seed) {
   const Eigen::Index m = from.num_faces();
   std::vector<double> prefix(std::size_t(m) + 1, 0.0);
-  for (Eigen::Index t = 0; t < m; ++t) prefix[t + 1] = prefix[t] + triangle_area(from.vertices, from.faces, t);
+  for (Eigen::Index t = 0; t < m; ++t)
+    prefix[t + 1] = prefix[t] + triangle_area(from.vertices, from.faces, t);
   const double total = prefix.back();
-  if (!(total > 0) || !std::isfinite(total)) throw std::invalid_argument("mesh_distance: a mesh has zero or non-finite area");
+  if (!(total > 0) || !std::isfinite(total))
+    throw std::invalid_argument("mesh_distance: a mesh has zero or non-finite area");
 
   std::vector<double> d2(std::size_t(samples), 0.0);
-  tbb::parallel_for(tbb::blocked_range<long long>(0, samples, 1024), [&](const tbb::blocked_range<long long>& r) {
-    for (long long i = r.begin(); i != r.end(); ++i) {
-      const double u = uniform(seed, std::uint64_t(i), 0) * total;
-      // First triangle whose prefix end exceeds u; zero-area triangles are never picked.
-      auto it = std::upper_bound(prefix.begin() + 1, prefix.end(), u);
-      Eigen::Index t = std::min<Eigen::Index>(Eigen::Index(it - prefix.begin()) - 1, m - 1);
-      const double r1 = std::sqrt(uniform(seed, std::uint64_t(i), 1)), r2 = uniform(seed, std::uint64_t(i), 2);
-      const Eigen::Vector3d a = from.vertices.row(from.faces(t, 0)), b = from.vertices.row(from.faces(t, 1)),
-                            c = from.vertices.row(from.faces(t, 2));
-      const Eigen::Vector3d p = (1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c;
-      d2[std::size_t(i)] = to.closest(p).squared_distance;
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<long long>(0, samples, 1024), [&](const tbb::blocked_range<long long>& r) {
+        for (long long i = r.begin(); i != r.end(); ++i) {
+          const double u = uniform(seed, std::uint64_t(i), 0) * total;
+          // First triangle whose prefix end exceeds u; zero-area triangles are never picked.
+          auto it = std::upper_bound(prefix.begin() + 1, prefix.end(), u);
+          Eigen::Index t = std::min<Eigen::Index>(Eigen::Index(it - prefix.begin()) - 1, m - 1);
+          const double r1 = std::sqrt(uniform(seed, std::uint64_t(i), 1)),
+                       r2 = uniform(seed, std::uint64_t(i), 2);
+          const Eigen::Vector3d a = from.vertices.row(from.faces(t, 0)),
+                                b = from.vertices.row(from.faces(t, 1)),
+                                c = from.vertices.row(from.faces(t, 2));
+          const Eigen::Vector3d p = (1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c;
+          d2[std::size_t(i)] = to.closest(p).squared_distance;
+        }
+      });
   return d2;
 }
 
@@ -85,14 +92,16 @@ Side summarise(const std::vector<double>& d2) {
 
 }  // namespace
 
-MeshDistance mesh_distance(const TriangleMesh& a, const TriangleMesh& b, long long samples, std::uint64_t seed) {
+MeshDistance mesh_distance(const TriangleMesh& a, const TriangleMesh& b, long long samples,
+                           std::uint64_t seed) {
   if (samples <= 0) throw std::invalid_argument("mesh_distance: samples must be positive");
   check_mesh(a, "A");
   check_mesh(b, "B");
   const TriangleBvh bvh_a(a.vertices, a.faces), bvh_b(b.vertices, b.faces);
   // Different streams for the two sides so that A == B does not give correlated sample sets.
   const Side fwd = summarise(sampled_squared_distances(a, bvh_b, samples, seed));
-  const Side bwd = summarise(sampled_squared_distances(b, bvh_a, samples, mix(seed ^ 0x5bd1e995ULL)));
+  const Side bwd =
+      summarise(sampled_squared_distances(b, bvh_a, samples, mix(seed ^ 0x5bd1e995ULL)));
   MeshDistance d;
   d.samples = samples;
   d.rms_forward = std::sqrt(fwd.sum_squares / double(samples));
@@ -108,7 +117,8 @@ namespace {
 
 /// The triangle's edge vectors b-a, c-a in an orthonormal frame of its own plane (columns).
 /// Returns false for a degenerate triangle (no frame).
-bool local_edges(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, Eigen::Matrix2d& e) {
+bool local_edges(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                 Eigen::Matrix2d& e) {
   const Eigen::Vector3d e1 = b - a, e2 = c - a;
   const Eigen::Vector3d n = e1.cross(e2);
   const double l1 = e1.norm(), ln = n.norm();
@@ -141,8 +151,10 @@ double quasi_conformal_error(const TriangleMesh& initial, const Positions& curre
   double weighted = 0, weights = 0;
   for (Eigen::Index t = 0; t < f.rows(); ++t) {
     Eigen::Matrix2d e0, e1;
-    if (!local_edges(x0.row(f(t, 0)), x0.row(f(t, 1)), x0.row(f(t, 2)), e0)) continue;  // no initial area
-    if (!local_edges(current.row(f(t, 0)), current.row(f(t, 1)), current.row(f(t, 2)), e1)) continue;
+    if (!local_edges(x0.row(f(t, 0)), x0.row(f(t, 1)), x0.row(f(t, 2)), e0))
+      continue;  // no initial area
+    if (!local_edges(current.row(f(t, 0)), current.row(f(t, 1)), current.row(f(t, 2)), e1))
+      continue;
     const double ratio = singular_value_ratio(e1 * e0.inverse());
     if (!std::isfinite(ratio)) continue;
     const double w = 0.5 * std::abs(e0(0, 0) * e0(1, 1));

@@ -71,7 +71,8 @@ void BM_PcgSolve(benchmark::State& state) {
   auto& f = HatFixture::get();
   PcgOptions o;
   o.relative_tolerance = 1e-8;
-  o.preconditioner = state.range(0) == 0 ? PcgPreconditioner::jacobi : PcgPreconditioner::incomplete_cholesky;
+  o.preconditioner =
+      state.range(0) == 0 ? PcgPreconditioner::jacobi : PcgPreconditioner::incomplete_cholesky;
   PcgSolver solver(o);
   int iterations = 0;
   for (auto _ : state) {

@@ -130,9 +130,9 @@ struct PhaseFixture {
   Case c;
   const MeshSource* source = nullptr;
   std::unique_ptr<RebuiltOctreeBasis> basis;
-  SparseMatrix A;          // M + δK
-  Eigen::MatrixXd C, B;    // x = c, b = M c
-  double spmv_seconds = 0; // best of several fine SpMVs with 3 columns (filled lazily)
+  SparseMatrix A;           // M + δK
+  Eigen::MatrixXd C, B;     // x = c, b = M c
+  double spmv_seconds = 0;  // best of several fine SpMVs with 3 columns (filled lazily)
 };
 
 PhaseFixture& phase_fixture(int which) {
@@ -261,12 +261,14 @@ void BM_Rebuilt_Cycle(benchmark::State& state) {
     state.counters["level" + std::to_string(l) + "_visits"] = double(work[l].visits) * per;
     state.counters["level" + std::to_string(l) + "_ms"] = 1e3 * work[l].seconds * per;
   }
-  state.counters["solve_ms"] = 1e3 * cycle_seconds;  // the cycle plus copies in/out and the final residual
+  state.counters["solve_ms"] =
+      1e3 * cycle_seconds;  // the cycle plus copies in/out and the final residual
   label(state, f);
 }
 
-// One forward Gauss-Seidel sweep (timed as 5) on the finest level (3 right-hand sides), in fine SpMVs: the
-// unit the W-cycle's cost is made of (a W-cycle is 10 fine sweeps + 1 residual + coarse work).
+// One forward Gauss-Seidel sweep (timed as 5) on the finest level (3 right-hand sides), in fine
+// SpMVs: the unit the W-cycle's cost is made of (a W-cycle is 10 fine sweeps + 1 residual + coarse
+// work).
 void BM_Rebuilt_Sweep(benchmark::State& state) {
   auto& f = phase_fixture(int(state.range(0)));
   MultigridSolver solver(mg_options(MultigridCycle::W));
@@ -296,18 +298,36 @@ void BM_Rebuilt_SetMatrix(benchmark::State& state) {
 }
 
 // Meshes: 0 = armadillo depth 9, 1 = sphere depth 8. Grouped by mesh so each fixture is built once.
-void phase_args(benchmark::internal::Benchmark* b) { b->ArgName("mesh")->Unit(benchmark::kMillisecond)->UseRealTime(); }
+void phase_args(benchmark::internal::Benchmark* b) {
+  b->ArgName("mesh")->Unit(benchmark::kMillisecond)->UseRealTime();
+}
 
-#define MCF_PHASES(mesh_id)                                                                            \
-  BENCHMARK(BM_Rebuilt_Octree)->Arg(mesh_id)->Apply(phase_args)->Iterations(mesh_id == 0 ? 2 : 3);      \
-  BENCHMARK(BM_Rebuilt_Clip)->Arg(mesh_id)->Apply(phase_args)->Iterations(mesh_id == 0 ? 2 : 3);        \
-  BENCHMARK(BM_Rebuilt_Integrate)->Arg(mesh_id)->Apply(phase_args)->Iterations(mesh_id == 0 ? 2 : 3);   \
-  BENCHMARK(BM_Rebuilt_Hierarchy)->Arg(mesh_id)->Apply(phase_args)->Iterations(mesh_id == 0 ? 2 : 3);   \
-  BENCHMARK(BM_Rebuilt_SpMV)->Arg(mesh_id)->Apply(phase_args);                                          \
-  BENCHMARK(BM_Rebuilt_SetMatrix)->Arg(mesh_id)->Apply(phase_args)->Iterations(3);                       \
-  BENCHMARK(BM_Rebuilt_Sweep)->Arg(mesh_id)->Apply(phase_args)->Iterations(5);                          \
-  BENCHMARK(BM_Rebuilt_Cycle)->Args({mesh_id, 0})->ArgNames({"mesh", "W"})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3); \
-  BENCHMARK(BM_Rebuilt_Cycle)->Args({mesh_id, 1})->ArgNames({"mesh", "W"})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+#define MCF_PHASES(mesh_id)                                                                        \
+  BENCHMARK(BM_Rebuilt_Octree)->Arg(mesh_id)->Apply(phase_args)->Iterations(mesh_id == 0 ? 2 : 3); \
+  BENCHMARK(BM_Rebuilt_Clip)->Arg(mesh_id)->Apply(phase_args)->Iterations(mesh_id == 0 ? 2 : 3);   \
+  BENCHMARK(BM_Rebuilt_Integrate)                                                                  \
+      ->Arg(mesh_id)                                                                               \
+      ->Apply(phase_args)                                                                          \
+      ->Iterations(mesh_id == 0 ? 2 : 3);                                                          \
+  BENCHMARK(BM_Rebuilt_Hierarchy)                                                                  \
+      ->Arg(mesh_id)                                                                               \
+      ->Apply(phase_args)                                                                          \
+      ->Iterations(mesh_id == 0 ? 2 : 3);                                                          \
+  BENCHMARK(BM_Rebuilt_SpMV)->Arg(mesh_id)->Apply(phase_args);                                     \
+  BENCHMARK(BM_Rebuilt_SetMatrix)->Arg(mesh_id)->Apply(phase_args)->Iterations(3);                 \
+  BENCHMARK(BM_Rebuilt_Sweep)->Arg(mesh_id)->Apply(phase_args)->Iterations(5);                     \
+  BENCHMARK(BM_Rebuilt_Cycle)                                                                      \
+      ->Args({mesh_id, 0})                                                                         \
+      ->ArgNames({"mesh", "W"})                                                                    \
+      ->Unit(benchmark::kMillisecond)                                                              \
+      ->UseRealTime()                                                                              \
+      ->Iterations(3);                                                                             \
+  BENCHMARK(BM_Rebuilt_Cycle)                                                                      \
+      ->Args({mesh_id, 1})                                                                         \
+      ->ArgNames({"mesh", "W"})                                                                    \
+      ->Unit(benchmark::kMillisecond)                                                              \
+      ->UseRealTime()                                                                              \
+      ->Iterations(3);
 
 MCF_PHASES(0)
 MCF_PHASES(1)
@@ -347,7 +367,8 @@ void timed_steps(benchmark::State& state, Step&& step) {
   state.counters["steal_ms"] = steal >= 0 ? 1e3 * steal / double(state.iterations()) : -1.0;
 }
 
-void step_counters(benchmark::State& state, const Case& c, const MeshSource& m, const BasisStats& s) {
+void step_counters(benchmark::State& state, const Case& c, const MeshSource& m,
+                   const BasisStats& s) {
   state.counters["dimension"] = double(s.dimension);
   state.counters["split_triangles"] = double(s.split_triangles);
   state.counters["cubature_points"] = double(s.cubature_points);
@@ -360,7 +381,8 @@ void step_counters(benchmark::State& state, const Case& c, const MeshSource& m, 
 // range(0): TBB threads.
 void BM_Step_Tracked(benchmark::State& state) {
   auto& f = tracked_fixture();
-  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              std::size_t(state.range(0)));
   TrackedOctreeBasis& basis = *f.basis;
   MultigridSolver solver(mg_options(MultigridCycle::W));
   // As in a flow (ReducedSystem): the tracked pattern is fixed, so it is checked once and the
@@ -410,7 +432,13 @@ void BM_Step_Tracked(benchmark::State& state) {
   }();
   step_counters(state, f.c, *f.source, basis.stats());
 }
-BENCHMARK(BM_Step_Tracked)->ArgName("threads")->Arg(2)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
+BENCHMARK(BM_Step_Tracked)
+    ->ArgName("threads")
+    ->Arg(2)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(5);
 
 // The tracked update alone, by matrix (range(0): 1 = mass, 2 = stiffness, 3 = both), 1 thread:
 // shows how the per-step update splits between the shared per-point geometry and each matrix.
@@ -426,7 +454,14 @@ void BM_Tracked_Update(benchmark::State& state) {
   state.SetLabel(mass && stiffness ? "mass+stiffness" : mass ? "mass" : "stiffness");
   step_counters(state, f.c, *f.source, f.basis->stats());
 }
-BENCHMARK(BM_Tracked_Update)->ArgName("matrices")->Arg(3)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(BM_Tracked_Update)
+    ->ArgName("matrices")
+    ->Arg(3)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 struct RebuiltStepFixture {
   Case c;
@@ -436,14 +471,16 @@ struct RebuiltStepFixture {
 
 void BM_Step_Rebuilt(benchmark::State& state) {
   const Case c = arm_case();
-  auto& f = acquire<RebuiltStepFixture>("rebuilt-step:" + c.spec + "@" + std::to_string(c.depth), [c] {
-    auto r = std::make_unique<RebuiltStepFixture>();
-    r->c = c;
-    r->source = &mesh(c.spec);
-    r->basis = std::make_unique<RebuiltOctreeBasis>(r->source->mesh, options(c));
-    return r;
-  });
-  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
+  auto& f =
+      acquire<RebuiltStepFixture>("rebuilt-step:" + c.spec + "@" + std::to_string(c.depth), [c] {
+        auto r = std::make_unique<RebuiltStepFixture>();
+        r->c = c;
+        r->source = &mesh(c.spec);
+        r->basis = std::make_unique<RebuiltOctreeBasis>(r->source->mesh, options(c));
+        return r;
+      });
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              std::size_t(state.range(0)));
   RebuiltOctreeBasis& basis = *f.basis;
   const Positions& vertices = f.source->mesh.vertices;
   Eigen::MatrixXd X, B;
@@ -455,7 +492,8 @@ void BM_Step_Rebuilt(benchmark::State& state) {
     // A fresh solver: after a rebuild on a moved mesh the pattern is new, so the Galerkin pattern
     // must be rebuilt (reusing the solver on identical vertices would skip that).
     MultigridSolver solver(mg_options(MultigridCycle::W));
-    solver.set_matrix_sum(1.0, basis.mass(), c.dt, basis.stiffness(), {basis.prolongations(), basis.colours()});
+    solver.set_matrix_sum(1.0, basis.mass(), c.dt, basis.stiffness(),
+                          {basis.prolongations(), basis.colours()});
     auto t2 = Clock::now();
     X = basis.initial_coefficients();
     symmetric_multiply(basis.mass(), X, B);
@@ -481,7 +519,12 @@ void BM_Step_Rebuilt(benchmark::State& state) {
   state.counters["threads"] = double(state.range(0));
   step_counters(state, c, *f.source, basis.stats());
 }
-BENCHMARK(BM_Step_Rebuilt)->ArgName("threads")->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(BM_Step_Rebuilt)
+    ->ArgName("threads")
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 struct HatStepFixture {
   const MeshSource* source = nullptr;
@@ -496,7 +539,8 @@ void BM_Step_HatCholmod(benchmark::State& state) {
     h->basis = std::make_unique<HatBasis>(h->source->mesh);
     return h;
   });
-  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              std::size_t(state.range(0)));
   // CHOLMOD's BLAS at the same count, as a flow with `threads` runs it (solvers/blas_threads.h).
   const ScopedBlasThreads blas(int(state.range(0)));
   HatBasis& basis = *f.basis;
@@ -540,7 +584,12 @@ void BM_Step_HatCholmod(benchmark::State& state) {
   state.counters["faces"] = double(f.source->mesh.num_faces());
   state.SetLabel(c.spec);
 }
-BENCHMARK(BM_Step_HatCholmod)->ArgName("threads")->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_Step_HatCholmod)
+    ->ArgName("threads")
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
 
 /// Frees the last fixture (registered last, so it runs after every octree benchmark).
 void BM_Octree_Release(benchmark::State& state) {

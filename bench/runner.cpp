@@ -97,7 +97,8 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   json result;
   try {
     const MeshSource& source = meshes.get(config.mesh);
-    if (!frames.empty() || config.save_every > 0) fs::create_directories(frame_dir);  // write_mesh does not
+    if (!frames.empty() || config.save_every > 0)
+      fs::create_directories(frame_dir);  // write_mesh does not
     TriangleMesh initial;  // X_0 as the flow sees it (after area normalisation, if any)
     auto measure = [&](int step, const Positions& V) {
       json mj = json::object();
@@ -109,7 +110,8 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
     observer.on_step = [&](int step, double, const Positions& V) {
       if (step == 0) initial = TriangleMesh{V, source.mesh.faces};
       if (frames.count(step) || (config.save_every > 0 && step % config.save_every == 0)) {
-        write_mesh((frame_dir / frame_name(step)).string(), TriangleMesh{V, source.mesh.faces}, true, FaceCheck::trusted);
+        write_mesh((frame_dir / frame_name(step)).string(), TriangleMesh{V, source.mesh.faces},
+                   true, FaceCheck::trusted);
         written.push_back(step);
       }
       // Metrics at step 0 too (the initial sphericity is the baseline of the cMCF plots), then
@@ -147,19 +149,23 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   result["cell"] = cell_json(e, p);
   result["study_config"] = e.study_config;
   if (!written.empty()) result["frames"] = {{"dir", "frames/" + p.hash}, {"steps", written}};
-  result["run_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0) result["steal_seconds"] = steal;
+  result["run_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
+    result["steal_seconds"] = steal;
   return result;
 }
 
 /// Distances between this cell's frames and its reference cell's frames at the same steps.
-json reference_distances(const ExperimentConfig& e, const fs::path& out, const CellPlan& cell, const CellPlan& ref) {
+json reference_distances(const ExperimentConfig& e, const fs::path& out, const CellPlan& cell,
+                         const CellPlan& ref) {
   json list = json::array();
   for (int step : e.metrics.frames) {
     const fs::path a = out / "frames" / cell.hash / frame_name(step);
     const fs::path b = out / "frames" / ref.hash / frame_name(step);
     if (!fs::exists(a) || !fs::exists(b)) continue;
-    const MeshDistance d = metric_hooks().mesh_distance(read_mesh(a.string()), read_mesh(b.string()), e.metrics.distance_samples);
+    const MeshDistance d = metric_hooks().mesh_distance(
+        read_mesh(a.string()), read_mesh(b.string()), e.metrics.distance_samples);
     list.push_back({{"step", step},
                     {"rms", d.rms},
                     {"max", d.max},
@@ -176,7 +182,8 @@ json reference_distances(const ExperimentConfig& e, const fs::path& out, const C
 
 const MeshSource& MeshCache::get(const std::string& spec) {
   auto it = meshes_.find(spec);
-  if (it == meshes_.end()) it = meshes_.emplace(spec, std::make_shared<MeshSource>(load_mesh_spec(spec))).first;
+  if (it == meshes_.end())
+    it = meshes_.emplace(spec, std::make_shared<MeshSource>(load_mesh_spec(spec))).first;
   return *it->second;
 }
 
@@ -185,7 +192,9 @@ std::string code_version() {
   return v;
 }
 
-bool in_shard(int index, int shard_index, int shard_count) { return index % shard_count == shard_index; }
+bool in_shard(int index, int shard_index, int shard_count) {
+  return index % shard_count == shard_index;
+}
 
 void parse_shard(const std::string& text, int& shard_index, int& shard_count) {
   const auto slash = text.find('/');
@@ -194,15 +203,18 @@ void parse_shard(const std::string& text, int& shard_index, int& shard_count) {
     size_t a = 0, b = 0;
     const int i = std::stoi(text.substr(0, slash), &a);
     const int n = std::stoi(text.substr(slash + 1), &b);
-    if (a != slash || b != text.size() - slash - 1 || n < 1 || i < 0 || i >= n) throw std::invalid_argument("");
+    if (a != slash || b != text.size() - slash - 1 || n < 1 || i < 0 || i >= n)
+      throw std::invalid_argument("");
     shard_index = i;
     shard_count = n;
   } catch (const std::logic_error&) {
-    throw std::invalid_argument("--shard: expected i/n with 0 <= i < n (e.g. 3/16), got \"" + text + "\"");
+    throw std::invalid_argument("--shard: expected i/n with 0 <= i < n (e.g. 3/16), got \"" + text +
+                                "\"");
   }
 }
 
-std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& out_dir, MeshCache& meshes, int threads,
+std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& out_dir,
+                                 MeshCache& meshes, int threads,
                                  const std::function<bool(const Cell&)>& wanted) {
   std::vector<CellPlan> plans;
   const std::string version = code_version();
@@ -217,11 +229,13 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
       try {
         p.mesh_fingerprint = mesh_fingerprint(meshes.get(c.flow.mesh).mesh);
       } catch (const std::exception& ex) {
-        throw ConfigError(e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + "): mesh: " + ex.what());
+        throw ConfigError(e.source + " (cell " + std::to_string(c.index) + " " +
+                          c.assignment.dump() + "): mesh: " + ex.what());
       }
       // Before any cell runs: a cell that cannot run on its mesh stops the whole plan.
-      validate_flow_mesh(c.flow, meshes.get(c.flow.mesh).report,
-                         e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + ")");
+      validate_flow_mesh(
+          c.flow, meshes.get(c.flow.mesh).report,
+          e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + ")");
       p.key = cell_key(p.cell.config, c.repetition, p.mesh_fingerprint);
       p.config_key = cell_key(p.cell.config, -1, p.mesh_fingerprint);
       p.hash = cell_hash(p.key, version);
@@ -232,10 +246,13 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
   return plans;
 }
 
-nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans, int shard_index, int shard_count) {
+nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
+                        int shard_index, int shard_count) {
   json cells = json::array();
   for (const CellPlan& p : plans) {
-    json c = {{"index", p.cell.index}, {"repetition", p.cell.repetition}, {"assignment", p.cell.assignment}};
+    json c = {{"index", p.cell.index},
+              {"repetition", p.cell.repetition},
+              {"assignment", p.cell.assignment}};
     if (!p.hash.empty()) c["hash"] = p.hash;
     cells.push_back(std::move(c));
   }
@@ -251,18 +268,22 @@ nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& 
           {"study_config", e.study_config}};
 }
 
-std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index, int shard_count) {
+std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index,
+                          int shard_count) {
   auto safe = [](std::string s) {
     for (char& ch : s)
-      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-') ch = '_';
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-')
+        ch = '_';
     return s;
   };
   std::string name = safe(e.name) + (e.quick ? "-quick" : "") + "@" + safe(code_version());
-  if (shard_count > 1) name += ".shard-" + std::to_string(shard_index) + "-of-" + std::to_string(shard_count);
+  if (shard_count > 1)
+    name += ".shard-" + std::to_string(shard_index) + "-of-" + std::to_string(shard_count);
   return (fs::path(out_dir) / kPlanFolder / (name + ".json")).string();
 }
 
-const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans, const CellPlan& cell) {
+const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
+                              const CellPlan& cell) {
   const json& ref = e.metrics.reference;
   if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
   const CellPlan* best = nullptr;
@@ -288,8 +309,9 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
     throw std::invalid_argument("--shard: expected i/n with 0 <= i < n");
   const MetricHooks& hooks = metric_hooks();
   auto missing = [&](const char* key) {
-    throw ConfigError(e.source + ": metrics." + key +
-                      ": this build has no implementation of the metric (bench/metrics*.cpp missing)");
+    throw ConfigError(
+        e.source + ": metrics." + key +
+        ": this build has no implementation of the metric (bench/metrics*.cpp missing)");
   };
   if (e.metrics.quasi_conformal && !hooks.quasi_conformal_error) missing("quasi_conformal");
   if (e.metrics.sphericity && !hooks.sphericity) missing("sphericity");
@@ -299,9 +321,10 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   MeshCache meshes;
   // Every mesh this shard needs is loaded (and every cell named) before anything is written,
   // so a bad mesh spec fails the run cleanly. Reference distances need the names of all cells.
-  const std::vector<CellPlan> plans = plan_cells(e, o.out_dir, meshes, o.threads, [&](const Cell& c) {
-    return with_reference || in_shard(c.index, o.shard_index, o.shard_count);
-  });
+  const std::vector<CellPlan> plans =
+      plan_cells(e, o.out_dir, meshes, o.threads, [&](const Cell& c) {
+        return with_reference || in_shard(c.index, o.shard_index, o.shard_count);
+      });
 
   RunSummary s;
   s.total = int(plans.size());
@@ -352,13 +375,17 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
       const CellPlan* ref = reference_for(e, plans, p);
       if (!ref || !fs::exists(p.file) || !fs::exists(ref->file)) continue;
       json result = read_json_file(p.file);
-      const bool stale = ran_now.count(p.hash) || ran_now.count(ref->hash) || !result.contains("reference_distance");
+      const bool stale = ran_now.count(p.hash) || ran_now.count(ref->hash) ||
+                         !result.contains("reference_distance");
       if (!stale || result.value("status", "") == "error") continue;
       const json ref_result = read_json_file(ref->file);
       if (ref_result.value("status", "") == "error") continue;
       result["reference_distance"] = reference_distances(e, out, p, *ref);
-      result["reference_cell"] = {{"index", ref->cell.index}, {"hash", ref->hash}, {"key", ref->key},
-                                  {"assignment", ref->cell.assignment}, {"repetition", ref->cell.repetition}};
+      result["reference_cell"] = {{"index", ref->cell.index},
+                                  {"hash", ref->hash},
+                                  {"key", ref->key},
+                                  {"assignment", ref->cell.assignment},
+                                  {"repetition", ref->cell.repetition}};
       write_file_atomic(p.file, result.dump(1) + "\n");
       ++s.distances;
     }

@@ -22,7 +22,7 @@ struct CellPlan {
   Cell cell;
   std::string mesh_fingerprint, key, hash;
   std::string config_key;  ///< key without the repetition: `compare` pools repetitions under it
-  std::string file;  ///< OUT/<hash>.json
+  std::string file;        ///< OUT/<hash>.json
 };
 
 /// Meshes are loaded once per spec per process (hashing needs the loaded mesh's bytes).
@@ -38,14 +38,15 @@ struct CellReport {
   int done = 0, total = 0;  ///< cells of this shard finished so far (run or skipped) / in the shard
   const CellPlan* plan = nullptr;
   bool skipped = false;
-  std::string status;       ///< ok | singular | error | skipped
+  std::string status;  ///< ok | singular | error | skipped
   std::string error;
   double seconds = 0;
 };
 
 /// A cell's flow has finished step `step` of `steps` (0 = the input, before the first step).
 struct StepReport {
-  int cell_number = 0, total = 0;  ///< this cell's place among the shard's cells (1-based) / their number
+  int cell_number = 0,
+      total = 0;  ///< this cell's place among the shard's cells (1-based) / their number
   const CellPlan* plan = nullptr;
   int step = 0, steps = 0;
 };
@@ -56,7 +57,8 @@ struct RunOptions {
   bool force = false;
   int threads = -1;  ///< >= 0 overrides every cell's "threads" (part of the config, so of the key)
   std::function<void(const CellReport&)> on_cell;  ///< progress (stderr in the CLI)
-  std::function<void(const StepReport&)> on_step;  ///< inside a cell that runs (not for skipped ones)
+  std::function<void(const StepReport&)>
+      on_step;  ///< inside a cell that runs (not for skipped ones)
 };
 
 struct RunSummary {
@@ -74,8 +76,9 @@ void parse_shard(const std::string& text, int& shard_index, int& shard_count);
 /// Names every cell (loading the meshes of the cells `wanted` selects, all if empty).
 /// `threads` >= 0 overrides the cells' thread count. A mesh that fails to load throws,
 /// naming the config file and the cell.
-std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& out_dir, MeshCache& meshes,
-                                 int threads = -1, const std::function<bool(const Cell&)>& wanted = {});
+std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& out_dir,
+                                 MeshCache& meshes, int threads = -1,
+                                 const std::function<bool(const Cell&)>& wanted = {});
 
 /// The plan `run` writes into OUT before its first cell: the whole matrix it expanded (index,
 /// repetition, assignment of every cell; the hash of the cells it named), the study config, the
@@ -83,8 +86,10 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
 /// before finishing any. One file per study variant, commit and shard (one writer each):
 /// OUT/plans/<study>[-quick]@<commit>[.shard-<i>-of-<n>].json. Not a `*.json` file of OUT
 /// itself, so nothing that reads cell results sees it.
-nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans, int shard_index, int shard_count);
-std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index, int shard_count);
+nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
+                        int shard_index, int shard_count);
+std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index,
+                          int shard_count);
 inline constexpr const char* kPlanFolder = "plans";
 
 /// Runs the shard. Config problems (including metrics whose hooks this build lacks) throw
@@ -95,6 +100,7 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& options);
 /// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the
 /// one agreeing with the cell on most assigned keys, then the lowest index); nullptr if none or
 /// if the cell is a reference cell itself.
-const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans, const CellPlan& cell);
+const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
+                              const CellPlan& cell);
 
 }  // namespace mcf

@@ -1,14 +1,14 @@
 #include "datasets/atomic_file.h"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace mcf {
 
@@ -41,7 +41,8 @@ void sync_to_disk(const fs::path& path) {
   // fsync on a read-only descriptor flushes the file's (or folder's) data all the same: it acts on
   // the inode, so a file another stream wrote and closed needs no descriptor of its writer.
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw std::runtime_error(path.string() + ": cannot open to sync: " + std::strerror(errno));
+  if (fd < 0)
+    throw std::runtime_error(path.string() + ": cannot open to sync: " + std::strerror(errno));
   int rc;
   do rc = ::fsync(fd);
   while (rc != 0 && errno == EINTR);

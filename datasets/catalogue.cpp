@@ -5,14 +5,14 @@
 
 #include "datasets/mesh_error.h"
 
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <filesystem>
-#include <spawn.h>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 extern char** environ;
@@ -24,9 +24,20 @@ namespace fs = std::filesystem;
 
 const std::vector<std::string>& model_names() {
   // Checked by the catalogue test to load and validate (manifold, no degenerate faces).
-  static const std::vector<std::string> names = {
-      "armadillo", "bunny00", "refined_elephant", "mannequin-devil", "knot1", "knot2", "man",
-      "elephant",  "camel",   "cow",              "dino",            "homer", "bull",  "triceratops"};
+  static const std::vector<std::string> names = {"armadillo",
+                                                 "bunny00",
+                                                 "refined_elephant",
+                                                 "mannequin-devil",
+                                                 "knot1",
+                                                 "knot2",
+                                                 "man",
+                                                 "elephant",
+                                                 "camel",
+                                                 "cow",
+                                                 "dino",
+                                                 "homer",
+                                                 "bull",
+                                                 "triceratops"};
   return names;
 }
 
@@ -56,7 +67,9 @@ int run_process(const std::vector<std::string>& args) {
 
 }  // namespace
 
-std::vector<std::string> catalogue_models() { return model_names(); }
+std::vector<std::string> catalogue_models() {
+  return model_names();
+}
 
 std::string catalogue_path(const std::string& model) {
   const auto& names = model_names();
@@ -88,19 +101,22 @@ std::string catalogue_path(const std::string& model) {
                                  std::to_string(counter++));
   fs::remove_all(tmp, ec);
   fs::create_directories(tmp, ec);
-  if (ec) throw MeshError("cgal:" + model + ": cannot create " + tmp.string() + ": " + ec.message());
+  if (ec)
+    throw MeshError("cgal:" + model + ": cannot create " + tmp.string() + ": " + ec.message());
   const std::string member = "data/meshes/" + model + ".off";
   const int rc = run_process({"tar", "-xzf", archive.string(), "-C", tmp.string(), member});
   const fs::path extracted = tmp / member;
   if (rc != 0 || !fs::is_regular_file(extracted, ec)) {
     fs::remove_all(tmp, ec);
-    throw MeshError("cgal:" + model + ": could not extract " + member + " from " + archive.string() +
-                    " (tar exit status " + std::to_string(rc) + ")");
+    throw MeshError("cgal:" + model + ": could not extract " + member + " from " +
+                    archive.string() + " (tar exit status " + std::to_string(rc) + ")");
   }
   fs::rename(extracted, target, ec);
   std::error_code ignore;
   fs::remove_all(tmp, ignore);
-  if (ec) throw MeshError("cgal:" + model + ": cannot move the extracted model to " + target.string() + ": " + ec.message());
+  if (ec)
+    throw MeshError("cgal:" + model + ": cannot move the extracted model to " + target.string() +
+                    ": " + ec.message());
   return target.string();
 }
 

@@ -32,7 +32,7 @@ TriangleMesh icosahedron() {
   TriangleMesh m;
   m.vertices.resize(12, 3);
   m.vertices << -1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, 0,  //
-      0, -1, t, 0, 1, t, 0, -1, -t, 0, 1, -t,             //
+      0, -1, t, 0, 1, t, 0, -1, -t, 0, 1, -t,            //
       t, 0, -1, t, 0, 1, -t, 0, -1, -t, 0, 1;
   m.faces.resize(20, 3);
   m.faces << 0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11,  //
@@ -85,7 +85,8 @@ TriangleMesh revolve(const std::vector<double>& rho, const std::vector<double>& 
   const Triangles band = grid_faces(n_around, rings - 1, true);
   std::vector<std::array<int, 3>> faces;
   faces.reserve(band.rows() + 2 * n_around);
-  for (Eigen::Index f = 0; f < band.rows(); ++f) faces.push_back({band(f, 0), band(f, 1), band(f, 2)});
+  for (Eigen::Index f = 0; f < band.rows(); ++f)
+    faces.push_back({band(f, 0), band(f, 1), band(f, 2)});
   int next = rings * n_around;
   if (bottom_pole) {
     const int p = next++;
@@ -108,14 +109,16 @@ TriangleMesh revolve(const std::vector<double>& rho, const std::vector<double>& 
 // stay near-equilateral everywhere: a fixed count would leave slivers in the pole fans and
 // crowd a thin neck. Neighbouring rings are stitched by a zipper that always advances on the
 // ring whose next vertex comes first in angle; rings are staggered by half a step.
-TriangleMesh revolve_closed(const std::vector<double>& rho, const std::vector<double>& z, int max_around) {
+TriangleMesh revolve_closed(const std::vector<double>& rho, const std::vector<double>& z,
+                            int max_around) {
   const int K = static_cast<int>(rho.size()) - 1;
   const double rho_max = *std::max_element(rho.begin(), rho.end());
   std::vector<int> count(K + 1, 1), start(K + 1, 0);
   std::vector<double> offset(K + 1, 0.0);
   int total = 0;
   for (int k = 0; k <= K; ++k) {
-    if (k > 0 && k < K) count[k] = std::max(6, static_cast<int>(std::lround(max_around * rho[k] / rho_max)));
+    if (k > 0 && k < K)
+      count[k] = std::max(6, static_cast<int>(std::lround(max_around * rho[k] / rho_max)));
     offset[k] = (k % 2) * kPi / count[k];
     start[k] = total;
     total += count[k];
@@ -163,17 +166,19 @@ TriangleMesh revolve_closed(const std::vector<double>& rho, const std::vector<do
 
 // Resamples a densely sampled profile curve at `segments` equal arc-length steps, so that
 // rings are evenly spaced along the surface (no crowding at caps, no stretching at the neck).
-void resample_by_arclength(const std::vector<double>& rho, const std::vector<double>& z, int segments,
-                           std::vector<double>& out_rho, std::vector<double>& out_z) {
+void resample_by_arclength(const std::vector<double>& rho, const std::vector<double>& z,
+                           int segments, std::vector<double>& out_rho, std::vector<double>& out_z) {
   std::vector<double> s(rho.size(), 0.0);
-  for (size_t k = 1; k < rho.size(); ++k) s[k] = s[k - 1] + std::hypot(rho[k] - rho[k - 1], z[k] - z[k - 1]);
+  for (size_t k = 1; k < rho.size(); ++k)
+    s[k] = s[k - 1] + std::hypot(rho[k] - rho[k - 1], z[k] - z[k - 1]);
   out_rho.assign(segments + 1, 0.0);
   out_z.assign(segments + 1, 0.0);
   size_t k = 0;
   for (int j = 0; j <= segments; ++j) {
     const double target = s.back() * j / segments;
     while (k + 2 < s.size() && s[k + 1] < target) ++k;
-    const double t = s[k + 1] > s[k] ? std::clamp((target - s[k]) / (s[k + 1] - s[k]), 0.0, 1.0) : 0.0;
+    const double t =
+        s[k + 1] > s[k] ? std::clamp((target - s[k]) / (s[k + 1] - s[k]), 0.0, 1.0) : 0.0;
     out_rho[j] = rho[k] + t * (rho[k + 1] - rho[k]);
     out_z[j] = z[k] + t * (z[k + 1] - z[k]);
   }
@@ -197,7 +202,8 @@ int rows_for(double length, double max_rho, int n_around) {
 }  // namespace
 
 TriangleMesh make_icosphere(int level, double radius) {
-  require(level >= 0 && level <= 12, "icosphere level must be in 0..12, got " + std::to_string(level));
+  require(level >= 0 && level <= 12,
+          "icosphere level must be in 0..12, got " + std::to_string(level));
   require(radius > 0, "icosphere radius must be positive");
   TriangleMesh m = icosahedron();
   // Project after every level (not once at the end): the classic icosphere, more uniform.
@@ -210,7 +216,8 @@ TriangleMesh make_icosphere(int level, double radius) {
 }
 
 TriangleMesh make_sphere(long long target_vertices, double radius) {
-  require(target_vertices >= 12, "sphere needs at least 12 vertices, got " + std::to_string(target_vertices));
+  require(target_vertices >= 12,
+          "sphere needs at least 12 vertices, got " + std::to_string(target_vertices));
   require(radius > 0, "sphere radius must be positive");
   // Frequency-k geodesic sphere: each icosahedron face carries a triangular grid with k segments
   // per edge, 10 k^2 + 2 vertices in all; k is the closest to the target.
@@ -247,13 +254,15 @@ TriangleMesh make_sphere(long long target_vertices, double radius) {
           if (it == edge_point.end()) {
             it = edge_point.emplace(key, static_cast<int>(verts.size())).first;
             verts.push_back((w[0] * ico.vertices.row(c[0]) + w[1] * ico.vertices.row(c[1]) +
-                             w[2] * ico.vertices.row(c[2])) / k);
+                             w[2] * ico.vertices.row(c[2])) /
+                            k);
           }
           id = it->second;
         } else {
           id = static_cast<int>(verts.size());
           verts.push_back((w[0] * ico.vertices.row(c[0]) + w[1] * ico.vertices.row(c[1]) +
-                           w[2] * ico.vertices.row(c[2])) / k);
+                           w[2] * ico.vertices.row(c[2])) /
+                          k);
         }
         grid[i * (k + 1) + j] = id;
       }

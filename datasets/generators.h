@@ -23,7 +23,8 @@ TriangleMesh make_torus(double R = 1.0, double r = 0.3, int n_major = 96, int n_
 /// the axis, rising 1 per turn (0.4 gap between turns); one boundary loop (a disk topologically).
 /// segments_per_turn is rounded up to a multiple of 4 so the square's corners are vertices;
 /// profile_segments divide the ribbon's height.
-TriangleMesh make_cubical_spiral(int turns = 3, int segments_per_turn = 128, int profile_segments = 8);
+TriangleMesh make_cubical_spiral(int turns = 3, int segments_per_turn = 128,
+                                 int profile_segments = 8);
 /// Dumbbell: two spheres joined by a thin neck (closed, genus 0). Surface of revolution about z:
 /// unit spheres centred at z = ±1.5 joined by a smooth neck of radius 0.25; `resolution`
 /// vertices around the widest rings, fewer on narrower rings (proportional to the radius, at
@@ -35,9 +36,11 @@ TriangleMesh make_dumbbell(int resolution = 64);
 TriangleMesh make_rounded_cylinder(double radius = 0.5, double length = 2.0, int resolution = 64);
 /// Open cylinder (two boundary loops), axis z, z in [-length/2, length/2], faces oriented away
 /// from the axis.
-TriangleMesh make_open_cylinder(double radius = 0.5, double length = 2.0, int n_around = 64, int n_along = 40);
+TriangleMesh make_open_cylinder(double radius = 0.5, double length = 2.0, int n_around = 64,
+                                int n_along = 40);
 /// Catenoid between z = -h and z = h (two boundary loops): ρ(z) = waist·cosh(z/waist), h = height.
 /// The defaults (h/waist = 1 < 1.2) give the stable catenoid, a minimal surface MCF keeps.
-TriangleMesh make_catenoid(double waist = 1.0, double height = 1.0, int n_around = 64, int n_along = 24);
+TriangleMesh make_catenoid(double waist = 1.0, double height = 1.0, int n_around = 64,
+                           int n_along = 24);
 
 }  // namespace mcf

@@ -15,6 +15,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <unistd.h>
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -22,8 +23,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -33,7 +34,6 @@
 #include <sstream>
 #include <string>
 #include <string_view>
-#include <unistd.h>
 #include <vector>
 
 namespace mcf {
@@ -62,7 +62,8 @@ void silence_openmesh() {
 
 std::string lower_extension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -143,7 +144,8 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
     long long dim = -1;
     if (!(ds >> dim)) fail(path, "bad " + magic + " dimension line '" + rest + "'");
     if (dim != 3)
-      fail(path, magic + " of dimension " + std::to_string(dim) + ": only surfaces in 3 dimensions are read");
+      fail(path, magic + " of dimension " + std::to_string(dim) +
+                     ": only surfaces in 3 dimensions are read");
     rest.clear();  // getline leaves it alone when the dimension ended the line
     std::getline(ds, rest);
     skip_blank_lines();
@@ -164,22 +166,25 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
     for (int c = 0; c < coordinates; ++c) {
       char* end = nullptr;
       x[c] = std::strtod(p, &end);
-      if (end == p) fail(path, "vertex " + std::to_string(v) + ": cannot parse coordinates '" + line + "'");
+      if (end == p)
+        fail(path, "vertex " + std::to_string(v) + ": cannot parse coordinates '" + line + "'");
       if (!std::isfinite(x[c]))
         fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate ('" + line + "')");
       p = end;
     }
     if (x[3] == 0.0)
-      fail(path, "vertex " + std::to_string(v) + " has homogeneous coordinate w = 0, a point at infinity ('" +
-                     line + "')");
+      fail(path, "vertex " + std::to_string(v) +
+                     " has homogeneous coordinate w = 0, a point at infinity ('" + line + "')");
     for (int c = 0; c < 3; ++c) {
       const double y = x[c] / x[3];  // exact when w = 1
-      if (!std::isfinite(y)) fail(path, "vertex " + std::to_string(v) + ": x/w overflows ('" + line + "')");
+      if (!std::isfinite(y))
+        fail(path, "vertex " + std::to_string(v) + ": x/w overflows ('" + line + "')");
       walk.coords.push_back(y);
     }
     ++v;
   }
-  if (v < nv) fail(path, "file ends after " + std::to_string(v) + " of " + std::to_string(nv) + " vertices");
+  if (v < nv)
+    fail(path, "file ends after " + std::to_string(v) + " of " + std::to_string(nv) + " vertices");
   long long f = 0;
   std::vector<int> corner;
   while (f < nf && std::getline(in, line)) {
@@ -188,13 +193,15 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
     const char* p = line.c_str();
     char* end = nullptr;
     const long long k = std::strtoll(p, &end, 10);
-    if (end == p || k < 3) fail(path, "face " + std::to_string(f) + ": bad vertex count in '" + line + "'");
+    if (end == p || k < 3)
+      fail(path, "face " + std::to_string(f) + ": bad vertex count in '" + line + "'");
     corner.clear();
     for (long long i = 0; i < k; ++i) {
       p = end;
       const long long idx = std::strtoll(p, &end, 10);
       if (end == p)
-        fail(path, "face " + std::to_string(f) + ": expected " + std::to_string(k) + " indices in '" + line + "'");
+        fail(path, "face " + std::to_string(f) + ": expected " + std::to_string(k) +
+                       " indices in '" + line + "'");
       if (idx < 0 || idx >= nv)
         fail(path, "face " + std::to_string(f) + " references vertex " + std::to_string(idx) +
                        " but the mesh has " + std::to_string(nv) + " vertices");
@@ -203,7 +210,8 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
     add_fan(walk, corner, f);
     ++f;
   }
-  if (f < nf) fail(path, "file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
+  if (f < nf)
+    fail(path, "file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
   return true;
 }
 
@@ -217,7 +225,8 @@ bool walk_off(const std::string& path, WalkedMesh& walk) {
 // own record is lost (a tetrahedron so written loaded as 2 faces). So the file is walked here
 // instead, every record checked, and errors name the vertex or face and its byte.
 void walk_off_binary(const std::string& path, WalkedMesh& walk) {
-  static_assert(std::endian::native == std::endian::little, "binary OFF is read as little-endian words");
+  static_assert(std::endian::native == std::endian::little,
+                "binary OFF is read as little-endian words");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file");
   std::error_code ec;
@@ -242,9 +251,12 @@ void walk_off_binary(const std::string& path, WalkedMesh& walk) {
   prefix("C", 3);   // vertex colour: 3 ints (OpenMesh reads no face colour unless asked)
   prefix("N", 3);   // normal: 3 floats, after the point
   if (p < header.size() && (header[p] == '4' || header[p] == 'n'))
-    fail(path, "binary OFF with other than 3 coordinates per vertex ('" + header + "') is not supported");
-  if (header.size() < p + 10 || header.compare(p, 3, "OFF") != 0 || header.compare(p + 4, 6, "BINARY") != 0)
-    fail(path, "binary OFF header must be the first line, '[ST][C][N]OFF BINARY', not '" + header + "'");
+    fail(path,
+         "binary OFF with other than 3 coordinates per vertex ('" + header + "') is not supported");
+  if (header.size() < p + 10 || header.compare(p, 3, "OFF") != 0 ||
+      header.compare(p + 4, 6, "BINARY") != 0)
+    fail(path,
+         "binary OFF header must be the first line, '[ST][C][N]OFF BINARY', not '" + header + "'");
   const unsigned long long body = header.size() + 1;
 
   // Words come through a 1 MiB buffer; `at` is the file offset of the next one.
@@ -258,7 +270,8 @@ void walk_off_binary(const std::string& path, WalkedMesh& walk) {
       next = 0;
       in.read(buffer.data() + filled, static_cast<std::streamsize>(buffer.size() - filled));
       filled += static_cast<std::size_t>(in.gcount());
-      if (filled < 4) fail(path, "binary OFF ends at byte " + std::to_string(size) + ", inside " + where);
+      if (filled < 4)
+        fail(path, "binary OFF ends at byte " + std::to_string(size) + ", inside " + where);
     }
     std::uint32_t w;
     std::memcpy(&w, buffer.data() + next, 4);
@@ -271,13 +284,14 @@ void walk_off_binary(const std::string& path, WalkedMesh& walk) {
   // The least the counts need (a face is at least 4 words), before anything is allocated.
   const unsigned long long need = 12 + 4ull * vertex_words * nv + 16ull * nf;
   if (need > size - body) {
-    std::string why = "binary OFF announces " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
-                      " faces, at least " + std::to_string(need) + " bytes, but has " +
-                      std::to_string(size - body) + " after its header line";
+    std::string why = "binary OFF announces " + std::to_string(nv) + " vertices and " +
+                      std::to_string(nf) + " faces, at least " + std::to_string(need) +
+                      " bytes, but has " + std::to_string(size - body) + " after its header line";
     const std::uint32_t snv = __builtin_bswap32(nv), snf = __builtin_bswap32(nf);
     const unsigned long long swapped_need = 12 + 4ull * vertex_words * snv + 16ull * snf;
     if (swapped_need <= size - body)
-      why += "; read big-endian (Geomview's byte order) the counts would be " + std::to_string(snv) + " and " + std::to_string(snf) +
+      why += "; read big-endian (Geomview's byte order) the counts would be " +
+             std::to_string(snv) + " and " + std::to_string(snf) +
              ", but binary OFF is read here as OpenMesh reads and writes it, little-endian";
     fail(path, why);
   }
@@ -291,7 +305,8 @@ void walk_off_binary(const std::string& path, WalkedMesh& walk) {
       if (w >= 3) continue;  // normal, colour, texture coordinate: not kept
       const float x = std::bit_cast<float>(bits);
       if (!std::isfinite(x))
-        fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate (byte " + std::to_string(record) + ")");
+        fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate (byte " +
+                       std::to_string(record) + ")");
       walk.coords.push_back(x);
     }
   }
@@ -301,20 +316,23 @@ void walk_off_binary(const std::string& path, WalkedMesh& walk) {
     const std::string where = "face " + std::to_string(f);
     const std::uint32_t k = word(where);
     if (k < 3)
-      fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") has " + std::to_string(k) +
-                     " corners" +
-                     (f > 0 && k <= 1 ? std::string(" (a Geomview colour count after face ") + std::to_string(f - 1) +
-                                            "'s indices? OpenMesh's binary OFF, read here, has none)"
-                                      : std::string()));
+      fail(path,
+           "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") has " +
+               std::to_string(k) + " corners" +
+               (f > 0 && k <= 1
+                    ? std::string(" (a Geomview colour count after face ") + std::to_string(f - 1) +
+                          "'s indices? OpenMesh's binary OFF, read here, has none)"
+                    : std::string()));
     if (4ull * k > size - at)
-      fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") announces " + std::to_string(k) +
-                     " corners, more than the rest of the file holds");
+      fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") announces " +
+                     std::to_string(k) + " corners, more than the rest of the file holds");
     corner.clear();
     for (std::uint32_t i = 0; i < k; ++i) {
       const std::uint32_t idx = word(where);
       if (idx >= nv)
-        fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) + ") references vertex " +
-                       std::to_string(idx) + " but the mesh has " + std::to_string(nv) + " vertices");
+        fail(path, "face " + std::to_string(f) + " (byte " + std::to_string(record) +
+                       ") references vertex " + std::to_string(idx) + " but the mesh has " +
+                       std::to_string(nv) + " vertices");
       corner.push_back(static_cast<int>(idx));
     }
     add_fan(walk, corner, f);
@@ -345,8 +363,11 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
       for (int c = 0; c < 3; ++c) {
         char* end = nullptr;
         double x = std::strtod(p, &end);
-        if (end == p) fail(path, "vertex " + std::to_string(vertices) + ": cannot parse '" + line + "'");
-        if (!std::isfinite(x)) fail(path, "vertex " + std::to_string(vertices) + " has a non-finite coordinate ('" + line + "')");
+        if (end == p)
+          fail(path, "vertex " + std::to_string(vertices) + ": cannot parse '" + line + "'");
+        if (!std::isfinite(x))
+          fail(path, "vertex " + std::to_string(vertices) + " has a non-finite coordinate ('" +
+                         line + "')");
         walk.coords.push_back(x);
         p = end;
       }
@@ -360,30 +381,38 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
         // OpenMesh drops a face with a bad index as "non-manifold", which hides the real cause.
         char* end = nullptr;
         const long long v = std::strtoll(tok.c_str(), &end, 10);
-        if (end == tok.c_str() || (*end != '\0' && *end != '/') || v == 0 || (v < 0 && -v > vertices))
-          fail(path, "line " + std::to_string(line_number) + ": face corner '" + tok + "' is not a vertex index (1.." +
-                         std::to_string(vertices) + " or -1..-" + std::to_string(vertices) + " so far)");
+        if (end == tok.c_str() || (*end != '\0' && *end != '/') || v == 0 ||
+            (v < 0 && -v > vertices))
+          fail(path, "line " + std::to_string(line_number) + ": face corner '" + tok +
+                         "' is not a vertex index (1.." + std::to_string(vertices) + " or -1..-" +
+                         std::to_string(vertices) + " so far)");
         if (v > max_index) {
           max_index = v;
           max_index_line = line_number;
         }
         // Forward references (v beyond the vertices read so far) are checked once the file ends.
-        corner.push_back(static_cast<int>(std::min<long long>(v > 0 ? v - 1 : vertices + v, std::numeric_limits<int>::max())));
+        corner.push_back(static_cast<int>(
+            std::min<long long>(v > 0 ? v - 1 : vertices + v, std::numeric_limits<int>::max())));
       }
-      if (corner.size() < 3) fail(path, "line " + std::to_string(line_number) + ": face with fewer than 3 corners: '" + line + "'");
+      if (corner.size() < 3)
+        fail(path, "line " + std::to_string(line_number) + ": face with fewer than 3 corners: '" +
+                       line + "'");
       add_fan(walk, corner, line_number);
     }
   }
-  if (vertices == 0 && walk.triangles.empty()) fail(path, "no vertex or face records (not an OBJ file?)");
+  if (vertices == 0 && walk.triangles.empty())
+    fail(path, "no vertex or face records (not an OBJ file?)");
   if (max_index > vertices)
-    fail(path, "line " + std::to_string(max_index_line) + ": face refers to vertex " + std::to_string(max_index) +
-                   " but the file has " + std::to_string(vertices) + " vertices");
+    fail(path, "line " + std::to_string(max_index_line) + ": face refers to vertex " +
+                   std::to_string(max_index) + " but the file has " + std::to_string(vertices) +
+                   " vertices");
 }
 
 // Whether word is the keyword (given in lowercase) in any case: STL's keywords are lowercase, but
 // files in capitals ("SOLID", "OUTER LOOP", "VERTEX") exist.
 bool is_keyword(std::string_view word, std::string_view keyword) {
-  return word.size() == keyword.size() && std::equal(word.begin(), word.end(), keyword.begin(), [](char w, char k) {
+  return word.size() == keyword.size() &&
+         std::equal(word.begin(), word.end(), keyword.begin(), [](char w, char k) {
            return std::tolower(static_cast<unsigned char>(w)) == k;
          });
 }
@@ -427,8 +456,8 @@ class AsciiStlLines {
     if (!error_.empty()) return;
     if (!partial_.empty() || overlong_) line(partial_);
     if (error_.empty() && corners_due_ > 0)
-      error_ = "the file ends " + std::to_string(corners_due_) + " vertex line(s) short of the facet opened on line " +
-               std::to_string(loop_line_);
+      error_ = "the file ends " + std::to_string(corners_due_) +
+               " vertex line(s) short of the facet opened on line " + std::to_string(loop_line_);
   }
   const std::string& error() const { return error_; }
   /// Facets opened so far: the triangles OpenMesh's reader will try to add, to compare with those
@@ -454,7 +483,9 @@ class AsciiStlLines {
     s.remove_prefix(e);
     return w;
   }
-  void problem(const std::string& what) { error_ = "line " + std::to_string(number_) + ": " + what; }
+  void problem(const std::string& what) {
+    error_ = "line " + std::to_string(number_) + ": " + what;
+  }
 
   void line(std::string_view s) {
     ++number_;
@@ -463,21 +494,26 @@ class AsciiStlLines {
     const std::string_view first = word(rest);
     if (corners_due_ == 0) {
       if (is_keyword(first, "vertex"))
-        return problem("a vertex line outside a facet's three corners (OpenMesh's reader skips it): " + quoted(s));
+        return problem(
+            "a vertex line outside a facet's three corners (OpenMesh's reader skips it): " +
+            quoted(s));
       if (s.find("outer") != std::string_view::npos || s.find("OUTER") != std::string_view::npos) {
         corners_due_ = 3;
         loop_line_ = number_;
         ++facets_;
       } else if (is_keyword(first, "outer")) {
-        return problem(quoted(s) + ": OpenMesh's reader opens a facet only at 'outer' or 'OUTER' (STL's keywords "
-                       "are lowercase), and would skip this one");
+        return problem(
+            quoted(s) +
+            ": OpenMesh's reader opens a facet only at 'outer' or 'OUTER' (STL's keywords "
+            "are lowercase), and would skip this one");
       }
       return;
     }
     --corners_due_;
     if (!is_keyword(first, "vertex"))
       return problem("expected 'vertex x y z', corner " + std::to_string(3 - corners_due_) +
-                     " of the facet opened by 'outer' on line " + std::to_string(loop_line_) + ", found " + quoted(s));
+                     " of the facet opened by 'outer' on line " + std::to_string(loop_line_) +
+                     ", found " + quoted(s));
     int count = 0;
     for (std::string_view w = word(rest); !w.empty(); w = word(rest), ++count) {
       if (count == 3) return problem("vertex line with more than 3 coordinates: " + quoted(s));
@@ -501,16 +537,18 @@ class AsciiStlLines {
       if (!whole || number_text_.find_first_not_of("0123456789+-.eE") != std::string::npos)
         return problem("vertex coordinate '" + number_text_ + "' is not a number: " + quoted(s));
     }
-    if (count < 3) return problem("vertex line with " + std::to_string(count) + " of 3 coordinates: " + quoted(s));
+    if (count < 3)
+      return problem("vertex line with " + std::to_string(count) +
+                     " of 3 coordinates: " + quoted(s));
   }
 
-  std::string partial_;        // the current line's bytes from earlier pieces
-  bool overlong_ = false;      // the current line passed kMaxLine (its bytes are dropped)
-  long long number_ = 0;       // lines ended so far
-  int corners_due_ = 0;        // vertex lines the open facet still needs
-  long long facets_ = 0;       // facets opened ('outer' lines): the triangles OpenMesh tries to add
-  long long loop_line_ = 0;    // the line that opened it
-  std::string number_text_;    // a coordinate, NUL-terminated for strtof
+  std::string partial_;      // the current line's bytes from earlier pieces
+  bool overlong_ = false;    // the current line passed kMaxLine (its bytes are dropped)
+  long long number_ = 0;     // lines ended so far
+  int corners_due_ = 0;      // vertex lines the open facet still needs
+  long long facets_ = 0;     // facets opened ('outer' lines): the triangles OpenMesh tries to add
+  long long loop_line_ = 0;  // the line that opened it
+  std::string number_text_;  // a coordinate, NUL-terminated for strtof
   std::string error_;
 };
 
@@ -545,7 +583,8 @@ bool zeros_from(const std::string& path, unsigned long long from) {
 // (fewer than 50) or are all zero (a zero record would be a degenerate triangle at the origin);
 // other bytes after them may be triangles a wrong count leaves out, and are refused, as is a
 // file too short for its count. `why` says why the file is not read as ASCII.
-long long binary_stl_triangles(const std::string& path, const std::string& head, const std::string& why) {
+long long binary_stl_triangles(const std::string& path, const std::string& head,
+                               const std::string& why) {
   if (head.size() < 84) fail(path, "binary STL shorter than its 84-byte header (" + why + ")");
   std::uint32_t n = 0;
   std::memcpy(&n, head.data() + 80, 4);
@@ -553,13 +592,14 @@ long long binary_stl_triangles(const std::string& path, const std::string& head,
   const unsigned long long size = fs::file_size(path, ec);
   if (ec) fail(path, "cannot read the file's size: " + ec.message());
   const unsigned long long need = 84 + 50ull * n;
-  const std::string announced = "binary STL announces " + std::to_string(n) + " triangles (84 + 50 * " +
-                                std::to_string(n) + " = " + std::to_string(need) + " bytes) but the file has " +
-                                std::to_string(size) + " bytes";
+  const std::string announced =
+      "binary STL announces " + std::to_string(n) + " triangles (84 + 50 * " + std::to_string(n) +
+      " = " + std::to_string(need) + " bytes) but the file has " + std::to_string(size) + " bytes";
   if (size < need) fail(path, announced + " (" + why + ")");
   if (size - need >= 50 && !zeros_from(path, need))
     fail(path, announced + ": the " + std::to_string(size - need) +
-                   " bytes after its last triangle, too many for padding and not all zero, may be triangles "
+                   " bytes after its last triangle, too many for padding and not all zero, may be "
+                   "triangles "
                    "its count leaves out");
   return n;
 }
@@ -595,16 +635,20 @@ StlLayout scan_stl(const std::string& path) {
   read(chunk, kChunk);
   const auto start = head.find_first_not_of(" \t\r\n");
   if (start == std::string::npos || !is_keyword(std::string_view(head).substr(start, 5), "solid"))
-    return {true, binary_stl_triangles(path, head, "it does not start with 'solid', so it is no ASCII STL")};
+    return {true, binary_stl_triangles(path, head,
+                                       "it does not start with 'solid', so it is no ASCII STL")};
   std::size_t bad = first_non_text_byte(head);
-  if (bad == std::string::npos && (bad = first_non_text_byte(chunk)) != std::string::npos) bad += head.size();
+  if (bad == std::string::npos && (bad = first_non_text_byte(chunk)) != std::string::npos)
+    bad += head.size();
   if (bad != std::string::npos) {
-    const auto c = static_cast<unsigned char>(bad < head.size() ? head[bad] : chunk[bad - head.size()]);
+    const auto c =
+        static_cast<unsigned char>(bad < head.size() ? head[bad] : chunk[bad - head.size()]);
     char byte[8];
     std::snprintf(byte, sizeof byte, "0x%02x", c);
-    return {true, binary_stl_triangles(path, head,
-                                       "it starts with 'solid', as some binary headers do, but its byte " +
-                                           std::to_string(bad) + " is " + byte + ", which no ASCII STL holds")};
+    return {true, binary_stl_triangles(
+                      path, head,
+                      "it starts with 'solid', as some binary headers do, but its byte " +
+                          std::to_string(bad) + " is " + byte + ", which no ASCII STL holds")};
   }
   AsciiStlLines lines;
   lines.feed(head.data(), head.size());
@@ -629,16 +673,18 @@ IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const 
   om.reserve(nv, nf + nv + 2, nf);  // edges: nf + nv - χ for a closed mesh
   std::vector<IoMesh::VertexHandle> vh(nv);
   for (Eigen::Index i = 0; i < nv; ++i)
-    vh[i] = om.add_vertex(IoMesh::Point(mesh.vertices(i, 0), mesh.vertices(i, 1), mesh.vertices(i, 2)));
+    vh[i] =
+        om.add_vertex(IoMesh::Point(mesh.vertices(i, 0), mesh.vertices(i, 1), mesh.vertices(i, 2)));
   for (Eigen::Index f = 0; f < nf; ++f) {
     const int a = mesh.faces(f, 0), b = mesh.faces(f, 1), c = mesh.faces(f, 2);
     for (int v : {a, b, c})
       if (v < 0 || v >= nv)
-        fail(path, prefix + name_face(f) + " references vertex " + std::to_string(v) + " but the mesh has " +
-                       std::to_string(nv) + " vertices");
+        fail(path, prefix + name_face(f) + " references vertex " + std::to_string(v) +
+                       " but the mesh has " + std::to_string(nv) + " vertices");
     // OpenMesh's add_face does not expect a repeated corner (its readers skip such faces).
     if (a == b || b == c || c == a)
-      fail(path, prefix + name_face(f) + " repeats vertex " + name_vertex(a == b || a == c ? a : b) + " (a degenerate face)");
+      fail(path, prefix + name_face(f) + " repeats vertex " +
+                     name_vertex(a == b || a == c ? a : b) + " (a degenerate face)");
     if (om.add_face(vh[a], vh[b], vh[c]).is_valid()) continue;
     // Why OpenMesh refused it, from the half-edge structure as it stood (a failed add_face
     // changes nothing).
@@ -648,15 +694,18 @@ IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const 
       const auto h = om.find_halfedge(vh[corner[j]], vh[corner[(j + 1) % 3]]);
       if (h.is_valid() && !om.is_boundary(h))
         why = "its edge (" + name_vertex(corner[j]) + ", " + name_vertex(corner[(j + 1) % 3]) +
-              ") already has a face on the same side: the edge is in more than two faces, or the faces "
+              ") already has a face on the same side: the edge is in more than two faces, or the "
+              "faces "
               "around it are inconsistently oriented";
     }
     for (int j = 0; j < 3 && why.empty(); ++j)
       if (!om.is_boundary(vh[corner[j]]))
-        why = "its vertex " + name_vertex(corner[j]) + " is already surrounded by a closed fan of faces";
-    if (why.empty()) why = "its faces around a vertex cannot be ordered into one fan (a non-manifold vertex)";
-    fail(path, prefix + "non-manifold mesh: " + name_face(f) + " (vertices " + name_vertex(a) + ", " + name_vertex(b) + ", " +
-                   name_vertex(c) + ") cannot be added: " + why);
+        why = "its vertex " + name_vertex(corner[j]) +
+              " is already surrounded by a closed fan of faces";
+    if (why.empty())
+      why = "its faces around a vertex cannot be ordered into one fan (a non-manifold vertex)";
+    fail(path, prefix + "non-manifold mesh: " + name_face(f) + " (vertices " + name_vertex(a) +
+                   ", " + name_vertex(b) + ", " + name_vertex(c) + ") cannot be added: " + why);
   }
   return om;
 }
@@ -670,7 +719,8 @@ TriangleMesh read_stl_through_openmesh(const std::string& path, const StlLayout&
   IoMesh om;
   OpenMesh::IO::Options opt;
   if (layout.binary) opt += OpenMesh::IO::Options::Binary;
-  if (!OpenMesh::IO::read_mesh(om, in, ".stl", opt)) fail(path, "OpenMesh could not parse the file");
+  if (!OpenMesh::IO::read_mesh(om, in, ".stl", opt))
+    fail(path, "OpenMesh could not parse the file");
   const long long file_triangles = layout.triangles;
   const long long nv = static_cast<long long>(om.n_vertices());
   const long long nf = static_cast<long long>(om.n_faces());
@@ -685,8 +735,10 @@ TriangleMesh read_stl_through_openmesh(const std::string& path, const StlLayout&
     }
     std::sort(points.begin(), points.end());
     if (std::adjacent_find(points.begin(), points.end()) != points.end())
-      fail(path, "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
-                 "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
+      fail(
+          path,
+          "non-manifold mesh: OpenMesh had to duplicate vertices to add faces around complex edges "
+          "or vertices (an edge in more than two faces, or inconsistently oriented faces)");
   }
   if (nf < file_triangles)
     fail(path, "only " + std::to_string(nf) + " of the file's " + std::to_string(file_triangles) +
@@ -702,7 +754,8 @@ TriangleMesh read_stl_through_openmesh(const std::string& path, const StlLayout&
   for (auto fh : om.faces()) {
     int c = 0;
     for (auto vh : om.fv_range(fh)) {
-      if (c == 3) fail(path, "face " + std::to_string(fh.idx()) + " is not a triangle after loading");
+      if (c == 3)
+        fail(path, "face " + std::to_string(fh.idx()) + " is not a triangle after loading");
       mesh.faces(fh.idx(), c++) = vh.idx();
     }
   }
@@ -736,18 +789,22 @@ TriangleMesh read_mesh(const std::string& path) {
   TriangleMesh mesh;
   const Eigen::Index nv = static_cast<Eigen::Index>(walk.coords.size() / 3);
   const Eigen::Index nt = static_cast<Eigen::Index>(walk.source.size());
-  mesh.vertices = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(walk.coords.data(), nv, 3);
+  mesh.vertices = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+      walk.coords.data(), nv, 3);
   std::vector<double>().swap(walk.coords);
-  mesh.faces = Eigen::Map<const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>>(walk.triangles.data(), nt, 3);
+  mesh.faces = Eigen::Map<const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+      walk.triangles.data(), nt, 3);
   std::vector<int>().swap(walk.triangles);
   auto name_face = [&](Eigen::Index t) {
-    std::string face = (walk.source_is_line ? "the face on line " : "face ") + std::to_string(walk.source[t]);
+    std::string face =
+        (walk.source_is_line ? "the face on line " : "face ") + std::to_string(walk.source[t]);
     // A polygon's triangles share its name: say which one.
     Eigen::Index first = t, last = t;
     while (first > 0 && walk.source[first - 1] == walk.source[t]) --first;
     while (last + 1 < nt && walk.source[last + 1] == walk.source[t]) ++last;
     if (last == first) return face;
-    return "triangle " + std::to_string(t - first + 1) + " of " + std::to_string(last - first + 1) + " fanned from " + face;
+    return "triangle " + std::to_string(t - first + 1) + " of " + std::to_string(last - first + 1) +
+           " fanned from " + face;
   };
   auto name_vertex = [&](int v) { return std::to_string(v + walk.index_base); };
   half_edge_mesh(path, "", mesh, name_face, name_vertex);
@@ -757,7 +814,8 @@ TriangleMesh read_mesh(const std::string& path) {
 namespace {
 
 // half_edge_mesh for a mesh in memory: faces and vertices named by their 0-based indices.
-IoMesh half_edge_mesh_in_memory(const std::string& name, const std::string& prefix, const TriangleMesh& mesh) {
+IoMesh half_edge_mesh_in_memory(const std::string& name, const std::string& prefix,
+                                const TriangleMesh& mesh) {
   return half_edge_mesh(
       name, prefix, mesh, [](Eigen::Index f) { return "face " + std::to_string(f); },
       [](int v) { return std::to_string(v); });
@@ -774,25 +832,32 @@ namespace {
 // OFF, OBJ and PLY are written here rather than by OpenMesh, whose writers round coordinates to
 // float: with 17 significant digits a text file reproduces every double, and binary PLY stores
 // doubles. An ASCII PLY body is line for line an OFF body; only their headers differ.
-bool write_exact(const fs::path& file, const TriangleMesh& mesh, const std::string& ext, bool binary) {
+bool write_exact(const fs::path& file, const TriangleMesh& mesh, const std::string& ext,
+                 bool binary) {
   std::FILE* out = std::fopen(file.c_str(), "wb");
   if (!out) return false;
   std::vector<char> buffer(1 << 20);
   std::setvbuf(out, buffer.data(), _IOFBF, buffer.size());
   const bool obj = ext == ".obj";
   const long long nv = mesh.num_vertices(), nf = mesh.num_faces();
-  if (ext == ".ply") std::fputs(ply_header(mesh, binary).c_str(), out);
-  else if (obj) std::fprintf(out, "# %lld vertices, %lld faces\n", nv, nf);
-  else std::fprintf(out, "OFF\n%lld %lld 0\n", nv, nf);
+  if (ext == ".ply")
+    std::fputs(ply_header(mesh, binary).c_str(), out);
+  else if (obj)
+    std::fprintf(out, "# %lld vertices, %lld faces\n", nv, nf);
+  else
+    std::fprintf(out, "OFF\n%lld %lld 0\n", nv, nf);
   if (ext == ".ply" && binary) {
     write_ply_binary_body(out, mesh);
   } else {
     for (Eigen::Index v = 0; v < nv; ++v)
-      std::fprintf(out, obj ? "v %.17g %.17g %.17g\n" : "%.17g %.17g %.17g\n", mesh.vertices(v, 0), mesh.vertices(v, 1),
-                   mesh.vertices(v, 2));
+      std::fprintf(out, obj ? "v %.17g %.17g %.17g\n" : "%.17g %.17g %.17g\n", mesh.vertices(v, 0),
+                   mesh.vertices(v, 1), mesh.vertices(v, 2));
     for (Eigen::Index f = 0; f < nf; ++f) {
-      if (obj) std::fprintf(out, "f %d %d %d\n", mesh.faces(f, 0) + 1, mesh.faces(f, 1) + 1, mesh.faces(f, 2) + 1);
-      else std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
+      if (obj)
+        std::fprintf(out, "f %d %d %d\n", mesh.faces(f, 0) + 1, mesh.faces(f, 1) + 1,
+                     mesh.faces(f, 2) + 1);
+      else
+        std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
     }
   }
   const bool ok = std::ferror(out) == 0;

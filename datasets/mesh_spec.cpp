@@ -50,35 +50,47 @@ struct Generator {
   std::function<double(const Values&)> faces;
 };
 
-int as_int(const Values& v, const std::string& k) { return static_cast<int>(v.at(k)); }
+int as_int(const Values& v, const std::string& k) {
+  return static_cast<int>(v.at(k));
+}
 
 const std::vector<Generator>& generators() {
   static const std::vector<Generator> table = {
       {"sphere",
        {{"vertices", true, 10242, "target vertex count"}, {"radius", false, 1.0, "radius"}},
-       [](const Values& v) { return make_sphere(static_cast<long long>(v.at("vertices")), v.at("radius")); },
+       [](const Values& v) {
+         return make_sphere(static_cast<long long>(v.at("vertices")), v.at("radius"));
+       },
        "geodesic sphere with about `vertices` vertices, centred at the origin",
        [](const Values& v) { return 2 * v.at("vertices"); }},
       {"icosphere",
-       {{"level", true, 5, "1-to-4 subdivisions of the icosahedron", 12}, {"radius", false, 1.0, "radius"}},
+       {{"level", true, 5, "1-to-4 subdivisions of the icosahedron", 12},
+        {"radius", false, 1.0, "radius"}},
        [](const Values& v) { return make_icosphere(as_int(v, "level"), v.at("radius")); },
        "icosahedron subdivided `level` times (10*4^level+2 vertices)",
        [](const Values& v) { return 20 * std::pow(4.0, v.at("level")); }},
       {"torus",
-       {{"R", false, 1.0, "major radius"}, {"r", false, 0.3, "minor radius"},
-        {"n_major", true, 96, "segments around the axis"}, {"n_minor", true, 32, "segments around the tube"}},
-       [](const Values& v) { return make_torus(v.at("R"), v.at("r"), as_int(v, "n_major"), as_int(v, "n_minor")); },
+       {{"R", false, 1.0, "major radius"},
+        {"r", false, 0.3, "minor radius"},
+        {"n_major", true, 96, "segments around the axis"},
+        {"n_minor", true, 32, "segments around the tube"}},
+       [](const Values& v) {
+         return make_torus(v.at("R"), v.at("r"), as_int(v, "n_major"), as_int(v, "n_minor"));
+       },
        "torus about z (genus 1)",
        [](const Values& v) { return 2 * v.at("n_major") * v.at("n_minor"); }},
       {"spiral",
-       {{"turns", true, 3, "turns"}, {"segments_per_turn", true, 128, "segments along one turn"},
+       {{"turns", true, 3, "turns"},
+        {"segments_per_turn", true, 128, "segments along one turn"},
         {"profile_segments", true, 8, "segments across the ribbon"}},
        [](const Values& v) {
-         return make_cubical_spiral(as_int(v, "turns"), as_int(v, "segments_per_turn"), as_int(v, "profile_segments"));
+         return make_cubical_spiral(as_int(v, "turns"), as_int(v, "segments_per_turn"),
+                                    as_int(v, "profile_segments"));
        },
        "cubical spiral: square-profile helical ribbon with boundary",
        [](const Values& v) {
-         return 2 * 4 * std::ceil(v.at("segments_per_turn") / 4) * v.at("turns") * v.at("profile_segments");
+         return 2 * 4 * std::ceil(v.at("segments_per_turn") / 4) * v.at("turns") *
+                v.at("profile_segments");
        }},
       {"dumbbell",
        {{"resolution", true, 64, "vertices around"}},
@@ -86,27 +98,36 @@ const std::vector<Generator>& generators() {
        "two unit spheres joined by a thin neck (genus 0)",
        [](const Values& v) { return 2 * v.at("resolution") * v.at("resolution"); }},
       {"rounded_cylinder",
-       {{"radius", false, 0.5, "radius"}, {"length", false, 2.0, "length of the straight part"},
+       {{"radius", false, 0.5, "radius"},
+        {"length", false, 2.0, "length of the straight part"},
         {"resolution", true, 64, "vertices around"}},
-       [](const Values& v) { return make_rounded_cylinder(v.at("radius"), v.at("length"), as_int(v, "resolution")); },
+       [](const Values& v) {
+         return make_rounded_cylinder(v.at("radius"), v.at("length"), as_int(v, "resolution"));
+       },
        "closed capsule (cylinder with hemispherical caps)",
        [](const Values& v) {  // rings spaced as the widest ring's vertices along the profile
          const double n = v.at("resolution"), r = v.at("radius"), l = v.at("length");
          return 2 * n * (n * (std::numbers::pi * r + l) / (2 * std::numbers::pi * r) + 1);
        }},
       {"open_cylinder",
-       {{"radius", false, 0.5, "radius"}, {"length", false, 2.0, "length"},
-        {"n_around", true, 64, "vertices around"}, {"n_along", true, 40, "segments along"}},
+       {{"radius", false, 0.5, "radius"},
+        {"length", false, 2.0, "length"},
+        {"n_around", true, 64, "vertices around"},
+        {"n_along", true, 40, "segments along"}},
        [](const Values& v) {
-         return make_open_cylinder(v.at("radius"), v.at("length"), as_int(v, "n_around"), as_int(v, "n_along"));
+         return make_open_cylinder(v.at("radius"), v.at("length"), as_int(v, "n_around"),
+                                   as_int(v, "n_along"));
        },
        "open cylinder (two boundary loops)",
        [](const Values& v) { return 2 * v.at("n_around") * v.at("n_along"); }},
       {"catenoid",
-       {{"waist", false, 1.0, "waist radius"}, {"height", false, 1.0, "half height h (z in [-h, h])"},
-        {"n_around", true, 64, "vertices around"}, {"n_along", true, 24, "segments along"}},
+       {{"waist", false, 1.0, "waist radius"},
+        {"height", false, 1.0, "half height h (z in [-h, h])"},
+        {"n_around", true, 64, "vertices around"},
+        {"n_along", true, 24, "segments along"}},
        [](const Values& v) {
-         return make_catenoid(v.at("waist"), v.at("height"), as_int(v, "n_around"), as_int(v, "n_along"));
+         return make_catenoid(v.at("waist"), v.at("height"), as_int(v, "n_around"),
+                              as_int(v, "n_along"));
        },
        "catenoid (minimal surface, two boundary loops)",
        [](const Values& v) { return 2 * v.at("n_around") * v.at("n_along"); }},
@@ -133,7 +154,8 @@ bool looks_like_file(const std::string& s) {
 
 // Whole-string numbers only: "12abc", "", "1e400" and "nan" are errors, and so is "1.5" for an
 // integer key.
-double parse_number(const std::string& spec, const std::string& key, const std::string& text, bool integer) {
+double parse_number(const std::string& spec, const std::string& key, const std::string& text,
+                    bool integer) {
   const char* begin = text.c_str();
   char* end = nullptr;
   errno = 0;
@@ -145,7 +167,8 @@ double parse_number(const std::string& spec, const std::string& key, const std::
     value = std::strtod(begin, &end);
   }
   if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(value))
-    fail(spec, "key '" + key + "' needs " + (integer ? "an integer" : "a number") + ", got '" + text + "'");
+    fail(spec, "key '" + key + "' needs " + (integer ? "an integer" : "a number") + ", got '" +
+                   text + "'");
   return value;
 }
 
@@ -173,7 +196,8 @@ void fit_unit_cube(TriangleMesh& mesh) {
   // anywhere and keep their place relative to the surface.
   for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
     auto p = mesh.vertices.row(v);
-    if ((p.array() >= -1e-12).all() && (p.array() <= 1.0 + 1e-12).all()) p = p.cwiseMax(0.0).cwiseMin(1.0);
+    if ((p.array() >= -1e-12).all() && (p.array() <= 1.0 + 1e-12).all())
+      p = p.cwiseMax(0.0).cwiseMin(1.0);
   }
 }
 
@@ -193,7 +217,8 @@ MeshSource load_mesh_spec(const std::string& spec) {
       fail(spec, "unknown modifier key '" + key + "' (only @faces=N)");
     target_faces = static_cast<long long>(parse_number(spec, "faces", mod.substr(eq + 1), true));
     if (target_faces < 1 || target_faces > kMaxFaces)
-      fail(spec, "key 'faces' must be in 1.." + std::to_string(kMaxFaces) + ", got " + mod.substr(eq + 1));
+      fail(spec, "key 'faces' must be in 1.." + std::to_string(kMaxFaces) + ", got " +
+                     mod.substr(eq + 1));
   }
   if (head.empty()) fail(spec, "empty mesh spec");
 
@@ -218,7 +243,8 @@ MeshSource load_mesh_spec(const std::string& spec) {
       fit_unit_cube(src.mesh);
     } else {
       const auto& table = generators();
-      auto g = std::find_if(table.begin(), table.end(), [&](const Generator& x) { return x.name == name; });
+      auto g = std::find_if(table.begin(), table.end(),
+                            [&](const Generator& x) { return x.name == name; });
       if (g == table.end()) {
         std::string known = "cgal";
         for (const auto& x : table) known += ", " + x.name;
@@ -235,23 +261,28 @@ MeshSource load_mesh_spec(const std::string& spec) {
         const auto eq = item.find('=');
         const std::string key = item.substr(0, eq);
         if (eq == std::string::npos || key.empty())
-          fail(spec, "expected key=value, got '" + item + "' (keys of " + name + ": " + param_list(*g) + ")");
-        auto p = std::find_if(g->params.begin(), g->params.end(), [&](const Param& x) { return x.key == key; });
+          fail(spec, "expected key=value, got '" + item + "' (keys of " + name + ": " +
+                         param_list(*g) + ")");
+        auto p = std::find_if(g->params.begin(), g->params.end(),
+                              [&](const Param& x) { return x.key == key; });
         if (p == g->params.end())
           fail(spec, "unknown key '" + key + "' for " + name + " (keys: " + param_list(*g) + ")");
-        if (std::find(seen.begin(), seen.end(), key) != seen.end()) fail(spec, "key '" + key + "' given twice");
+        if (std::find(seen.begin(), seen.end(), key) != seen.end())
+          fail(spec, "key '" + key + "' given twice");
         seen.push_back(key);
         values[key] = parse_number(spec, key, item.substr(eq + 1), p->integer);
         if (p->integer && std::abs(values[key]) > p->max)
-          fail(spec, "key '" + key + "' is out of range (at most " + std::to_string(static_cast<long long>(p->max)) +
-                         "), got " + item.substr(eq + 1));
+          fail(spec, "key '" + key + "' is out of range (at most " +
+                         std::to_string(static_cast<long long>(p->max)) + "), got " +
+                         item.substr(eq + 1));
       }
       // Values the generators refuse (a count or size <= 0) are theirs to name; a size that would
       // overflow their int counts or exhaust memory is refused here, before anything is built.
       if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second > 0; })) {
         const double faces = g->faces(values);
         if (!(faces <= static_cast<double>(kMaxFaces)))
-          fail(spec, "these values make about " + std::to_string(static_cast<long long>(std::min(faces, 1e18))) +
+          fail(spec, "these values make about " +
+                         std::to_string(static_cast<long long>(std::min(faces, 1e18))) +
                          " faces, more than the " + std::to_string(kMaxFaces) + " a mesh may have");
       }
       src.kind = name;
@@ -279,7 +310,8 @@ MeshSource load_mesh_spec(const std::string& spec) {
   if (target_faces > 0) {
     src.mesh = subdivide_to_faces(src.mesh, target_faces);
     // Midpoints of a sphere lie inside it; put them back so sphere_radius stays exact.
-    if (src.sphere_radius) src.mesh.vertices = src.mesh.vertices.rowwise().normalized() * *src.sphere_radius;
+    if (src.sphere_radius)
+      src.mesh.vertices = src.mesh.vertices.rowwise().normalized() * *src.sphere_radius;
     // Likewise chord midpoints around a cylinder: back onto radius r about the z axis.
     if (src.cylinder_radius)
       for (Eigen::Index v = 0; v < src.mesh.vertices.rows(); ++v) {
@@ -294,7 +326,8 @@ MeshSource load_mesh_spec(const std::string& spec) {
 
 std::string mesh_spec_help() {
   std::string s =
-      "Mesh specs: NAME[:key=value,...][@faces=N] | cgal:MODEL[@faces=N] | path/to/file.{off,ply,obj,stl}[@faces=N]\n"
+      "Mesh specs: NAME[:key=value,...][@faces=N] | cgal:MODEL[@faces=N] | "
+      "path/to/file.{off,ply,obj,stl}[@faces=N]\n"
       "  @faces=N subdivides 1-to-4 until at least N faces. Files and cgal models are scaled\n"
       "  uniformly into the unit cube; generated shapes keep their size.\n"
       "Generators:\n";

@@ -20,12 +20,12 @@ struct MeshSource {
   /// Its faces hold in a half-edge mesh (read_mesh or load_mesh_spec checked them; subdivision
   /// keeps that), so writers may pass FaceCheck::trusted for it and its flowed copies.
   TriangleMesh mesh;
-  std::string spec;           ///< as given
-  std::string kind;           ///< "sphere", "icosphere", "cgal", "file", ...
-  bool analytic = false;      ///< generated shape (keeps its size); real models are unit-cube scaled
-  std::optional<double> sphere_radius;  ///< set for sphere and icosphere (centre at the origin)
+  std::string spec;       ///< as given
+  std::string kind;       ///< "sphere", "icosphere", "cgal", "file", ...
+  bool analytic = false;  ///< generated shape (keeps its size); real models are unit-cube scaled
+  std::optional<double> sphere_radius;    ///< set for sphere and icosphere (centre at the origin)
   std::optional<double> cylinder_radius;  ///< set for open_cylinder (axis z through the origin)
-  MeshReport report;          ///< validation report (validate_mesh has passed)
+  MeshReport report;                      ///< validation report (validate_mesh has passed)
 };
 
 /// Parses the spec, builds/loads, scales real models to the unit cube, subdivides to @faces,

@@ -29,7 +29,17 @@ enum class Encoding { Ascii, LittleEndian, BigEndian };
 
 // The scalar types, both spellings of the format: the original (char, uchar, ...) and the sized
 // one (int8, uint8, ...). Resolved once from the header, so the body's values switch on an enum.
-enum class Scalar : unsigned char { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64, None };
+enum class Scalar : unsigned char {
+  Int8,
+  UInt8,
+  Int16,
+  UInt16,
+  Int32,
+  UInt32,
+  Float32,
+  Float64,
+  None
+};
 
 Scalar scalar_type(const std::string& t) {
   if (t == "char" || t == "int8") return Scalar::Int8;
@@ -45,11 +55,20 @@ Scalar scalar_type(const std::string& t) {
 
 int scalar_size(Scalar t) {
   switch (t) {
-    case Scalar::Int8: case Scalar::UInt8: return 1;
-    case Scalar::Int16: case Scalar::UInt16: return 2;
-    case Scalar::Int32: case Scalar::UInt32: case Scalar::Float32: return 4;
-    case Scalar::Float64: return 8;
-    case Scalar::None: break;
+    case Scalar::Int8:
+    case Scalar::UInt8:
+      return 1;
+    case Scalar::Int16:
+    case Scalar::UInt16:
+      return 2;
+    case Scalar::Int32:
+    case Scalar::UInt32:
+    case Scalar::Float32:
+      return 4;
+    case Scalar::Float64:
+      return 8;
+    case Scalar::None:
+      break;
   }
   return 0;
 }
@@ -86,7 +105,8 @@ Header parse_header(const std::string& path, const std::string& data) {
     if (pos >= data.size()) fail(line_number, "the header has no end_header line");
     const std::size_t eol = data.find('\n', pos);
     // Words are read with >>, which skips blanks and the '\r' of a CRLF file.
-    const std::string line = data.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos);
+    const std::string line =
+        data.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos);
     pos = eol == std::string::npos ? data.size() : eol + 1;
     ++line_number;
     std::istringstream ls(line);
@@ -106,14 +126,20 @@ Header parse_header(const std::string& path, const std::string& data) {
     if (word == "format") {
       std::string encoding, version;
       ls >> encoding >> version;
-      if (encoding == "ascii") h.encoding = Encoding::Ascii;
-      else if (encoding == "binary_little_endian") h.encoding = Encoding::LittleEndian;
-      else if (encoding == "binary_big_endian") h.encoding = Encoding::BigEndian;
-      else fail(line_number, "unknown format '" + encoding + "' (ascii, binary_little_endian, binary_big_endian)");
+      if (encoding == "ascii")
+        h.encoding = Encoding::Ascii;
+      else if (encoding == "binary_little_endian")
+        h.encoding = Encoding::LittleEndian;
+      else if (encoding == "binary_big_endian")
+        h.encoding = Encoding::BigEndian;
+      else
+        fail(line_number,
+             "unknown format '" + encoding + "' (ascii, binary_little_endian, binary_big_endian)");
       have_format = true;
     } else if (word == "element") {
       Element e;
-      if (!(ls >> e.name >> e.count) || e.count < 0) fail(line_number, "bad element line '" + line + "'");
+      if (!(ls >> e.name >> e.count) || e.count < 0)
+        fail(line_number, "bad element line '" + line + "'");
       h.elements.push_back(e);
     } else if (word == "property") {
       if (h.elements.empty()) fail(line_number, "property before any element");
@@ -121,7 +147,8 @@ Header parse_header(const std::string& path, const std::string& data) {
       std::string first, count_type, type;
       ls >> first;
       const bool list = first == "list";
-      if (list) ls >> count_type >> type >> p.name;
+      if (list)
+        ls >> count_type >> type >> p.name;
       else {
         type = first;
         ls >> p.name;
@@ -143,9 +170,13 @@ Header parse_header(const std::string& path, const std::string& data) {
 class BodyReader {
  public:
   BodyReader(const std::string& path, const std::string& data, const Header& h)
-      : path_(path), data_(data), encoding_(h.encoding), pos_(h.body_offset), line_(h.body_line),
-        swap_(h.encoding != Encoding::Ascii &&
-              (h.encoding == Encoding::LittleEndian) != (std::endian::native == std::endian::little)) {}
+      : path_(path),
+        data_(data),
+        encoding_(h.encoding),
+        pos_(h.body_offset),
+        line_(h.body_line),
+        swap_(h.encoding != Encoding::Ascii && (h.encoding == Encoding::LittleEndian) !=
+                                                   (std::endian::native == std::endian::little)) {}
 
   /// What the next values are, for error messages only (composed by what(), on failure).
   enum class Part { value, list_length, corner };
@@ -160,7 +191,8 @@ class BodyReader {
     part_ = part;
     corner_ = corner;
     const double v = encoding_ == Encoding::Ascii ? next_text(/*integer=*/true) : next_binary(type);
-    if (encoding_ != Encoding::Ascii && v != std::floor(v)) fail(what() + " is not an integer (" + std::to_string(v) + ")");
+    if (encoding_ != Encoding::Ascii && v != std::floor(v))
+      fail(what() + " is not an integer (" + std::to_string(v) + ")");
     part_ = Part::value;
     return static_cast<long long>(v);
   }
@@ -178,26 +210,34 @@ class BodyReader {
   void end_record() {
     if (encoding_ != Encoding::Ascii || record_values_ == 0) return;
     std::size_t p = pos_;
-    while (p < data_.size() && data_[p] != '\n' && std::isspace(static_cast<unsigned char>(data_[p]))) ++p;
+    while (p < data_.size() && data_[p] != '\n' &&
+           std::isspace(static_cast<unsigned char>(data_[p])))
+      ++p;
     if (p < data_.size() && data_[p] != '\n')
-      throw MeshError(path_ + ": line " + std::to_string(line_) + ": " + record() + " has more values than its " +
-                      std::to_string(record_values_) + " declared in the header");
+      throw MeshError(path_ + ": line " + std::to_string(line_) + ": " + record() +
+                      " has more values than its " + std::to_string(record_values_) +
+                      " declared in the header");
   }
   /// "line 12" (ASCII) or "byte 4711" (binary): where the last value read began.
   std::string where() const {
-    return encoding_ == Encoding::Ascii ? "line " + std::to_string(token_line_) : "byte " + std::to_string(token_pos_);
+    return encoding_ == Encoding::Ascii ? "line " + std::to_string(token_line_)
+                                        : "byte " + std::to_string(token_pos_);
   }
-  [[noreturn]] void fail(const std::string& problem) const { throw MeshError(path_ + ": " + where() + ": " + problem); }
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw MeshError(path_ + ": " + where() + ": " + problem);
+  }
   [[noreturn]] void fail_at_end() const {
     throw MeshError(path_ + ": the file ends at " +
-                    (encoding_ == Encoding::Ascii ? "line " + std::to_string(line_) : "byte " + std::to_string(data_.size())) +
+                    (encoding_ == Encoding::Ascii ? "line " + std::to_string(line_)
+                                                  : "byte " + std::to_string(data_.size())) +
                     " before " + record() + " is complete");
   }
 
  private:
   // "face 1 corner 2", "face 1 of 4 (list length)" or "face 1 of 4".
   std::string what() const {
-    if (part_ == Part::corner) return element_->name + " " + std::to_string(index_) + " corner " + std::to_string(corner_);
+    if (part_ == Part::corner)
+      return element_->name + " " + std::to_string(index_) + " corner " + std::to_string(corner_);
     return record() + (part_ == Part::list_length ? " (list length)" : "");
   }
 
@@ -208,8 +248,9 @@ class BodyReader {
     }
     if (pos_ >= data_.size()) fail_at_end();
     if (record_values_ > 0 && line_ != token_line_)
-      throw MeshError(path_ + ": line " + std::to_string(token_line_) + ": " + record() + " ends after " +
-                      std::to_string(record_values_) + " values (the header declares more)");
+      throw MeshError(path_ + ": line " + std::to_string(token_line_) + ": " + record() +
+                      " ends after " + std::to_string(record_values_) +
+                      " values (the header declares more)");
     ++record_values_;
     token_line_ = line_;
     token_pos_ = pos_;
@@ -221,9 +262,11 @@ class BodyReader {
     const char* last = data_.c_str() + stop;
     pos_ = stop;
     char* end = nullptr;
-    const double v = integer ? static_cast<double>(std::strtoll(first, &end, 10)) : std::strtod(first, &end);
+    const double v =
+        integer ? static_cast<double>(std::strtoll(first, &end, 10)) : std::strtod(first, &end);
     if (end != last)
-      fail(what() + ": '" + std::string(first, last) + (integer ? "' is not an integer" : "' cannot be parsed as a number"));
+      fail(what() + ": '" + std::string(first, last) +
+           (integer ? "' is not an integer" : "' cannot be parsed as a number"));
     return v;
   }
 
@@ -242,15 +285,24 @@ class BodyReader {
       return static_cast<double>(v);
     };
     switch (type) {
-      case Scalar::Int8: return as(std::int8_t{});
-      case Scalar::UInt8: return as(std::uint8_t{});
-      case Scalar::Int16: return as(std::int16_t{});
-      case Scalar::UInt16: return as(std::uint16_t{});
-      case Scalar::Int32: return as(std::int32_t{});
-      case Scalar::UInt32: return as(std::uint32_t{});
-      case Scalar::Float32: return as(float{});
-      case Scalar::Float64: return as(double{});
-      case Scalar::None: break;
+      case Scalar::Int8:
+        return as(std::int8_t{});
+      case Scalar::UInt8:
+        return as(std::uint8_t{});
+      case Scalar::Int16:
+        return as(std::int16_t{});
+      case Scalar::UInt16:
+        return as(std::uint16_t{});
+      case Scalar::Int32:
+        return as(std::int32_t{});
+      case Scalar::UInt32:
+        return as(std::uint32_t{});
+      case Scalar::Float32:
+        return as(float{});
+      case Scalar::Float64:
+        return as(double{});
+      case Scalar::None:
+        break;
     }
     return 0.0;  // not reached: the header admits known types only
   }
@@ -292,11 +344,14 @@ WalkedMesh scan_ply(const std::string& path) {
       if (p.name == std::string(1, char('x' + c)) && !p.is_list()) axis_of[c] = static_cast<int>(i);
   }
   for (int c = 0; c < 3; ++c)
-    if (axis_of[c] < 0) throw MeshError(path + ": the vertex element has no scalar property '" + std::string(1, char('x' + c)) + "'");
+    if (axis_of[c] < 0)
+      throw MeshError(path + ": the vertex element has no scalar property '" +
+                      std::string(1, char('x' + c)) + "'");
 
   // Every value takes at least one byte (a digit, or a binary char), so a count beyond that is a
   // broken header; checked before the coordinates are allocated.
-  if (static_cast<double>(vertex->count) * vertex->properties.size() > static_cast<double>(data.size() - header.body_offset))
+  if (static_cast<double>(vertex->count) * vertex->properties.size() >
+      static_cast<double>(data.size() - header.body_offset))
     throw MeshError(path + ": the header declares " + std::to_string(vertex->count) +
                     " vertices, more than the file's body can hold");
   if (vertex->count > std::numeric_limits<int>::max())
@@ -312,7 +367,8 @@ WalkedMesh scan_ply(const std::string& path) {
     int corner_list = -1;
     if (e.name == "face")
       for (std::size_t i = 0; i < e.properties.size(); ++i)
-        if (e.properties[i].is_list() && (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
+        if (e.properties[i].is_list() &&
+            (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
           corner_list = static_cast<int>(i);
     if (e.name == "face" && corner_list < 0 && e.count > 0)
       throw MeshError(path + ": the face element has no list property 'vertex_indices'");
@@ -326,7 +382,8 @@ WalkedMesh scan_ply(const std::string& path) {
             for (int c = 0; c < 3; ++c)
               if (axis_of[c] == static_cast<int>(i)) {
                 if (!std::isfinite(v))
-                  body.fail("vertex " + std::to_string(r) + " has a non-finite coordinate " + p.name);
+                  body.fail("vertex " + std::to_string(r) + " has a non-finite coordinate " +
+                            p.name);
                 out.coords[3 * r + c] = v;
               }
           continue;
@@ -334,7 +391,9 @@ WalkedMesh scan_ply(const std::string& path) {
         const long long k = body.next_integer(p.count_type, BodyReader::Part::list_length);
         if (k < 0) body.fail(body.record() + ": negative list length " + std::to_string(k));
         const bool corners = static_cast<int>(i) == corner_list;
-        if (corners && k < 3) body.fail("face " + std::to_string(r) + " has " + std::to_string(k) + " corners (at least 3)");
+        if (corners && k < 3)
+          body.fail("face " + std::to_string(r) + " has " + std::to_string(k) +
+                    " corners (at least 3)");
         corner.clear();
         for (long long j = 0; j < k; ++j) {
           if (!corners) {
@@ -343,8 +402,8 @@ WalkedMesh scan_ply(const std::string& path) {
           }
           const long long index = body.next_integer(p.type, BodyReader::Part::corner, j);
           if (index < 0 || index >= vertex->count)
-            body.fail("face " + std::to_string(r) + " references vertex " + std::to_string(index) + " but the mesh has " +
-                      std::to_string(vertex->count) + " vertices");
+            body.fail("face " + std::to_string(r) + " references vertex " + std::to_string(index) +
+                      " but the mesh has " + std::to_string(vertex->count) + " vertices");
           corner.push_back(static_cast<int>(index));
         }
         if (!corners) continue;
@@ -361,8 +420,10 @@ WalkedMesh scan_ply(const std::string& path) {
 std::string ply_header(const TriangleMesh& mesh, bool binary) {
   return std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
          " 1.0\ncomment mcfbench: double-precision coordinates\nelement vertex " +
-         std::to_string(mesh.num_vertices()) + "\nproperty double x\nproperty double y\nproperty double z\nelement face " +
-         std::to_string(mesh.num_faces()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+         std::to_string(mesh.num_vertices()) +
+         "\nproperty double x\nproperty double y\nproperty double z\nelement face " +
+         std::to_string(mesh.num_faces()) +
+         "\nproperty list uchar int vertex_indices\nend_header\n";
 }
 
 void write_ply_binary_body(std::FILE* out, const TriangleMesh& mesh) {

@@ -39,7 +39,8 @@ inline Bounds bounds_of(const Positions& vertices, const std::vector<char>& refe
 
 /// Bounds of the vertices the faces use; of every vertex when there are no faces.
 inline Bounds surface_bounds(const TriangleMesh& mesh) {
-  if (mesh.num_faces() == 0) return {mesh.vertices.colwise().minCoeff(), mesh.vertices.colwise().maxCoeff()};
+  if (mesh.num_faces() == 0)
+    return {mesh.vertices.colwise().minCoeff(), mesh.vertices.colwise().maxCoeff()};
   return bounds_of(mesh.vertices, referenced_vertices(mesh.num_vertices(), mesh.faces));
 }
 

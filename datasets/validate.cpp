@@ -59,8 +59,12 @@ std::vector<EdgeUse> sorted_edge_uses(const Triangles& faces) {
   return uses;
 }
 
-int edge_a(std::uint64_t key) { return static_cast<int>(key >> 32); }
-int edge_b(std::uint64_t key) { return static_cast<int>(key & 0xffffffffu); }
+int edge_a(std::uint64_t key) {
+  return static_cast<int>(key >> 32);
+}
+int edge_b(std::uint64_t key) {
+  return static_cast<int>(key & 0xffffffffu);
+}
 
 double face_area(const TriangleMesh& mesh, Eigen::Index f) {
   const Eigen::Vector3d a = mesh.vertices.row(mesh.faces(f, 0));
@@ -97,7 +101,9 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
   // Degeneracy relative to the model's size: the studies mix unit-cube models and big analytic
   // shapes, so an absolute area threshold would be wrong for one of them.
   const std::vector<char> referenced = referenced_vertices(n, mesh.faces);
-  const double diag2 = bounds_of(mesh.vertices, referenced).extent().squaredNorm();  // a stray vertex is not the model's size
+  const double diag2 = bounds_of(mesh.vertices, referenced)
+                           .extent()
+                           .squaredNorm();  // a stray vertex is not the model's size
   const double min_area = 1e-14 * diag2;
   MeshReport report;
   report.vertices = n;
@@ -107,7 +113,8 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
     if (area == 0.0 || area <= min_area)
       fail(name, "face " + std::to_string(f) + " is degenerate (area " + std::to_string(area) +
                      ", vertices " + std::to_string(mesh.faces(f, 0)) + ", " +
-                     std::to_string(mesh.faces(f, 1)) + ", " + std::to_string(mesh.faces(f, 2)) + ")");
+                     std::to_string(mesh.faces(f, 1)) + ", " + std::to_string(mesh.faces(f, 2)) +
+                     ")");
     report.area += area;
   }
 
@@ -126,9 +133,10 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
     while (j < uses.size() && uses[j].key == uses[i].key) ++j;
     const int a = edge_a(uses[i].key), b = edge_b(uses[i].key);
     if (j - i > 2)
-      fail(name, "non-manifold edge (" + std::to_string(a) + ", " + std::to_string(b) + ") is shared by " +
-                     std::to_string(j - i) + " faces (" + std::to_string(uses[i].face) + ", " +
-                     std::to_string(uses[i + 1].face) + ", " + std::to_string(uses[i + 2].face) + ", ...)");
+      fail(name, "non-manifold edge (" + std::to_string(a) + ", " + std::to_string(b) +
+                     ") is shared by " + std::to_string(j - i) + " faces (" +
+                     std::to_string(uses[i].face) + ", " + std::to_string(uses[i + 1].face) + ", " +
+                     std::to_string(uses[i + 2].face) + ", ...)");
     if (j - i == 1) {
       boundary_uf.unite(a, b);
       on_boundary[a] = on_boundary[b] = 1;

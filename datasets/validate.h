@@ -18,7 +18,7 @@ struct MeshReport {
   long long boundary_loops = 0;
   long long connected_components = 0;
   long long euler_characteristic = 0;
-  long long genus = 0;          ///< sum over components of (2 - χ_c - b_c) / 2
+  long long genus = 0;  ///< sum over components of (2 - χ_c - b_c) / 2
   double area = 0.0;
   /// Interior edges whose two faces traverse them in the same direction (0 for a consistently
   /// oriented mesh). Reported, not fatal: some real models are not orientable-consistent.

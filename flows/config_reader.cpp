@@ -20,13 +20,16 @@ nlohmann::json read_config_file(const std::string& path) {
   auto dotted = [&open] {
     std::string p;
     for (const Level& l : open) {
-      if (l.array) p += "[]";
-      else if (!l.key.empty()) p += (p.empty() ? "" : ".") + l.key;
+      if (l.array)
+        p += "[]";
+      else if (!l.key.empty())
+        p += (p.empty() ? "" : ".") + l.key;
     }
     return p;
   };
   std::string duplicate;
-  const nlohmann::json::parser_callback_t track = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+  const nlohmann::json::parser_callback_t track = [&](int, nlohmann::json::parse_event_t event,
+                                                      nlohmann::json& parsed) {
     using E = nlohmann::json::parse_event_t;
     if (event == E::object_start || event == E::array_start) {
       open.push_back(Level{event == E::array_start, "", {}});
@@ -34,7 +37,8 @@ nlohmann::json read_config_file(const std::string& path) {
       if (!open.empty()) open.pop_back();
     } else if (event == E::key && !open.empty()) {
       open.back().key = parsed.get<std::string>();
-      if (!open.back().keys.insert(open.back().key).second && duplicate.empty()) duplicate = dotted();
+      if (!open.back().keys.insert(open.back().key).second && duplicate.empty())
+        duplicate = dotted();
     }
     return true;
   };
@@ -46,7 +50,9 @@ nlohmann::json read_config_file(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {  // out_of_range.406: a number beyond double range
     throw ConfigError(path + ": " + (open.empty() ? std::string() : dotted() + ": ") + e.what());
   }
-  if (!duplicate.empty()) throw ConfigError(path + ": " + duplicate + ": key appears twice in one object (JSON would keep the last)");
+  if (!duplicate.empty())
+    throw ConfigError(path + ": " + duplicate +
+                      ": key appears twice in one object (JSON would keep the last)");
   return j;
 }
 
@@ -56,7 +62,9 @@ const nlohmann::json& ConfigReader::empty_object() {
 }
 
 ConfigReader::ConfigReader(const nlohmann::json& object, std::string source, std::string prefix)
-    : object_(object.is_null() ? empty_object() : object), source_(std::move(source)), prefix_(std::move(prefix)) {
+    : object_(object.is_null() ? empty_object() : object),
+      source_(std::move(source)),
+      prefix_(std::move(prefix)) {
   if (!object_.is_object())
     throw ConfigError(source_ + ": " + (prefix_.empty() ? std::string("config") : prefix_) +
                       ": expected an object, got " + object_.dump());
@@ -67,7 +75,7 @@ void ConfigReader::fail(const std::string& key, const std::string& what) const {
 }
 
 std::string ConfigReader::get_string(const std::string& key, const std::string& fallback,
-                                      const std::vector<std::string>& allowed) {
+                                     const std::vector<std::string>& allowed) {
   read_.insert(key);
   if (!object_.contains(key)) return fallback;
   const auto& v = object_.at(key);
@@ -97,14 +105,16 @@ double ConfigReader::get_number(const std::string& key, double fallback, double 
   return d;
 }
 
-long long ConfigReader::get_integer(const std::string& key, long long fallback, long long min, long long max) {
+long long ConfigReader::get_integer(const std::string& key, long long fallback, long long min,
+                                    long long max) {
   read_.insert(key);
   if (!object_.contains(key)) return fallback;
   const auto& v = object_.at(key);
   if (!v.is_number_integer()) fail(key, "expected an integer, got " + v.dump());
   const long long i = v.get<long long>();
   if (i < min || i > max)
-    fail(key, "value " + std::to_string(i) + " out of range [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    fail(key, "value " + std::to_string(i) + " out of range [" + std::to_string(min) + ", " +
+                  std::to_string(max) + "]");
   return i;
 }
 

@@ -27,7 +27,9 @@ class ConfigReader {
   /// `source` names the file (or "command line"); `prefix` is the dotted path of this object.
   ConfigReader(const nlohmann::json& object, std::string source, std::string prefix = "");
 
-  std::string path(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  std::string path(const std::string& key) const {
+    return prefix_.empty() ? key : prefix_ + "." + key;
+  }
   bool has(const std::string& key) const { return object_.contains(key); }
 
   std::string get_string(const std::string& key, const std::string& fallback,

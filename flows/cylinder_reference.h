@@ -20,22 +20,26 @@ namespace mcf {
 
 struct CylinderReference {
   double r0 = 1.0;
-  std::string flow;                 ///< "mcf", "cmcf" or "heat"
-  double discrete = 1.0;            ///< semi-implicit recursion after the steps so far
-  std::vector<Eigen::Index> ring;   ///< the input's vertices nearest to half height
+  std::string flow;                ///< "mcf", "cmcf" or "heat"
+  double discrete = 1.0;           ///< semi-implicit recursion after the steps so far
+  std::vector<Eigen::Index> ring;  ///< the input's vertices nearest to half height
 
   CylinderReference(double radius, std::string flow_name, const Positions& X0)
       : r0(radius), flow(std::move(flow_name)), discrete(radius) {
     const double zmid = 0.5 * (X0.col(2).minCoeff() + X0.col(2).maxCoeff());
     double nearest = std::numeric_limits<double>::infinity();
-    for (Eigen::Index i = 0; i < X0.rows(); ++i) nearest = std::min(nearest, std::abs(X0(i, 2) - zmid));
+    for (Eigen::Index i = 0; i < X0.rows(); ++i)
+      nearest = std::min(nearest, std::abs(X0(i, 2) - zmid));
     for (Eigen::Index i = 0; i < X0.rows(); ++i)
       if (std::abs(X0(i, 2) - zmid) <= nearest + 1e-9 * r0) ring.push_back(i);
   }
   void advance(double dt) {
-    if (flow == "heat") discrete = discrete / (1.0 + dt / (r0 * r0));
-    else if (flow == "cmcf") discrete = discrete * discrete / (discrete + dt / r0);
-    else discrete = discrete * discrete * discrete / (discrete * discrete + dt);
+    if (flow == "heat")
+      discrete = discrete / (1.0 + dt / (r0 * r0));
+    else if (flow == "cmcf")
+      discrete = discrete * discrete / (discrete + dt / r0);
+    else
+      discrete = discrete * discrete * discrete / (discrete * discrete + dt);
   }
   double continuous(double t) const {
     if (flow == "heat") return r0 * std::exp(-t / (r0 * r0));

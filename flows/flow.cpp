@@ -22,13 +22,18 @@ namespace mcf {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 int severity(SolveStatus s) {
   switch (s) {
-    case SolveStatus::converged: return 0;
-    case SolveStatus::max_iterations: return 1;
-    default: return 2;
+    case SolveStatus::converged:
+      return 0;
+    case SolveStatus::max_iterations:
+      return 1;
+    default:
+      return 2;
   }
 }
 
@@ -37,7 +42,11 @@ int severity(SolveStatus s) {
 class FlowStepContext final : public StepContext {
  public:
   FlowStepContext(Basis& basis, LinearSolver& solver, const std::string& flow, double dt)
-      : basis_(basis), solver_(solver), system_(std::make_unique<ReducedSystem>(basis, solver)), flow_(flow), dt_(dt) {}
+      : basis_(basis),
+        solver_(solver),
+        system_(std::make_unique<ReducedSystem>(basis, solver)),
+        flow_(flow),
+        dt_(dt) {}
 
   double dt() const override { return dt_; }
   const Coefficients& current() const override { return *x_; }
@@ -54,7 +63,9 @@ class FlowStepContext final : public StepContext {
   }
   // M and K are symmetric: a parallel, thread-count independent gather instead of Eigen's serial
   // scatter (solvers/symmetric_multiply.h).
-  Coefficients apply_mass(const Coefficients& X) const override { return symmetric_multiply(basis_.mass(), X); }
+  Coefficients apply_mass(const Coefficients& X) const override {
+    return symmetric_multiply(basis_.mass(), X);
+  }
   Coefficients apply_stiffness(const Coefficients& X) const override {
     return symmetric_multiply(basis_.stiffness(), X);
   }
@@ -119,7 +130,9 @@ nlohmann::json stats_json(const BasisStats& s) {
   return j;
 }
 
-bool all_finite(const Positions& V) { return V.allFinite(); }
+bool all_finite(const Positions& V) {
+  return V.allFinite();
+}
 
 }  // namespace
 
@@ -140,9 +153,11 @@ Normalization unit_area_normalization(const Positions& V, const Triangles& F) {
   return n;
 }
 
-FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const FlowObserver& observer) {
+FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
+                     const FlowObserver& observer) {
   const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
-  tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+  tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
+                                  std::size_t(threads));
   // CHOLMOD's BLAS has its own pool: capped alike, at what TBB can run (environment.blas_threads).
   const ScopedBlasThreads blas(std::min(threads, tbb::info::default_concurrency()));
 
@@ -181,7 +196,8 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
       free > solver->max_dimension())
     throw ConfigError(source.spec + ": solver: \"" + config.solver.name + "\" factorizes at most " +
                       std::to_string(solver->max_dimension()) + " functions and this basis has " +
-                      std::to_string(free) + " free ones; use \"cholmod\", \"pcg\" or \"multigrid\"");
+                      std::to_string(free) +
+                      " free ones; use \"cholmod\", \"pcg\" or \"multigrid\"");
   std::unique_ptr<Integrator> integrator = make_integrator(config.integrator, config.extrapolate);
   result["system"] = stats_json(basis->stats());
   result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);
@@ -194,9 +210,11 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
   const double area0 = surface_area(mesh);
   double previous_area = area0;
   std::optional<SphereReference> sphere;
-  if (source.sphere_radius && !config.normalize_area) sphere.emplace(*source.sphere_radius, config.flow == "heat");
+  if (source.sphere_radius && !config.normalize_area)
+    sphere.emplace(*source.sphere_radius, config.flow == "heat");
   std::optional<CylinderReference> cylinder;
-  if (source.cylinder_radius && !config.normalize_area) cylinder.emplace(*source.cylinder_radius, config.flow, V);
+  if (source.cylinder_radius && !config.normalize_area)
+    cylinder.emplace(*source.cylinder_radius, config.flow, V);
 
   if (observer.on_step) observer.on_step(0, 0.0, V);
   nlohmann::json steps = nlohmann::json::array();
@@ -228,12 +246,13 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
     Coefficients x_new = integrator->step(ctx);
     const SolveReport& worst = ctx.worst_;
     nlohmann::json record = {{"step", step}, {"t", t}};
-    record["solver"] = {{"iterations", ctx.iterations_},
-                        {"solves", ctx.solves_},
-                        {"residuals", ctx.residuals_per_solve_.empty() ? std::vector<double>{}
-                                                                      : ctx.residuals_per_solve_.back()},
-                        {"relative_residual", worst.relative_residual},
-                        {"status", to_string(worst.status)}};
+    record["solver"] = {
+        {"iterations", ctx.iterations_},
+        {"solves", ctx.solves_},
+        {"residuals", ctx.residuals_per_solve_.empty() ? std::vector<double>{}
+                                                       : ctx.residuals_per_solve_.back()},
+        {"relative_residual", worst.relative_residual},
+        {"status", to_string(worst.status)}};
     if (ctx.solves_ > 1) record["solver"]["residuals_per_solve"] = ctx.residuals_per_solve_;
     // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
     // Gauss-Seidel on a level), or why it failed.
@@ -247,12 +266,15 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
     // A stopping step is recorded with its seconds too (every step has them: the result.json
     // contract), then the flow stops.
     const auto stop_here = [&](const std::string& reason) {
-      record["seconds"] = {{"update", ctx.update_seconds_}, {"solve", ctx.solve_seconds_}, {"total", seconds_since(step_start)}};
+      record["seconds"] = {{"update", ctx.update_seconds_},
+                           {"solve", ctx.solve_seconds_},
+                           {"total", seconds_since(step_start)}};
       steps.push_back(record);
       stop(step, reason);
     };
     if (!worst.ok()) {
-      stop_here(std::string("solver: ") + to_string(worst.status) + (worst.message.empty() ? "" : " (" + worst.message + ")"));
+      stop_here(std::string("solver: ") + to_string(worst.status) +
+                (worst.message.empty() ? "" : " (" + worst.message + ")"));
       break;
     }
 
@@ -272,7 +294,8 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
       // MCF, cMCF and heat flow never increase the area; a step that grows it by more than 5%
       // is an unstable (explicit) step, not a flow.
       record["area"] = area;
-      stop_here("diverged: the area grew by " + std::to_string(int(std::lround(100 * (area / previous_area - 1)))) +
+      stop_here("diverged: the area grew by " +
+                std::to_string(int(std::lround(100 * (area / previous_area - 1)))) +
                 "% in one step (unstable time step)");
       break;
     }
@@ -322,7 +345,8 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const F
     steps.push_back(std::move(record));
     if (observer.on_step) observer.on_step(step, t, V);
   }
-  if (!result.contains("stop")) result["stop"] = {{"step", int(steps.size())}, {"reason", "completed"}};
+  if (!result.contains("stop"))
+    result["stop"] = {{"step", int(steps.size())}, {"reason", "completed"}};
   result["steps"] = std::move(steps);
   out.final_mesh = TriangleMesh{V, F};
   return out;

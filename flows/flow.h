@@ -18,11 +18,12 @@ struct FlowObserver {
 };
 
 struct FlowOutcome {
-  nlohmann::json result;   ///< status, stop, config, mesh, system, steps (no environment)
-  TriangleMesh final_mesh; ///< vertex order of the input kept
+  nlohmann::json result;    ///< status, stop, config, mesh, system, steps (no environment)
+  TriangleMesh final_mesh;  ///< vertex order of the input kept
 };
 
-FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source, const FlowObserver& observer = {});
+FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
+                     const FlowObserver& observer = {});
 
 /// Scales the mesh to unit area about its area-weighted centroid, moved to the origin:
 /// returns (scale, centroid) so the same map can be applied to coefficients (B-splines

@@ -27,10 +27,12 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   {
     auto s = r.child("solver");
     c.solver.name = s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "dense"});
-    c.solver.tolerance = s.get_number("tolerance", c.solver.tolerance, 0, 1);  // absent: -1, the solver's default
-    c.solver.max_iterations = int(s.get_integer("max_iterations", c.solver.max_iterations, 1, 100000000));
-    c.solver.preconditioner =
-        s.get_string("preconditioner", c.solver.preconditioner, {"none", "jacobi", "ichol", "multigrid"});
+    c.solver.tolerance =
+        s.get_number("tolerance", c.solver.tolerance, 0, 1);  // absent: -1, the solver's default
+    c.solver.max_iterations =
+        int(s.get_integer("max_iterations", c.solver.max_iterations, 1, 100000000));
+    c.solver.preconditioner = s.get_string("preconditioner", c.solver.preconditioner,
+                                           {"none", "jacobi", "ichol", "multigrid"});
     c.solver.cycle = s.get_string("cycle", c.solver.cycle, {"V", "W"});
     c.solver.cycles = int(s.get_integer("cycles", c.solver.cycles, 1, 10000));
     c.solver.smooth = int(s.get_integer("smooth", c.solver.smooth, 0, 1000));
@@ -85,20 +87,25 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   const bool rebuilt = c.basis == "octree" && c.octree.tracking == "rebuilt";
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
   if (c.basis != "hat" && c.mass != "consistent")
-    fail("mass", "\"" + c.mass + "\" applies to the hat basis only; the octree basis integrates its "
-                 "consistent mass matrix by cubature");
-  if (c.basis == "hat" && (c.solver.name == "multigrid" || c.solver.preconditioner == "multigrid") &&
+    fail("mass", "\"" + c.mass +
+                     "\" applies to the hat basis only; the octree basis integrates its "
+                     "consistent mass matrix by cubature");
+  if (c.basis == "hat" &&
+      (c.solver.name == "multigrid" || c.solver.preconditioner == "multigrid") &&
       (c.solver.name != "pcg" || c.solver.preconditioner == "multigrid"))
     fail("solver", "multigrid needs a hierarchy: use basis \"octree\" (the hat basis has none)");
   if (rebuilt && c.flow == "cmcf")
-    fail("flow", "cmcf keeps the stiffness of t=0, which needs a fixed basis; the rebuilt octree "
-                 "changes its functions every step (use octree.tracking \"tracked\" or basis \"hat\")");
+    fail("flow",
+         "cmcf keeps the stiffness of t=0, which needs a fixed basis; the rebuilt octree "
+         "changes its functions every step (use octree.tracking \"tracked\" or basis \"hat\")");
   if (rebuilt && c.flow == "heat")
-    fail("flow", "heat flow keeps the operators of t=0, which needs a fixed basis; the rebuilt "
-                 "octree changes its functions every step");
+    fail("flow",
+         "heat flow keeps the operators of t=0, which needs a fixed basis; the rebuilt "
+         "octree changes its functions every step");
   if (rebuilt && (c.integrator == "bdf2" || c.integrator == "crank-nicolson"))
-    fail("integrator", "two-step schemes need coefficients in one fixed basis; the rebuilt octree "
-                       "changes its functions every step");
+    fail("integrator",
+         "two-step schemes need coefficients in one fixed basis; the rebuilt octree "
+         "changes its functions every step");
 }
 
 void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::string& source) {
@@ -107,9 +114,10 @@ void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::
   // recentres the whole surface every step: the held boundary would move with it (a loop grew by
   // 24% in 8 steps of cMCF on the mannequin). The two contradict each other, so refuse.
   if (c.normalize_area && mesh.boundary_loops > 0)
-    throw ConfigError(source + ": normalize_area: the mesh has " + std::to_string(mesh.boundary_loops) +
-                      " boundary loop(s), held fixed through the flow, which rescaling to unit area every "
-                      "step would move; run an open surface without normalize_area");
+    throw ConfigError(
+        source + ": normalize_area: the mesh has " + std::to_string(mesh.boundary_loops) +
+        " boundary loop(s), held fixed through the flow, which rescaling to unit area every "
+        "step would move; run an open surface without normalize_area");
 }
 
 }  // namespace mcf

@@ -19,29 +19,31 @@ struct OctreeConfig {
 };
 
 struct SolverConfig {
-  std::string name = "cholmod";          ///< cholmod | pcg | multigrid | dense (LLT reference, small systems)
-  double tolerance = -1;                 ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
-  int max_iterations = 1000;             ///< PCG iteration cap
-  std::string preconditioner = "jacobi"; ///< PCG: none | jacobi | ichol | multigrid
-  std::string cycle = "W";               ///< multigrid: V | W
-  int cycles = 1;                        ///< multigrid cycles per solve
-  int smooth = 5;                        ///< Gauss–Seidel sweeps before and after (each)
+  std::string name =
+      "cholmod";  ///< cholmod | pcg | multigrid | dense (LLT reference, small systems)
+  double tolerance =
+      -1;  ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
+  int max_iterations = 1000;              ///< PCG iteration cap
+  std::string preconditioner = "jacobi";  ///< PCG: none | jacobi | ichol | multigrid
+  std::string cycle = "W";                ///< multigrid: V | W
+  int cycles = 1;                         ///< multigrid cycles per solve
+  int smooth = 5;                         ///< Gauss–Seidel sweeps before and after (each)
 };
 
 struct FlowConfig {
-  std::string mesh;                       ///< mesh spec (datasets/mesh_spec.h)
-  std::string flow = "mcf";               ///< mcf | cmcf | heat
-  std::string basis = "hat";              ///< hat | octree
-  std::string mass = "consistent";        ///< hat basis: consistent | lumped
+  std::string mesh;                 ///< mesh spec (datasets/mesh_spec.h)
+  std::string flow = "mcf";         ///< mcf | cmcf | heat
+  std::string basis = "hat";        ///< hat | octree
+  std::string mass = "consistent";  ///< hat basis: consistent | lumped
   OctreeConfig octree;
   SolverConfig solver;
   std::string integrator = "semi-implicit";  ///< see integrator_names()
-  bool extrapolate = true;                ///< CN/BDF2: operators at the extrapolated X* (else frozen at X_n)
+  bool extrapolate = true;  ///< CN/BDF2: operators at the extrapolated X* (else frozen at X_n)
   double dt = 1e-3;
   int steps = 10;
-  bool normalize_area = false;            ///< unit area, centroid at origin, before and after every step
-  int threads = 0;                        ///< 0 = all cores
-  int save_every = 0;                     ///< write frame_NNNN.ply every K steps (0 = never)
+  bool normalize_area = false;  ///< unit area, centroid at origin, before and after every step
+  int threads = 0;              ///< 0 = all cores
+  int save_every = 0;           ///< write frame_NNNN.ply every K steps (0 = never)
 };
 
 /// Reads a flow config strictly (unknown keys, wrong types, out-of-range values are errors that

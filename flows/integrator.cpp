@@ -41,7 +41,8 @@ class TwoStep : public Integrator {
   bool uses_previous() const override { return true; }
 
  protected:
-  virtual Coefficients two_step(StepContext& c, const Coefficients& x, const Coefficients& x_prev) = 0;
+  virtual Coefficients two_step(StepContext& c, const Coefficients& x,
+                                const Coefficients& x_prev) = 0;
   bool extrapolate_;
 };
 
@@ -52,7 +53,8 @@ class CrankNicolson final : public TwoStep {
   std::string name() const override { return "crank-nicolson"; }
 
  protected:
-  Coefficients two_step(StepContext& c, const Coefficients& x, const Coefficients& x_prev) override {
+  Coefficients two_step(StepContext& c, const Coefficients& x,
+                        const Coefficients& x_prev) override {
     c.evaluate_operators(extrapolate_ ? Coefficients(1.5 * x - 0.5 * x_prev) : x);
     const double h = 0.5 * c.dt();
     return c.solve(1.0, h, c.apply_mass(x) - h * c.apply_stiffness(x), x, x);
@@ -66,7 +68,8 @@ class Bdf2 final : public TwoStep {
   std::string name() const override { return "bdf2"; }
 
  protected:
-  Coefficients two_step(StepContext& c, const Coefficients& x, const Coefficients& x_prev) override {
+  Coefficients two_step(StepContext& c, const Coefficients& x,
+                        const Coefficients& x_prev) override {
     c.evaluate_operators(extrapolate_ ? Coefficients(2.0 * x - x_prev) : x);
     const Coefficients target = 2.0 * x - 0.5 * x_prev;
     return c.solve(1.5, c.dt(), c.apply_mass(target), x, Coefficients(2.0 * x - x_prev));
@@ -96,8 +99,8 @@ class Series2 final : public Integrator {
 }  // namespace
 
 const std::vector<std::string>& integrator_names() {
-  static const std::vector<std::string> names = {"explicit-euler", "semi-implicit", "crank-nicolson",
-                                                 "bdf2",           "taylor2",       "neumann2"};
+  static const std::vector<std::string> names = {
+      "explicit-euler", "semi-implicit", "crank-nicolson", "bdf2", "taylor2", "neumann2"};
   return names;
 }
 

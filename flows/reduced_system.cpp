@@ -13,7 +13,10 @@
 namespace mcf {
 
 ReducedSystem::ReducedSystem(const Basis& basis, LinearSolver& solver)
-    : basis_(basis), solver_(solver), base_fixed_(basis.locked_functions()), full_key_(new_pattern_key()) {
+    : basis_(basis),
+      solver_(solver),
+      base_fixed_(basis.locked_functions()),
+      full_key_(new_pattern_key()) {
   std::sort(base_fixed_.begin(), base_fixed_.end());
 }
 
@@ -23,8 +26,8 @@ bool ReducedSystem::shares_pattern(const SparseRef& M, const SparseRef& K) {
   return shares_pattern_ == 1;
 }
 
-Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, const Coefficients& fixed_values,
-                                  const Coefficients& warm) {
+Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
+                                  const Coefficients& fixed_values, const Coefficients& warm) {
   // Views: no copies (the bases keep both on one pattern's index arrays).
   const SparseView M = basis_.mass();
   const SparseView K = basis_.stiffness();
@@ -47,11 +50,13 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
       bool is_empty = true;
       for (int p = outer[c]; p < outer[c + 1] && is_empty; ++p)
         is_empty = (shared ? sum_entry(a, m[p], b, k[p]) : v[p]) == 0.0;
-      if (is_empty && !std::binary_search(base_fixed_.begin(), base_fixed_.end(), int(c))) empty.push_back(int(c));
+      if (is_empty && !std::binary_search(base_fixed_.begin(), base_fixed_.end(), int(c)))
+        empty.push_back(int(c));
     }
   }
   fixed_.clear();
-  std::set_union(base_fixed_.begin(), base_fixed_.end(), empty.begin(), empty.end(), std::back_inserter(fixed_));
+  std::set_union(base_fixed_.begin(), base_fixed_.end(), empty.begin(), empty.end(),
+                 std::back_inserter(fixed_));
 
   // The basis's pattern is fixed while this object lives (a rebuilt basis gets a new
   // ReducedSystem), so a pattern key lets the solver skip comparing it each step. No key when M
@@ -69,7 +74,8 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     return X;
   }
   if (shared) {
-    if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) sum_ = M;  // M's pattern is fixed
+    if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows())
+      sum_ = M;  // M's pattern is fixed
     sum_on_pattern(a, M, b, K, sum_);
   }
 
@@ -153,9 +159,10 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R, con
     double* rv = reduced_.valuePtr();
     const double* sv = sum_.valuePtr();
     const int* src = source_nz_.data();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_nz_.size(), 1 << 14), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) rv[i] = sv[src[i]];
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_nz_.size(), 1 << 14),
+                      [&](const auto& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) rv[i] = sv[src[i]];
+                      });
   }
   // Right-hand side: R_f - S_fl Y_l.
   Coefficients Yfixed = Coefficients::Zero(n, 3);
@@ -202,8 +209,8 @@ void ReducedSystem::rebuild_reduction(const SparseMatrix& S) {
     outer[j + 1] = int(inner.size());
   }
   const std::vector<double> zeros(inner.size(), 0.0);
-  reduced_ = Eigen::Map<const SparseMatrix>(nf, nf, Eigen::Index(inner.size()), outer.data(), inner.data(),
-                                            zeros.data());
+  reduced_ = Eigen::Map<const SparseMatrix>(nf, nf, Eigen::Index(inner.size()), outer.data(),
+                                            inner.data(), zeros.data());
   reduced_.makeCompressed();
 
   // Restrict the finest prolongation's rows (and the finest colours) to the free functions; on
@@ -238,7 +245,8 @@ void ReducedSystem::solve_after_set(const ConstMatrixRef& R, MatrixRef X) {
   // records report().message, and the solve's own report used to replace the note unseen.
   std::string note = std::move(report_.message);
   report_ = solver_.solve(R, X);
-  if (!note.empty()) report_.message = report_.message.empty() ? std::move(note) : note + "; " + report_.message;
+  if (!note.empty())
+    report_.message = report_.message.empty() ? std::move(note) : note + "; " + report_.message;
 }
 
 }  // namespace mcf

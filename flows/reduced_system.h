@@ -6,9 +6,9 @@
 // by a diagonal entry and a matching right-hand side, so the pattern does not change with them.
 // With no function held (a closed surface) M and K go to the solver as they are
 // (LinearSolver::set_matrix_sum), so the sum is not stored here as well.
-// The reduced pattern and the restricted hierarchy are rebuilt only when the eliminated set changes;
-// the basis's own pattern must stay fixed while a ReducedSystem lives (make a new one after a
-// rebuild).
+// The reduced pattern and the restricted hierarchy are rebuilt only when the eliminated set
+// changes; the basis's own pattern must stay fixed while a ReducedSystem lives (make a new one
+// after a rebuild).
 
 #include "bases/basis.h"
 #include "solvers/linear_solver.h"
@@ -38,18 +38,18 @@ class ReducedSystem {
 
   const Basis& basis_;
   LinearSolver& solver_;
-  std::vector<int> base_fixed_;        // from the basis (boundary)
-  std::vector<int> fixed_;             // sorted; last solve's held functions (locked + empty rows)
-  std::vector<int> eliminated_;        // sorted; those the current reduction leaves out
-  std::vector<int> free_;              // reduced index -> full index
-  std::vector<int> reduced_of_;        // full index -> reduced index or -1
-  std::vector<int> source_nz_;         // reduced nonzero -> nonzero of the full matrix
-  SparseMatrix sum_;                   // a M + b K: only while functions are held (else the solver's)
+  std::vector<int> base_fixed_;  // from the basis (boundary)
+  std::vector<int> fixed_;       // sorted; last solve's held functions (locked + empty rows)
+  std::vector<int> eliminated_;  // sorted; those the current reduction leaves out
+  std::vector<int> free_;        // reduced index -> full index
+  std::vector<int> reduced_of_;  // full index -> reduced index or -1
+  std::vector<int> source_nz_;   // reduced nonzero -> nonzero of the full matrix
+  SparseMatrix sum_;             // a M + b K: only while functions are held (else the solver's)
   SparseMatrix reduced_;
-  std::vector<SparseMatrix> prolongations_;            // finest one row-restricted
+  std::vector<SparseMatrix> prolongations_;  // finest one row-restricted
   std::vector<std::vector<std::uint8_t>> colours_;
   bool reduction_valid_ = false;
-  int shares_pattern_ = -1;            // M and K on one pattern? (-1: not yet checked)
+  int shares_pattern_ = -1;  // M and K on one pattern? (-1: not yet checked)
   // Pattern keys (HierarchyView::pattern_key): sum_ keeps M's pattern for every (a, b) when M
   // and K share it, and reduced_ keeps its pattern until the fixed set changes.
   std::uint64_t full_key_ = 0, reduced_key_ = 0;

@@ -21,9 +21,12 @@ OctreeOptions octree_options(const OctreeConfig& c, bool analytic) {
   o.refine_input = c.refine_input;
   // "auto": the unit cube for models normalised into it (the paper's setting), the tight cube
   // around analytic shapes (which keep their own size).
-  if (c.cube == "unit") o.cube = OctreeCube::unit;
-  else if (c.cube == "tight") o.cube = OctreeCube::tight;
-  else o.cube = analytic ? OctreeCube::tight : OctreeCube::automatic;
+  if (c.cube == "unit")
+    o.cube = OctreeCube::unit;
+  else if (c.cube == "tight")
+    o.cube = OctreeCube::tight;
+  else
+    o.cube = analytic ? OctreeCube::tight : OctreeCube::automatic;
   return o;
 }
 
@@ -38,9 +41,11 @@ MultigridOptions multigrid_options(const SolverConfig& c) {
 
 }  // namespace
 
-std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& mesh, bool analytic) {
+std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& mesh,
+                                  bool analytic) {
   if (config.basis == "hat")
-    return std::make_unique<HatBasis>(mesh, config.mass == "lumped" ? MassKind::lumped : MassKind::consistent);
+    return std::make_unique<HatBasis>(
+        mesh, config.mass == "lumped" ? MassKind::lumped : MassKind::consistent);
   if (config.basis == "octree") {
     const OctreeOptions o = octree_options(config.octree, analytic);
     if (config.octree.tracking == "rebuilt") return std::make_unique<RebuiltOctreeBasis>(mesh, o);
@@ -52,7 +57,8 @@ std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& 
 std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config) {
   if (config.name == "cholmod") return std::make_unique<CholmodSolver>();
   if (config.name == "dense") return std::make_unique<DenseLltSolver>();
-  if (config.name == "multigrid") return std::make_unique<MultigridSolver>(multigrid_options(config));
+  if (config.name == "multigrid")
+    return std::make_unique<MultigridSolver>(multigrid_options(config));
   if (config.name == "pcg") {
     PcgOptions o;
     o.relative_tolerance = config.tolerance;
@@ -63,9 +69,12 @@ std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config) {
       cycle.tolerance = 0;
       return std::make_unique<MultigridPcgSolver>(cycle, o);
     }
-    if (config.preconditioner == "none") o.preconditioner = PcgPreconditioner::none;
-    else if (config.preconditioner == "jacobi") o.preconditioner = PcgPreconditioner::jacobi;
-    else o.preconditioner = PcgPreconditioner::incomplete_cholesky;
+    if (config.preconditioner == "none")
+      o.preconditioner = PcgPreconditioner::none;
+    else if (config.preconditioner == "jacobi")
+      o.preconditioner = PcgPreconditioner::jacobi;
+    else
+      o.preconditioner = PcgPreconditioner::incomplete_cholesky;
     return std::make_unique<PcgSolver>(o);
   }
   throw std::invalid_argument("unknown solver \"" + config.name + "\"");

@@ -10,7 +10,8 @@
 
 namespace mcf {
 
-std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& mesh, bool analytic);
+std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& mesh,
+                                  bool analytic);
 std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config);
 
 }  // namespace mcf

@@ -12,8 +12,12 @@ ScopedBlasThreads::ScopedBlasThreads(int threads) : previous_(openblas_get_num_t
   if (threads > 0) openblas_set_num_threads(threads);
 }
 
-ScopedBlasThreads::~ScopedBlasThreads() { openblas_set_num_threads(previous_); }
+ScopedBlasThreads::~ScopedBlasThreads() {
+  openblas_set_num_threads(previous_);
+}
 
-int blas_threads() { return openblas_get_num_threads(); }
+int blas_threads() {
+  return openblas_get_num_threads();
+}
 
 }  // namespace mcf

@@ -77,7 +77,8 @@ bool CholmodSolver::same_pattern(const SparseRef& A) const {
     Long pos = p[j];
     for (int k = outer[j]; k < outer[j + 1]; ++k) {
       if (inner[k] < j) continue;
-      if (pos == p[j + 1] || i[pos] != inner[k] || gather_[static_cast<std::size_t>(pos)] != k) return false;
+      if (pos == p[j + 1] || i[pos] != inner[k] || gather_[static_cast<std::size_t>(pos)] != k)
+        return false;
       ++pos;
     }
     if (pos != p[j + 1]) return false;
@@ -152,9 +153,9 @@ SolveReport CholmodSolver::factorize(const SparseRef& A, std::uint64_t key, Fill
   ++factorizations_;
   const Long n = static_cast<Long>(A.rows());
   if (common_.status == CHOLMOD_NOT_POSDEF || (ok && static_cast<Long>(factor_->minor) < n)) {
-    return fail(SolveStatus::not_positive_definite,
-                "matrix not positive definite (pivot " + std::to_string(factor_->minor) + " of " +
-                    std::to_string(n) + ")");
+    return fail(SolveStatus::not_positive_definite, "matrix not positive definite (pivot " +
+                                                        std::to_string(factor_->minor) + " of " +
+                                                        std::to_string(n) + ")");
   }
   if (!ok || common_.status < CHOLMOD_OK) {
     return fail(SolveStatus::failed,
@@ -188,8 +189,8 @@ SolveReport CholmodSolver::set_matrix(const SparseMatrix& A, HierarchyView hiera
   });
 }
 
-SolveReport CholmodSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                                          HierarchyView hierarchy) {
+SolveReport CholmodSolver::set_matrix_sum(double a, const SparseRef& M, double b,
+                                          const SparseRef& K, HierarchyView hierarchy) {
   // Off one pattern: the default forms Eigen's general sum and calls set_matrix.
   if (!summable(M, K)) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
   factor_ok_ = false;
@@ -234,14 +235,14 @@ SolveReport CholmodSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) 
   b.dtype = CHOLMOD_DOUBLE;
 
   // All columns in one call; solve2 reuses x_/y_/e_ across calls instead of reallocating.
-  if (!cholmod_l_solve2(CHOLMOD_A, factor_, &b, nullptr, &x_, nullptr, &y_, &e_, &common_) ||
-      !x_)
+  if (!cholmod_l_solve2(CHOLMOD_A, factor_, &b, nullptr, &x_, nullptr, &y_, &e_, &common_) || !x_)
     return make_report(SolveStatus::failed,
                        "cholmod_solve failed (status " + std::to_string(common_.status) + ")");
 
   const auto* xs = static_cast<const double*>(x_->x);
   for (Long c = 0; c < k; ++c)
-    std::copy(xs + c * static_cast<Long>(x_->d), xs + c * static_cast<Long>(x_->d) + n, X.col(c).data());
+    std::copy(xs + c * static_cast<Long>(x_->d), xs + c * static_cast<Long>(x_->d) + n,
+              X.col(c).data());
 
   // True residual r = b - A x through the cached lower triangle (sdmult honours stype, so no
   // copy of the full A is kept).

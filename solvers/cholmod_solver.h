@@ -60,7 +60,7 @@ class CholmodSolver final : public LinearSolver {
  private:
   void free_all();
   bool same_pattern(const SparseRef& A) const;  // A of the cached size and nonzeros: exact
-  void build_lower(const SparseRef& A);  // new pattern: (re)build the cached lower triangle
+  void build_lower(const SparseRef& A);         // new pattern: (re)build the cached lower triangle
   /// Both set_matrix entries: analyzes A's pattern when it is new (key: the caller's
   /// pattern_key), lets `fill(x, gather, count)` write the lower triangle's values (x[e] from
   /// the caller's entry gather[e]; false when one is NaN/inf), then factorizes.
@@ -69,12 +69,12 @@ class CholmodSolver final : public LinearSolver {
   SolveReport fail(SolveStatus status, std::string message);  // records and reports a failure
 
   cholmod_common common_{};
-  cholmod_sparse* lower_ = nullptr;   // cached lower triangle of A (stype = -1)
+  cholmod_sparse* lower_ = nullptr;  // cached lower triangle of A (stype = -1)
   cholmod_factor* factor_ = nullptr;
-  cholmod_dense* x_ = nullptr;        // solve2 workspaces, reused across solves
+  cholmod_dense* x_ = nullptr;  // solve2 workspaces, reused across solves
   cholmod_dense* y_ = nullptr;
   cholmod_dense* e_ = nullptr;
-  cholmod_dense* r_ = nullptr;        // residual workspace
+  cholmod_dense* r_ = nullptr;  // residual workspace
 
   std::int64_t rows_ = -1;
   std::int64_t nonzeros_ = 0;  // of the full A the cached pattern came from

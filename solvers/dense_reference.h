@@ -20,10 +20,12 @@ SolveReport dense_llt_solve(const SparseMatrix& A, const Eigen::MatrixXd& B, Eig
 /// The same as a LinearSolver (factorizes in set_matrix, ignores the warm start).
 class DenseLltSolver final : public LinearSolver {
  public:
-  explicit DenseLltSolver(Eigen::Index max_dimension = kDenseMaxDimension) : max_dimension_(max_dimension) {}
+  explicit DenseLltSolver(Eigen::Index max_dimension = kDenseMaxDimension)
+      : max_dimension_(max_dimension) {}
   std::string name() const override { return "dense-llt"; }
   Eigen::Index max_dimension() const override { return max_dimension_; }
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
+
  protected:
   SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override;
 

@@ -12,11 +12,16 @@ namespace mcf {
 
 const char* to_string(SolveStatus s) {
   switch (s) {
-    case SolveStatus::converged: return "converged";
-    case SolveStatus::max_iterations: return "max_iterations";
-    case SolveStatus::not_positive_definite: return "not_positive_definite";
-    case SolveStatus::numerical_issue: return "numerical_issue";
-    case SolveStatus::failed: return "failed";
+    case SolveStatus::converged:
+      return "converged";
+    case SolveStatus::max_iterations:
+      return "max_iterations";
+    case SolveStatus::not_positive_definite:
+      return "not_positive_definite";
+    case SolveStatus::numerical_issue:
+      return "numerical_issue";
+    case SolveStatus::failed:
+      return "failed";
   }
   return "unknown";
 }
@@ -28,11 +33,14 @@ std::uint64_t new_pattern_key() {
 
 bool same_pattern(const SparseRef& A, const SparseRef& B) {
   // Views of one pattern (a basis's mass and stiffness) share its arrays: nothing to compare.
-  const bool shared = A.outerIndexPtr() == B.outerIndexPtr() && A.innerIndexPtr() == B.innerIndexPtr();
+  const bool shared =
+      A.outerIndexPtr() == B.outerIndexPtr() && A.innerIndexPtr() == B.innerIndexPtr();
   return A.isCompressed() && B.isCompressed() && A.rows() == B.rows() && A.cols() == B.cols() &&
          A.nonZeros() == B.nonZeros() &&
-         (shared || (std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, B.outerIndexPtr()) &&
-                     std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr())));
+         (shared ||
+          (std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1,
+                      B.outerIndexPtr()) &&
+           std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr())));
 }
 
 void sum_on_pattern(double a, const SparseRef& M, double b, const SparseRef& K, SparseMatrix& S) {
@@ -78,8 +86,10 @@ void report_true_residual(const ConstMatrixRef& B, const ConstMatrixRef& R, Solv
     const double bn = B.col(c).norm();
     const double rn = R.col(c).norm();
     const double rel = bn > 0.0 ? rn / bn : rn;
-    if (!std::isfinite(rel)) worst = rel;
-    else if (std::isfinite(worst)) worst = std::max(worst, rel);
+    if (!std::isfinite(rel))
+      worst = rel;
+    else if (std::isfinite(worst))
+      worst = std::max(worst, rel);
   }
   report.relative_residual = worst;
   report.residuals = {worst};
@@ -93,9 +103,9 @@ SolveReport LinearSolver::solve(const ConstMatrixRef& B, MatrixRef X) {
   if (X.rows() != B.rows() || X.cols() != B.cols()) {
     SolveReport report;
     report.status = SolveStatus::failed;
-    report.message = "warm start has " + std::to_string(X.rows()) + " x " + std::to_string(X.cols()) +
-                     " entries, the right-hand side " + std::to_string(B.rows()) + " x " +
-                     std::to_string(B.cols());
+    report.message = "warm start has " + std::to_string(X.rows()) + " x " +
+                     std::to_string(X.cols()) + " entries, the right-hand side " +
+                     std::to_string(B.rows()) + " x " + std::to_string(B.cols());
     return report;
   }
   return solve_in_place(B, X);

@@ -21,22 +21,24 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using SparseRef = Eigen::Ref<const SparseMatrix>;
 
 enum class SolveStatus {
-  converged,          ///< reached the tolerance (or a direct solve succeeded)
-  max_iterations,     ///< stopped at the iteration cap; the answer is the last iterate
+  converged,              ///< reached the tolerance (or a direct solve succeeded)
+  max_iterations,         ///< stopped at the iteration cap; the answer is the last iterate
   not_positive_definite,  ///< the matrix is not SPD (the flow turned singular); not an abort
-  numerical_issue,    ///< NaN/inf met during the solve
-  failed              ///< anything else; see message
+  numerical_issue,        ///< NaN/inf met during the solve
+  failed                  ///< anything else; see message
 };
 
 const char* to_string(SolveStatus s);
 
 struct SolveReport {
   SolveStatus status = SolveStatus::converged;
-  int iterations = 0;                 ///< cycles (multigrid), CG iterations (PCG), 1 (direct)
-  double relative_residual = 0.0;     ///< max over right-hand sides of ||b - A x|| / ||b||
-  std::vector<double> residuals;      ///< relative residual after each iteration / cycle
+  int iterations = 0;              ///< cycles (multigrid), CG iterations (PCG), 1 (direct)
+  double relative_residual = 0.0;  ///< max over right-hand sides of ||b - A x|| / ||b||
+  std::vector<double> residuals;   ///< relative residual after each iteration / cycle
   std::string message;
-  bool ok() const { return status == SolveStatus::converged || status == SolveStatus::max_iterations; }
+  bool ok() const {
+    return status == SolveStatus::converged || status == SolveStatus::max_iterations;
+  }
 };
 
 /// Multigrid hierarchy as plain arrays (levels ordered coarsest first; the finest level is the
@@ -90,7 +92,9 @@ bool same_pattern(const SparseRef& A, const SparseRef& B);
 
 /// One entry of a M + b K. Every kernel that forms the system from M and K on one pattern calls
 /// this, so they agree bitwise (the multigrid's fused refill and sum_on_pattern below).
-inline double sum_entry(double a, double m, double b, double k) { return a * m + b * k; }
+inline double sum_entry(double a, double m, double b, double k) {
+  return a * m + b * k;
+}
 
 /// S = a M + b K entry by entry, in parallel, for M, K and S on one pattern (same_pattern: the
 /// caller checks; S keeps its pattern and only its values are written). This is how every flow
@@ -152,8 +156,8 @@ class LinearSolver {
   virtual SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) = 0;
 
  private:
-  SparseMatrix sum_;              // the default set_matrix_sum's a M + b K
-  std::uint64_t sum_key_ = 0;     // pattern key of the last call
+  SparseMatrix sum_;           // the default set_matrix_sum's a M + b K
+  std::uint64_t sum_key_ = 0;  // pattern key of the last call
 };
 
 }  // namespace mcf

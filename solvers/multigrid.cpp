@@ -1,19 +1,19 @@
 #include "solvers/multigrid.h"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/SparseCholesky>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <new>
 #include <stdexcept>
@@ -23,14 +23,16 @@
 
 namespace mcf {
 
-const char* to_string(MultigridCycle c) { return c == MultigridCycle::V ? "V" : "W"; }
+const char* to_string(MultigridCycle c) {
+  return c == MultigridCycle::V ? "V" : "W";
+}
 
 namespace {
 
-constexpr int kGrain = 256;            // rows per TBB task
-constexpr int kSerialBelow = 2048;     // loops shorter than this run serially (same result)
+constexpr int kGrain = 256;         // rows per TBB task
+constexpr int kSerialBelow = 2048;  // loops shorter than this run serially (same result)
 constexpr int kTile = MultigridSolver::tile_size;
-constexpr int kMinBlockTiles = 8;      // tiles per relaxation block, at least (find_blocks())
+constexpr int kMinBlockTiles = 8;  // tiles per relaxation block, at least (find_blocks())
 
 /// Runs f(begin, end) over [0, n), in parallel when n is large enough. Every kernel writes
 /// disjoint outputs and reads nothing that the same loop writes, so the split is irrelevant.
@@ -53,13 +55,17 @@ void for_rows(int n, F&& f) {
 /// Four doubles (GCC/Clang vector extensions: one AVX register when compiled for it, emulated
 /// otherwise). The kernels below hold four right-hand-side columns of one row in one vector.
 using v4 = double __attribute__((vector_size(32)));
-inline v4 splat(double a) { return v4{a, a, a, a}; }
+inline v4 splat(double a) {
+  return v4{a, a, a, a};
+}
 inline v4 load4(const double* p) {
   v4 r;
   std::memcpy(&r, p, sizeof(r));
   return r;
 }
-inline void store4(double* p, v4 v) { std::memcpy(p, &v, sizeof(v)); }
+inline void store4(double* p, v4 v) {
+  std::memcpy(p, &v, sizeof(v));
+}
 
 /// Cache-line aligned storage, so that a row's four columns (32 bytes at a multiple of 32) never
 /// straddle two cache lines.
@@ -69,7 +75,9 @@ struct CacheAligned {
   CacheAligned() = default;
   template <class U>
   CacheAligned(const CacheAligned<U>&) {}
-  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
+  T* allocate(std::size_t n) {
+    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64)));
+  }
   void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(64)); }
   friend bool operator==(const CacheAligned&, const CacheAligned&) { return true; }
 };
@@ -82,8 +90,11 @@ struct Csc {
   const int* inner = nullptr;
   const double* val = nullptr;
   explicit Csc(const SparseRef& m)
-      : rows(int(m.rows())), cols(int(m.cols())), outer(m.outerIndexPtr()),
-        inner(m.innerIndexPtr()), val(m.valuePtr()) {}
+      : rows(int(m.rows())),
+        cols(int(m.cols())),
+        outer(m.outerIndexPtr()),
+        inner(m.innerIndexPtr()),
+        val(m.valuePtr()) {}
 };
 
 // ---- kernels on interleaved buffers ---------------------------------------------------------
@@ -98,8 +109,8 @@ struct Csc {
 // (SmootherRows, relaxation blocks).
 
 /// Σ_p val[p] x[inner[p]] over p in [begin, end), into acc0 (even p - begin) and acc1 (odd).
-MCF_KERNEL_INLINE void gather_sub(const Csc& A, const double* x, std::size_t s, int o, int begin, int end, v4& acc0,
-                                  v4& acc1) {
+MCF_KERNEL_INLINE void gather_sub(const Csc& A, const double* x, std::size_t s, int o, int begin,
+                                  int end, v4& acc0, v4& acc1) {
   int p = begin;
   for (; p + 1 < end; p += 2) {
     acc0 -= splat(A.val[p]) * load4(x + std::size_t(A.inner[p]) * s + o);
@@ -111,8 +122,8 @@ MCF_KERNEL_INLINE void gather_sub(const Csc& A, const double* x, std::size_t s, 
 /// One Gauss-Seidel update of row i (= column i of the symmetric CSC matrix), columns o..o+3.
 /// diag_pos[i] is the position of the diagonal entry in column i (-1 if absent): the sum runs
 /// over the entries before and after it, in index order, without a test per entry.
-MCF_KERNEL_INLINE void gs_row(const Csc& A, const int* diag_pos, const double* inv_diag, const double* b, double* x,
-                              std::size_t s, int o, int i) {
+MCF_KERNEL_INLINE void gs_row(const Csc& A, const int* diag_pos, const double* inv_diag,
+                              const double* b, double* x, std::size_t s, int o, int i) {
   const std::size_t ii = std::size_t(i) * s + o;
   v4 acc0 = load4(b + ii), acc1 = splat(0.0);
   const int dp = diag_pos[i];
@@ -126,8 +137,8 @@ MCF_KERNEL_INLINE void gs_row(const Csc& A, const int* diag_pos, const double* i
 }
 
 /// r = b - A x (rows [begin, end)), columns o..o+3.
-MCF_KERNEL_INLINE void residual_rows(const Csc& A, const double* b, const double* x, double* r, std::size_t s,
-                                     int o, int begin, int end) {
+MCF_KERNEL_INLINE void residual_rows(const Csc& A, const double* b, const double* x, double* r,
+                                     std::size_t s, int o, int begin, int end) {
   for (int i = begin; i < end; ++i) {
     const std::size_t ii = std::size_t(i) * s + o;
     v4 acc0 = load4(b + ii), acc1 = splat(0.0);
@@ -139,8 +150,8 @@ MCF_KERNEL_INLINE void residual_rows(const Csc& A, const double* b, const double
 /// y = Mᵀ v (or y += Mᵀ v when Add) on output rows [begin, end) = columns of M (gather along
 /// columns, so parallel output ranges never write the same entry), columns o..o+3.
 template <bool Add>
-MCF_KERNEL_INLINE void transpose_rows(const Csc& M, const double* v, double* y, std::size_t s, int o, int begin,
-                                      int end) {
+MCF_KERNEL_INLINE void transpose_rows(const Csc& M, const double* v, double* y, std::size_t s,
+                                      int o, int begin, int end) {
   for (int J = begin; J < end; ++J) {
     v4 acc0 = splat(0.0), acc1 = splat(0.0);
     gather_sub(M, v, s, o, M.outer[J], M.outer[J + 1], acc0, acc1);
@@ -165,17 +176,17 @@ MCF_KERNEL_INLINE void transpose_rows(const Csc& M, const double* v, double* y, 
 ///   the finest residual, which is exact, so the cycle still converges to the solution of A x = b.
 /// Unused when some column lies farther than 16 bits from its row (the sweeps then read the CSC).
 struct SmootherRows {
-  bool aligned = false;                 // finest level: offset[p] belongs to CSC entry p
-  std::vector<int> start;               // coarse levels: row i's entries [start[i], start[i+1])
-  std::vector<std::int16_t> offset;     // column - row
-  std::vector<float> single;            // coarse levels' values
+  bool aligned = false;              // finest level: offset[p] belongs to CSC entry p
+  std::vector<int> start;            // coarse levels: row i's entries [start[i], start[i+1])
+  std::vector<std::int16_t> offset;  // column - row
+  std::vector<float> single;         // coarse levels' values
   bool empty() const { return !aligned && start.empty(); }
 };
 
 /// acc0/acc1 -= Σ_p val[p] x[i + offset[p]] over the compact entries [begin, end).
 template <class V>
-MCF_KERNEL_INLINE void gather_sub_compact(const std::int16_t* off, const V* val, const double* xi, std::size_t s,
-                                          int begin, int end, v4& acc0, v4& acc1) {
+MCF_KERNEL_INLINE void gather_sub_compact(const std::int16_t* off, const V* val, const double* xi,
+                                          std::size_t s, int begin, int end, v4& acc0, v4& acc1) {
   const std::ptrdiff_t st = std::ptrdiff_t(s);
   int p = begin;
   for (; p + 1 < end; p += 2) {
@@ -187,12 +198,12 @@ MCF_KERNEL_INLINE void gather_sub_compact(const std::int16_t* off, const V* val,
 
 /// gs_row on a coarse level's compact rows (values val: S.single).
 template <class V>
-MCF_KERNEL_INLINE void gs_row_compact(const SmootherRows& S, const V* val, const double* inv_diag, const double* b,
-                                      double* x, std::size_t s, int o, int i) {
+MCF_KERNEL_INLINE void gs_row_compact(const SmootherRows& S, const V* val, const double* inv_diag,
+                                      const double* b, double* x, std::size_t s, int o, int i) {
   const std::size_t ii = std::size_t(i) * s + o;
   v4 acc0 = load4(b + ii), acc1 = splat(0.0);
-  gather_sub_compact(S.offset.data(), val, x + ii, s, S.start[std::size_t(i)], S.start[std::size_t(i) + 1], acc0,
-                     acc1);
+  gather_sub_compact(S.offset.data(), val, x + ii, s, S.start[std::size_t(i)],
+                     S.start[std::size_t(i) + 1], acc0, acc1);
   store4(x + ii, (acc0 + acc1) * splat(inv_diag[i]));
 }
 
@@ -200,8 +211,8 @@ MCF_KERNEL_INLINE void gs_row_compact(const SmootherRows& S, const V* val, const
 /// before its diagonal (stored last), read from the matrix itself; bitwise what gs_row_compact
 /// computes on a copy of them.
 MCF_KERNEL_INLINE void gs_row_aligned(const Csc& A, const std::int16_t* off, const int* diag_pos,
-                                      const double* inv_diag, const double* b, double* x, std::size_t s, int o,
-                                      int i) {
+                                      const double* inv_diag, const double* b, double* x,
+                                      std::size_t s, int o, int i) {
   const std::size_t ii = std::size_t(i) * s + o;
   v4 acc0 = load4(b + ii), acc1 = splat(0.0);
   const int dp = diag_pos[i];
@@ -216,7 +227,8 @@ SparseMatrix symbolic_product(const SparseMatrix& Xm, const SparseMatrix& Ym) {
   const Csc X(Xm), Y(Ym);
   const int m = X.rows, q = Y.cols;
   std::vector<std::vector<int>> cols(static_cast<std::size_t>(q));
-  tbb::enumerable_thread_specific<std::vector<int>> marks([m] { return std::vector<int>(std::size_t(m), -1); });
+  tbb::enumerable_thread_specific<std::vector<int>> marks(
+      [m] { return std::vector<int>(std::size_t(m), -1); });
   tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
     auto& mark = marks.local();
     for (int J = r.begin(); J < r.end(); ++J) {
@@ -242,7 +254,8 @@ SparseMatrix symbolic_product(const SparseMatrix& Xm, const SparseMatrix& Ym) {
   outer[0] = 0;
   for (int J = 0; J < q; ++J) outer[J + 1] = outer[J] + int(cols[std::size_t(J)].size());
   tbb::parallel_for(0, q, [&](int J) {
-    std::copy(cols[std::size_t(J)].begin(), cols[std::size_t(J)].end(), M.innerIndexPtr() + outer[J]);
+    std::copy(cols[std::size_t(J)].begin(), cols[std::size_t(J)].end(),
+              M.innerIndexPtr() + outer[J]);
   });
   std::fill(M.valuePtr(), M.valuePtr() + nnz, 0.0);
   return M;
@@ -259,7 +272,8 @@ using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 /// identity), i.e. in grid order, so consecutive columns share most of their fine support:
 /// visiting them colour-major measured 1.3x slower.
 void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatrix& Cm,
-                     const std::vector<int>& transpose_pos, const std::vector<int>& column_order, Spa& spa) {
+                     const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
+                     Spa& spa) {
   const Csc A(Am), P(Pm);
   const int m = A.rows;
   const int* Couter = Cm.outerIndexPtr();
@@ -273,13 +287,15 @@ void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatri
       for (int p = P.outer[J]; p < P.outer[J + 1]; ++p) {
         const int t = P.inner[p];
         const double w = P.val[p];
-        for (int a = A.outer[t]; a < A.outer[t + 1]; ++a) v[std::size_t(A.inner[a])] += A.val[a] * w;
+        for (int a = A.outer[t]; a < A.outer[t + 1]; ++a)
+          v[std::size_t(A.inner[a])] += A.val[a] * w;
       }
       for (int e = Couter[J]; e < Couter[J + 1]; ++e) {
         const int I = Cinner[e];
         if (I > J) break;  // sorted: the rest is the mirror of columns > J
         double sum = 0.0;
-        for (int q = P.outer[I]; q < P.outer[I + 1]; ++q) sum += P.val[q] * v[std::size_t(P.inner[q])];
+        for (int q = P.outer[I]; q < P.outer[I + 1]; ++q)
+          sum += P.val[q] * v[std::size_t(P.inner[q])];
         Cval[e] = sum;
         const int t = transpose_pos[std::size_t(e)];
         if (t >= 0) Cval[t] = sum;
@@ -304,14 +320,18 @@ void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatri
 // 8-colour ordering and its iterates are unchanged. `perm[r]` is the caller's index of internal
 // row r, `inv` its inverse; both are empty for the identity.
 
-int old_index(const std::vector<int>& perm, int r) { return perm.empty() ? r : perm[std::size_t(r)]; }
-int new_index(const std::vector<int>& inv, int i) { return inv.empty() ? i : inv[std::size_t(i)]; }
+int old_index(const std::vector<int>& perm, int r) {
+  return perm.empty() ? r : perm[std::size_t(r)];
+}
+int new_index(const std::vector<int>& inv, int i) {
+  return inv.empty() ? i : inv[std::size_t(i)];
+}
 
 /// M with entry (i, j) moved to (row_inv[i], col_inv[j]) (col_perm = inverse of col_inv). With
 /// `sort` each column is sorted by its new row indices; without, the entries of each column keep
 /// their relative order (so a row sum visits its terms in the caller's order).
-SparseMatrix permuted(const SparseRef& Mm, const std::vector<int>& row_inv, const std::vector<int>& col_perm,
-                      bool sort) {
+SparseMatrix permuted(const SparseRef& Mm, const std::vector<int>& row_inv,
+                      const std::vector<int>& col_perm, bool sort) {
   const Csc M(Mm);
   SparseMatrix out(M.rows, M.cols);
   out.resizeNonZeros(Mm.nonZeros());
@@ -321,28 +341,30 @@ SparseMatrix permuted(const SparseRef& Mm, const std::vector<int>& row_inv, cons
     const int j = old_index(col_perm, r);
     outer[r + 1] = outer[r] + (M.outer[j + 1] - M.outer[j]);
   }
-  tbb::parallel_for(tbb::blocked_range<int>(0, M.cols, 1024), [&](const tbb::blocked_range<int>& range) {
-    std::vector<std::pair<int, double>> col;
-    for (int r = range.begin(); r < range.end(); ++r) {
-      const int j = old_index(col_perm, r);
-      col.clear();
-      for (int p = M.outer[j]; p < M.outer[j + 1]; ++p) col.emplace_back(new_index(row_inv, M.inner[p]), M.val[p]);
-      if (sort) std::sort(col.begin(), col.end());
-      for (std::size_t t = 0; t < col.size(); ++t) {
-        out.innerIndexPtr()[outer[r] + int(t)] = col[t].first;
-        out.valuePtr()[outer[r] + int(t)] = col[t].second;
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<int>(0, M.cols, 1024),
+                    [&](const tbb::blocked_range<int>& range) {
+                      std::vector<std::pair<int, double>> col;
+                      for (int r = range.begin(); r < range.end(); ++r) {
+                        const int j = old_index(col_perm, r);
+                        col.clear();
+                        for (int p = M.outer[j]; p < M.outer[j + 1]; ++p)
+                          col.emplace_back(new_index(row_inv, M.inner[p]), M.val[p]);
+                        if (sort) std::sort(col.begin(), col.end());
+                        for (std::size_t t = 0; t < col.size(); ++t) {
+                          out.innerIndexPtr()[outer[r] + int(t)] = col[t].first;
+                          out.valuePtr()[outer[r] + int(t)] = col[t].second;
+                        }
+                      }
+                    });
   return out;
 }
 
 /// Whether `stored` == permuted(given, row_inv, col_perm, sort) (pattern, and values when asked)
 /// without building the permuted copy. Unsorted, with diag_rank (the finest level): column r
 /// stores the caller's diag_rank[r]-th entry last (Impl::diagonal_last).
-bool same_permuted(const SparseMatrix& stored, const SparseRef& given, const std::vector<int>& row_inv,
-                   const std::vector<int>& col_perm, bool sort, bool values,
-                   const std::vector<int>& diag_rank = {}) {
+bool same_permuted(const SparseMatrix& stored, const SparseRef& given,
+                   const std::vector<int>& row_inv, const std::vector<int>& col_perm, bool sort,
+                   bool values, const std::vector<int>& diag_rank = {}) {
   if (stored.rows() != given.rows() || stored.cols() != given.cols() ||
       stored.nonZeros() != given.nonZeros() || !given.isCompressed())
     return false;
@@ -380,42 +402,42 @@ struct MultigridSolver::Impl {
   struct Level {
     // All matrices and buffers of a level are in its internal numbering (tile-wise colour-major
     // when colours were given; see number_by_colour()).
-    SparseMatrix A;                    // compressed, symmetric pattern; coarse levels sorted
-    std::vector<int> perm, inv;        // internal row r <-> caller's index perm[r]; empty: identity
-    std::vector<int> transpose_pos;    // entry e=(i,J) -> position of (J,i) (coarse levels)
+    SparseMatrix A;                  // compressed, symmetric pattern; coarse levels sorted
+    std::vector<int> perm, inv;      // internal row r <-> caller's index perm[r]; empty: identity
+    std::vector<int> transpose_pos;  // entry e=(i,J) -> position of (J,i) (coarse levels)
     std::vector<double> inv_diag;
-    std::vector<int> diag_pos;         // position of the diagonal entry of each column, -1 if none
+    std::vector<int> diag_pos;  // position of the diagonal entry of each column, -1 if none
     // Finest level of a hierarchy: each column stores its diagonal last (the smoother reads the
     // off-diagonal run in place); diag_rank[r] = the diagonal's place in the caller's column
     // (-1: none). Empty on coarse levels and a single level.
     std::vector<int> diag_rank;
     bool coloured = false;
-    std::vector<int> segment_start;    // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
-    int block_tiles = 1;               // tiles per relaxation block (find_blocks())
-    SmootherRows smoother;             // compact off-diagonal rows for the sweeps (may be empty)
+    std::vector<int> segment_start;  // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
+    int block_tiles = 1;             // tiles per relaxation block (find_blocks())
+    SmootherRows smoother;           // compact off-diagonal rows for the sweeps (may be empty)
     int tiles() const { return int(segment_start.size() / 8); }
     int blocks() const { return (tiles() + block_tiles - 1) / block_tiles; }
     // Transfer to the next finer level (absent on the finest level).
-    SparseMatrix P;                    // n_{l+1} x n_l
-    SparseMatrix PT;                   // n_l x n_{l+1}
-    Spa spa;                           // dense accumulators of the Galerkin product
+    SparseMatrix P;   // n_{l+1} x n_l
+    SparseMatrix PT;  // n_l x n_{l+1}
+    Spa spa;          // dense accumulators of the Galerkin product
     // Work buffers (interleaved n x k, row stride padded to a multiple of 4).
     Buffer x, b, r;
     int n() const { return int(A.rows()); }
   };
 
-  std::vector<Level> levels;           // coarsest first
+  std::vector<Level> levels;                       // coarsest first
   std::vector<std::vector<std::uint8_t>> colours;  // as given (to detect changes)
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
   // The coarsest solve when its matrix is only semi-definite (set_matrix: coarsest_pseudo_inverse):
   // a dense generalized inverse, empty while the LDLᵀ factor serves.
   Eigen::MatrixXd coarse_pinv;
   Eigen::MatrixXd coarse_rhs, coarse_sol;
-  int k = 0;                           // columns the buffers are sized for
-  std::size_t s = 0;                   // their row stride: k rounded up to a multiple of 4
+  int k = 0;          // columns the buffers are sized for
+  std::size_t s = 0;  // their row stride: k rounded up to a multiple of 4
   bool ready = false;
   std::int64_t symbolic_builds = 0, numeric_builds = 0, pattern_comparisons = 0;
-  std::uint64_t pattern_key = 0;       // the key the current pattern was set with (0: none)
+  std::uint64_t pattern_key = 0;         // the key the current pattern was set with (0: none)
   std::vector<MultigridLevelWork> work;  // per level, coarsest first (level_work())
 
   void ensure_buffers(int cols) {
@@ -445,8 +467,10 @@ struct MultigridSolver::Impl {
       if (col[std::size_t(i)] > 7) return;
     const int tiles = (n + kTile - 1) / kTile;
     L.segment_start.assign(std::size_t(tiles) * 8 + 1, 0);
-    for (int i = 0; i < n; ++i) ++L.segment_start[std::size_t(i / kTile) * 8 + col[std::size_t(i)] + 1];
-    for (std::size_t q = 1; q < L.segment_start.size(); ++q) L.segment_start[q] += L.segment_start[q - 1];
+    for (int i = 0; i < n; ++i)
+      ++L.segment_start[std::size_t(i / kTile) * 8 + col[std::size_t(i)] + 1];
+    for (std::size_t q = 1; q < L.segment_start.size(); ++q)
+      L.segment_start[q] += L.segment_start[q - 1];
     L.perm.resize(std::size_t(n));
     L.inv.resize(std::size_t(n));
     std::vector<int> fill(L.segment_start.begin(), L.segment_start.end() - 1);
@@ -510,7 +534,8 @@ struct MultigridSolver::Impl {
         tbb::blocked_range<int>(0, L.n(), 4096), 0,
         [&](const tbb::blocked_range<int>& rows, int far) {
           for (int r = rows.begin(); r < rows.end(); ++r)
-            for (int p = A.outer[r]; p < A.outer[r + 1]; ++p) far = std::max(far, std::abs(A.inner[p] / kTile - r / kTile));
+            for (int p = A.outer[r]; p < A.outer[r + 1]; ++p)
+              far = std::max(far, std::abs(A.inner[p] / kTile - r / kTile));
           return far;
         },
         [](int a, int b) { return std::max(a, b); });
@@ -541,7 +566,8 @@ struct MultigridSolver::Impl {
     std::vector<int> start(std::size_t(L.n()) + 1, 0);
     for (int i = 0; i < L.n(); ++i) {
       const int dp = L.diag_pos[std::size_t(i)];
-      start[std::size_t(i) + 1] = start[std::size_t(i)] + (A.outer[i + 1] - A.outer[i]) - (dp >= 0 ? 1 : 0);
+      start[std::size_t(i) + 1] =
+          start[std::size_t(i)] + (A.outer[i + 1] - A.outer[i]) - (dp >= 0 ? 1 : 0);
     }
     std::vector<std::int16_t> offset(std::size_t(start.back()));
     for (int i = 0; i < L.n(); ++i) {
@@ -744,7 +770,8 @@ struct MultigridSolver::Impl {
         const auto relax_block = [&](int q) {
           for_block_segments(L, q, reverse, [&](int r0, int r1) {
             if (S.aligned) {
-              for (int r = r0; r < r1; ++r) gs_row_aligned(A, S.offset.data(), dp, id, b, x, s, o, r);
+              for (int r = r0; r < r1; ++r)
+                gs_row_aligned(A, S.offset.data(), dp, id, b, x, s, o, r);
             } else if (!S.empty()) {
               for (int r = r0; r < r1; ++r) gs_row_compact(S, S.single.data(), id, b, x, s, o, r);
             } else {
@@ -760,9 +787,10 @@ struct MultigridSolver::Impl {
             for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
             continue;
           }
-          tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& r) {
-            for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
-          });
+          tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
+                            [&](const tbb::blocked_range<int>& r) {
+                              for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
+                            });
         }
       } else if (!reverse) {
         for (int i = 0; i < A.cols; ++i) gs_row(A, dp, id, b, x, s, o, i);
@@ -784,7 +812,8 @@ struct MultigridSolver::Impl {
             for (int r = r0; r < r1; ++r) order.push_back(old_index(L.perm, r));
           });
     } else {
-      for (int i = 0; i < L.n(); ++i) order.push_back(old_index(L.perm, reverse ? L.n() - 1 - i : i));
+      for (int i = 0; i < L.n(); ++i)
+        order.push_back(old_index(L.perm, reverse ? L.n() - 1 - i : i));
     }
     return order;
   }
@@ -793,7 +822,9 @@ struct MultigridSolver::Impl {
     Level& L = levels[std::size_t(l)];
     const Csc A(L.A);
     for (int o = 0; o < int(s); o += 4)
-      for_rows(A.cols, [&](int b, int e) { residual_rows(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e); });
+      for_rows(A.cols, [&](int b, int e) {
+        residual_rows(A, L.b.data(), L.x.data(), L.r.data(), s, o, b, e);
+      });
   }
 
   // Whether the LDLᵀ factor of the coarsest matrix is fit to solve with: it succeeded and no
@@ -821,7 +852,9 @@ struct MultigridSolver::Impl {
   std::string coarsest_pseudo_inverse(int& null_dimension) {
     const SparseMatrix& A = levels.front().A;
     const Eigen::Index n = A.rows();
-    if (n > 4096) return "coarsest-level factorization failed (" + std::to_string(n) + " functions: too many for its dense pseudo-inverse)";
+    if (n > 4096)
+      return "coarsest-level factorization failed (" + std::to_string(n) +
+             " functions: too many for its dense pseudo-inverse)";
     Eigen::MatrixXd dense = Eigen::MatrixXd(A);
     Eigen::VectorXd scale(n);
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -839,7 +872,9 @@ struct MultigridSolver::Impl {
     if (eig.info() != Eigen::Success) return "coarsest-level eigen-decomposition failed";
     const Eigen::VectorXd& lambda = eig.eigenvalues();  // ascending
     const double top = lambda[n - 1], floor = 1e-11 * top;
-    if (!(lambda[0] >= -floor)) return "coarsest-level matrix is not positive definite (eigenvalue " + std::to_string(lambda[0] / top) + " of the largest)";
+    if (!(lambda[0] >= -floor))
+      return "coarsest-level matrix is not positive definite (eigenvalue " +
+             std::to_string(lambda[0] / top) + " of the largest)";
     Eigen::VectorXd inverse(n);
     null_dimension = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -856,15 +891,19 @@ struct MultigridSolver::Impl {
     const int n = L.n();
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < k; ++c) coarse_rhs(i, c) = L.b[std::size_t(i) * s + std::size_t(c)];
-    if (coarse_pinv.size() > 0) coarse_sol.noalias() = coarse_pinv * coarse_rhs;
-    else coarse_sol = ldlt.solve(coarse_rhs);
+    if (coarse_pinv.size() > 0)
+      coarse_sol.noalias() = coarse_pinv * coarse_rhs;
+    else
+      coarse_sol = ldlt.solve(coarse_rhs);
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < k; ++c) L.x[std::size_t(i) * s + std::size_t(c)] = coarse_sol(i, c);
   }
 
   // Two clock reads per level visit (a W-cycle at depth 9 makes 384): noise next to the sweeps.
   using Clock = std::chrono::steady_clock;
-  static double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+  static double since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  }
 
   void cycle(int l, const MultigridOptions& opt) {
     const auto t0 = Clock::now();
@@ -882,7 +921,8 @@ struct MultigridSolver::Impl {
     // Restriction: b_C = Pᵀ r_F (gather over the columns of P).
     const Csc P(C.P), PT(C.PT);
     for (int o = 0; o < int(s); o += 4)
-      for_rows(P.cols, [&](int b, int e) { transpose_rows<false>(P, F.r.data(), C.b.data(), s, o, b, e); });
+      for_rows(P.cols,
+               [&](int b, int e) { transpose_rows<false>(P, F.r.data(), C.b.data(), s, o, b, e); });
     std::fill(C.x.begin(), C.x.end(), 0.0);
     // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
     const int gamma = (opt.cycle == MultigridCycle::W && l - 1 > 0) ? 2 : 1;
@@ -891,7 +931,8 @@ struct MultigridSolver::Impl {
     const double coarser = since(tc);  // the recursion's time, not this level's own
     // Prolongation: x_F += P x_C (gather over the columns of Pᵀ = rows of P).
     for (int o = 0; o < int(s); o += 4)
-      for_rows(PT.cols, [&](int b, int e) { transpose_rows<true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
+      for_rows(PT.cols,
+               [&](int b, int e) { transpose_rows<true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
     for (int i = 0; i < opt.post_smooth; ++i) sweep(l, true);
     w.seconds += since(t0) - coarser;
   }
@@ -963,12 +1004,16 @@ std::string MultigridSolver::name() const {
   return std::string("multigrid-") + to_string(options_.cycle);
 }
 
-int MultigridSolver::levels() const { return impl_->ready ? int(impl_->levels.size()) : 0; }
+int MultigridSolver::levels() const {
+  return impl_->ready ? int(impl_->levels.size()) : 0;
+}
 SparseMatrix MultigridSolver::level_matrix(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
   return permuted(L.A, L.perm, L.inv, true);  // back to the caller's numbering
 }
-bool MultigridSolver::level_is_coloured(int l) const { return impl_->levels.at(std::size_t(l)).coloured; }
+bool MultigridSolver::level_is_coloured(int l) const {
+  return impl_->levels.at(std::size_t(l)).coloured;
+}
 bool MultigridSolver::level_has_compact_smoother(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
   return L.coloured && !L.smoother.empty();
@@ -988,10 +1033,18 @@ std::vector<int> MultigridSolver::relaxation_order(int l, bool reverse) const {
   (void)impl_->levels.at(std::size_t(l));
   return impl_->relaxation_order(l, reverse);
 }
-std::int64_t MultigridSolver::symbolic_builds() const { return impl_->symbolic_builds; }
-std::int64_t MultigridSolver::numeric_builds() const { return impl_->numeric_builds; }
-std::int64_t MultigridSolver::pattern_comparisons() const { return impl_->pattern_comparisons; }
-std::vector<MultigridLevelWork> MultigridSolver::level_work() const { return impl_->work; }
+std::int64_t MultigridSolver::symbolic_builds() const {
+  return impl_->symbolic_builds;
+}
+std::int64_t MultigridSolver::numeric_builds() const {
+  return impl_->numeric_builds;
+}
+std::int64_t MultigridSolver::pattern_comparisons() const {
+  return impl_->pattern_comparisons;
+}
+std::vector<MultigridLevelWork> MultigridSolver::level_work() const {
+  return impl_->work;
+}
 void MultigridSolver::reset_level_work() {
   for (auto& w : impl_->work) w = MultigridLevelWork{};
 }
@@ -1000,14 +1053,15 @@ SolveReport MultigridSolver::set_matrix(const SparseMatrix& A, HierarchyView hie
   return set_levels(A, 1.0, 0.0, nullptr, hierarchy);
 }
 
-SolveReport MultigridSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                                            HierarchyView hierarchy) {
-  if (!summable(M, K)) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);  // the general sum
+SolveReport MultigridSolver::set_matrix_sum(double a, const SparseRef& M, double b,
+                                            const SparseRef& K, HierarchyView hierarchy) {
+  if (!summable(M, K))
+    return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);  // the general sum
   return set_levels(M, a, b, &K, hierarchy);
 }
 
-SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double b, const SparseRef* K,
-                                        HierarchyView hierarchy) {
+SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double b,
+                                        const SparseRef* K, HierarchyView hierarchy) {
   SolveReport rep;
   Impl& m = *impl_;
   m.ready = false;
@@ -1016,7 +1070,8 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double 
     rep.message = std::move(msg);
     return rep;
   };
-  if (A_in.rows() != A_in.cols() || A_in.rows() == 0) return fail(SolveStatus::failed, "matrix is not square or empty");
+  if (A_in.rows() != A_in.cols() || A_in.rows() == 0)
+    return fail(SolveStatus::failed, "matrix is not square or empty");
   // An uncompressed input is compressed into a copy (the kernels read the CSC arrays alone).
   SparseMatrix compressed;
   if (!A_in.isCompressed()) {
@@ -1032,7 +1087,8 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double 
   Eigen::Index fine = A.rows();
   for (std::size_t l = P.size(); l-- > 0;) {
     if (P[l].rows() != fine || P[l].cols() <= 0)
-      return fail(SolveStatus::failed, "prolongation " + std::to_string(l) + " has wrong dimensions");
+      return fail(SolveStatus::failed,
+                  "prolongation " + std::to_string(l) + " has wrong dimensions");
     fine = P[l].cols();
   }
 
@@ -1063,7 +1119,8 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double 
 
   if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);
   m.ldlt.factorize(m.levels.front().A);
-  if (!diag_ok) return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
+  if (!diag_ok)
+    return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
   m.coarse_pinv.resize(0, 0);
   if (!m.coarsest_factor_is_sound()) {
     // The octree's functions on a flat face parallel to a grid plane (the cubical spiral, a
@@ -1073,8 +1130,8 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double 
     int null_dimension = 0;
     const std::string why = m.coarsest_pseudo_inverse(null_dimension);
     if (!why.empty()) return fail(SolveStatus::not_positive_definite, why);
-    rep.message = "coarsest level semi-definite (null space of dimension " + std::to_string(null_dimension) +
-                  "): solved by its pseudo-inverse";
+    rep.message = "coarsest level semi-definite (null space of dimension " +
+                  std::to_string(null_dimension) + "): solved by its pseudo-inverse";
   }
   for (std::size_t l = 1; l < m.levels.size(); ++l)
     if (!m.levels[l].coloured)

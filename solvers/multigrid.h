@@ -41,14 +41,14 @@
 // given colouring is invalid keeps the internal order and is relaxed serially in it.
 //
 // Layout and cost: right-hand sides are interleaved (row-major n x k, the row padded to a multiple
-// of 4 columns) in preallocated per-level buffers; every kernel relaxes four columns of a row as one
-// vector (the flows' x, y, z and a zero column). Per cycle on
-// level l: pre + post sweeps, one residual, restriction b_c = Pᵀ r (gather over P's columns),
-// prolongation x += P x_c (gather over the columns of the stored Pᵀ). The Galerkin pattern of
-// Pᵀ (A_{l+1} P) is built once (symbolic_builds()); later set_matrix calls only recompute values:
-// per coarse column J, v = A_{l+1} P e_J in a thread-local dense accumulator, then the upper
-// entries (I <= J) as dot products P e_I · v, mirrored, so A_l is exactly symmetric and A P is
-// never stored. Measured numbers: README "Benchmarks" (bench/micro_octree.cpp).
+// of 4 columns) in preallocated per-level buffers; every kernel relaxes four columns of a row as
+// one vector (the flows' x, y, z and a zero column). Per cycle on level l: pre + post sweeps, one
+// residual, restriction b_c = Pᵀ r (gather over P's columns), prolongation x += P x_c (gather over
+// the columns of the stored Pᵀ). The Galerkin pattern of Pᵀ (A_{l+1} P) is built once
+// (symbolic_builds()); later set_matrix calls only recompute values: per coarse column J, v =
+// A_{l+1} P e_J in a thread-local dense accumulator, then the upper entries (I <= J) as dot
+// products P e_I · v, mirrored, so A_l is exactly symmetric and A P is never stored. Measured
+// numbers: README "Benchmarks" (bench/micro_octree.cpp).
 
 #include "solvers/linear_solver.h"
 
@@ -73,9 +73,9 @@ struct MultigridLevelWork {
 
 struct MultigridOptions {
   MultigridCycle cycle = MultigridCycle::W;
-  int cycles = 1;          ///< number of cycles per solve (the cap when tolerance > 0)
-  int pre_smooth = 5;      ///< Gauss-Seidel sweeps before the coarse correction, per level
-  int post_smooth = 5;     ///< Gauss-Seidel sweeps after the coarse correction, per level
+  int cycles = 1;       ///< number of cycles per solve (the cap when tolerance > 0)
+  int pre_smooth = 5;   ///< Gauss-Seidel sweeps before the coarse correction, per level
+  int post_smooth = 5;  ///< Gauss-Seidel sweeps after the coarse correction, per level
   /// 0: run exactly `cycles` cycles; > 0: stop early once the relative residual is below.
   double tolerance = 0.0;
 };
@@ -119,10 +119,10 @@ class MultigridSolver : public LinearSolver {
   void set_options(const MultigridOptions& options) { options_ = options; }
 
   // --- introspection (tests, benchmarks) ---
-  int levels() const;                              ///< 0 before set_matrix
+  int levels() const;  ///< 0 before set_matrix
   /// Level l's operator (l = 0 coarsest, levels()-1 finest) in the caller's numbering (a copy).
   SparseMatrix level_matrix(int l) const;
-  bool level_is_coloured(int l) const;             ///< false: serial Gauss-Seidel fallback
+  bool level_is_coloured(int l) const;  ///< false: serial Gauss-Seidel fallback
   /// Whether level l's sweeps read the compact rows: 16-bit offsets, single-precision values on
   /// coarse levels, double on the finest (header, "Smoother matrix").
   bool level_has_compact_smoother(int l) const;
@@ -133,8 +133,8 @@ class MultigridSolver : public LinearSolver {
   /// Blocks of one parity are relaxed in parallel, which is exact only because functions of
   /// blocks q and q' with |q - q'| >= 2 never couple.
   std::vector<int> relaxation_blocks(int l) const;
-  std::int64_t symbolic_builds() const;            ///< how often the Galerkin pattern was built
-  std::int64_t numeric_builds() const;             ///< how often coarse values were computed
+  std::int64_t symbolic_builds() const;  ///< how often the Galerkin pattern was built
+  std::int64_t numeric_builds() const;   ///< how often coarse values were computed
   /// How often set_matrix compared the given pattern with the stored one (skipped when the
   /// caller's pattern_key vouches for it).
   std::int64_t pattern_comparisons() const;
@@ -156,7 +156,8 @@ class MultigridSolver : public LinearSolver {
  private:
   struct Impl;
   /// Both set_matrix entries: the finest values are A's, or a A + b K when K is given (A = M).
-  SolveReport set_levels(const SparseRef& A, double a, double b, const SparseRef* K, HierarchyView hierarchy);
+  SolveReport set_levels(const SparseRef& A, double a, double b, const SparseRef* K,
+                         HierarchyView hierarchy);
   MultigridOptions options_;
   std::unique_ptr<Impl> impl_;
 };

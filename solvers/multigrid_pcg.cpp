@@ -5,14 +5,16 @@
 
 namespace mcf {
 
-MultigridPcgSolver::MultigridPcgSolver(MultigridOptions cycle, PcgOptions pcg) : multigrid_(cycle), pcg_(pcg) {
+MultigridPcgSolver::MultigridPcgSolver(MultigridOptions cycle, PcgOptions pcg)
+    : multigrid_(cycle), pcg_(pcg) {
   // A preconditioner must be symmetric for CG: equal pre- and post-smoothing sweeps, and the
   // cycle's post-smoother runs the colours in reverse (MultigridSolver::precondition).
   cycle.post_smooth = cycle.pre_smooth;
   multigrid_.set_options(cycle);
   pcg.preconditioner = PcgPreconditioner::external;
   pcg_.set_options(pcg);
-  pcg_.set_preconditioner([this](const Eigen::MatrixXd& r, Eigen::MatrixXd& z) { multigrid_.precondition(r, z); });
+  pcg_.set_preconditioner(
+      [this](const Eigen::MatrixXd& r, Eigen::MatrixXd& z) { multigrid_.precondition(r, z); });
 }
 
 namespace {
@@ -20,7 +22,8 @@ namespace {
 // a level without colouring) in front of PCG's own: PCG's report alone dropped it.
 SolveReport with_note(SolveReport preconditioner, SolveReport pcg) {
   if (!preconditioner.message.empty())
-    pcg.message = pcg.message.empty() ? preconditioner.message : preconditioner.message + "; " + pcg.message;
+    pcg.message =
+        pcg.message.empty() ? preconditioner.message : preconditioner.message + "; " + pcg.message;
   return pcg;
 }
 }  // namespace
@@ -31,8 +34,8 @@ SolveReport MultigridPcgSolver::set_matrix(const SparseMatrix& A, HierarchyView 
   return with_note(std::move(r), pcg_.set_matrix(A, hierarchy));
 }
 
-SolveReport MultigridPcgSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                                               HierarchyView hierarchy) {
+SolveReport MultigridPcgSolver::set_matrix_sum(double a, const SparseRef& M, double b,
+                                               const SparseRef& K, HierarchyView hierarchy) {
   SolveReport r = multigrid_.set_matrix_sum(a, M, b, K, hierarchy);
   if (!r.ok()) return r;
   return with_note(std::move(r), pcg_.set_matrix_sum(a, M, b, K, hierarchy));

@@ -15,8 +15,11 @@ class MultigridPcgSolver final : public LinearSolver {
   /// Both halves take M and K (each keeps its one copy of the sum).
   SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                              HierarchyView hierarchy = {}) override;
+
  protected:
-  SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override { return pcg_.solve(B, X); }
+  SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override {
+    return pcg_.solve(B, X);
+  }
 
  private:
   MultigridSolver multigrid_;

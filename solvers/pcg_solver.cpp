@@ -24,9 +24,11 @@ constexpr Index kChunk = 4096;
 template <class F>
 void for_chunks(Index n, F&& f) {
   const Index chunks = (n + kChunk - 1) / kChunk;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, chunks, 1), [&](const tbb::blocked_range<Index>& r) {
-    for (Index ch = r.begin(); ch < r.end(); ++ch) f(ch, ch * kChunk, std::min(n, (ch + 1) * kChunk));
-  });
+  tbb::parallel_for(tbb::blocked_range<Index>(0, chunks, 1),
+                    [&](const tbb::blocked_range<Index>& r) {
+                      for (Index ch = r.begin(); ch < r.end(); ++ch)
+                        f(ch, ch * kChunk, std::min(n, (ch + 1) * kChunk));
+                    });
 }
 
 // Eight independent accumulators in a fixed pattern: the lanes map onto SIMD registers without
@@ -57,21 +59,28 @@ void column_dots(const ConstMatrixRef& U, const ConstMatrixRef& V, VectorXd& out
   std::vector<double> partials(static_cast<std::size_t>(chunks * k), 0.0);
   for_chunks(n, [&](Index ch, Index b, Index e) {
     for (Index c = 0; c < k; ++c)
-      partials[static_cast<std::size_t>(ch * k + c)] = chunk_dot(U.col(c).data(), V.col(c).data(), b, e);
+      partials[static_cast<std::size_t>(ch * k + c)] =
+          chunk_dot(U.col(c).data(), V.col(c).data(), b, e);
   });
   combine(partials, k, out);
 }
 
-bool all_finite(const VectorXd& v) { return v.allFinite(); }
+bool all_finite(const VectorXd& v) {
+  return v.allFinite();
+}
 
 }  // namespace
 
 const char* to_string(PcgPreconditioner p) {
   switch (p) {
-    case PcgPreconditioner::none: return "none";
-    case PcgPreconditioner::jacobi: return "jacobi";
-    case PcgPreconditioner::incomplete_cholesky: return "incomplete_cholesky";
-    case PcgPreconditioner::external: return "external";
+    case PcgPreconditioner::none:
+      return "none";
+    case PcgPreconditioner::jacobi:
+      return "jacobi";
+    case PcgPreconditioner::incomplete_cholesky:
+      return "incomplete_cholesky";
+    case PcgPreconditioner::external:
+      return "external";
   }
   return "unknown";
 }
@@ -98,7 +107,9 @@ void PcgSolver::set_preconditioner(Preconditioner preconditioner) {
   external_ = std::move(preconditioner);
 }
 
-void PcgSolver::multiply(const ConstMatrixRef& X, MatrixXd& Y) const { symmetric_multiply(A_, X, Y); }
+void PcgSolver::multiply(const ConstMatrixRef& X, MatrixXd& Y) const {
+  symmetric_multiply(A_, X, Y);
+}
 
 SolveReport PcgSolver::build_preconditioner() {
   SolveReport rep;
@@ -124,21 +135,22 @@ SolveReport PcgSolver::build_preconditioner() {
       inv_diag_.resize(n);
       for (Index j = 0; j < n; ++j) {
         if (!(diag[j] > 0.0))
-          return fail(SolveStatus::not_positive_definite,
-                      "non-positive diagonal entry " + std::to_string(diag[j]) + " at row " +
-                          std::to_string(j));
+          return fail(SolveStatus::not_positive_definite, "non-positive diagonal entry " +
+                                                              std::to_string(diag[j]) + " at row " +
+                                                              std::to_string(j));
         inv_diag_[j] = 1.0 / diag[j];
       }
       break;
     case PcgPreconditioner::incomplete_cholesky: {
       for (Index j = 0; j < n; ++j)
         if (!(diag[j] > 0.0))
-          return fail(SolveStatus::not_positive_definite,
-                      "non-positive diagonal entry " + std::to_string(diag[j]) + " at row " +
-                          std::to_string(j));
+          return fail(SolveStatus::not_positive_definite, "non-positive diagonal entry " +
+                                                              std::to_string(diag[j]) + " at row " +
+                                                              std::to_string(j));
       // The AMD ordering depends on the pattern only; set_matrix drops ic_ when it changes.
       if (!ic_) {
-        ic_ = std::make_unique<Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>>>();
+        ic_ = std::make_unique<
+            Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>>>();
         ic_->analyzePattern(A_);
       }
       // Eigen raises the diagonal shift until the incomplete factorization succeeds; a
@@ -155,7 +167,8 @@ SolveReport PcgSolver::build_preconditioner() {
 }
 
 bool PcgSolver::keeps_pattern(const SparseRef& A, std::uint64_t key) {
-  const bool sized = A_.rows() == A.rows() && A_.cols() == A.cols() && A_.nonZeros() == A.nonZeros();
+  const bool sized =
+      A_.rows() == A.rows() && A_.cols() == A.cols() && A_.nonZeros() == A.nonZeros();
   return kept_.same(sized, key, [&] { return same_pattern(A, A_); });
 }
 
@@ -189,7 +202,8 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy
 SolveReport PcgSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                       HierarchyView hierarchy) {
   // Off one pattern (the general sum) or not square (set_matrix says so): the default.
-  if (!summable(M, K) || M.rows() != M.cols()) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
+  if (!summable(M, K) || M.rows() != M.cols())
+    return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
   have_matrix_ = false;
   // The sum straight into A_ (the copy set_matrix would make), compared as set_matrix compares.
   if (!keeps_pattern(M, hierarchy.pattern_key)) {
@@ -275,7 +289,8 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
         for (Index i = b; i < e; ++i) R(i, c) = B(i, c) - Q(i, c);
     });
     column_dots(R, R, rr);
-    for (Index c = 0; c < k; ++c) res[c] = bnorm[c] > 0.0 ? std::sqrt(rr[c]) / bnorm[c] : std::sqrt(rr[c]);
+    for (Index c = 0; c < k; ++c)
+      res[c] = bnorm[c] > 0.0 ? std::sqrt(rr[c]) / bnorm[c] : std::sqrt(rr[c]);
   };
   auto max_res = [&]() {
     double m = 0.0;
@@ -329,7 +344,8 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
   for (int it = 0; it < options_.max_iterations; ++it) {
     for (Index c = 0; c < k; ++c)
       if (active[static_cast<std::size_t>(c)] && !(rz[c] > 0.0))
-        return finish(std::isfinite(rz[c]) ? SolveStatus::not_positive_definite : SolveStatus::numerical_issue,
+        return finish(std::isfinite(rz[c]) ? SolveStatus::not_positive_definite
+                                           : SolveStatus::numerical_issue,
                       "r^T M^-1 r <= 0: preconditioner not positive definite");
 
     multiply(P, Q);
@@ -339,7 +355,8 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
       if (!active[static_cast<std::size_t>(c)]) continue;
       if (!std::isfinite(pq[c])) return finish(SolveStatus::numerical_issue, "NaN/inf in p^T A p");
       if (!(pq[c] > 0.0))
-        return finish(SolveStatus::not_positive_definite, "p^T A p <= 0: matrix not positive definite");
+        return finish(SolveStatus::not_positive_definite,
+                      "p^T A p <= 0: matrix not positive definite");
       alpha[c] = rz[c] / pq[c];
     }
 
@@ -360,7 +377,8 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
               r[i] -= a * q[i];
             }
           }
-          partials[static_cast<std::size_t>(ch * k + c)] = chunk_dot(R.col(c).data(), R.col(c).data(), b, e);
+          partials[static_cast<std::size_t>(ch * k + c)] =
+              chunk_dot(R.col(c).data(), R.col(c).data(), b, e);
         }
       });
       combine(partials, k, rr);
@@ -370,11 +388,13 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
         res[c] = bnorm[c] > 0.0 ? std::sqrt(rr[c]) / bnorm[c] : std::sqrt(rr[c]);
     rep.iterations = it + 1;
     rep.residuals.push_back(max_res());
-    if (!std::isfinite(rep.residuals.back())) return finish(SolveStatus::numerical_issue, "NaN/inf in the residual");
+    if (!std::isfinite(rep.residuals.back()))
+      return finish(SolveStatus::numerical_issue, "NaN/inf in the residual");
 
     bool all_done = true;
     for (Index c = 0; c < k; ++c) {
-      if (active[static_cast<std::size_t>(c)] && res[c] <= tol) active[static_cast<std::size_t>(c)] = 0;
+      if (active[static_cast<std::size_t>(c)] && res[c] <= tol)
+        active[static_cast<std::size_t>(c)] = 0;
       all_done = all_done && !active[static_cast<std::size_t>(c)];
     }
     if (all_done) {
@@ -397,8 +417,10 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
     apply_preconditioner(R, Z);
     VectorXd rz_new;
     column_dots(R, Z, rz_new);
-    if (!all_finite(rz_new)) return finish(SolveStatus::numerical_issue, "NaN/inf in the preconditioned residual");
-    for (Index c = 0; c < k; ++c) beta[c] = active[static_cast<std::size_t>(c)] ? rz_new[c] / rz[c] : 0.0;
+    if (!all_finite(rz_new))
+      return finish(SolveStatus::numerical_issue, "NaN/inf in the preconditioned residual");
+    for (Index c = 0; c < k; ++c)
+      beta[c] = active[static_cast<std::size_t>(c)] ? rz_new[c] / rz[c] : 0.0;
     for_chunks(n, [&](Index, Index b, Index e) {
       for (Index c = 0; c < k; ++c) {
         if (!active[static_cast<std::size_t>(c)]) continue;
@@ -415,7 +437,8 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
   true_residual();
   rep.relative_residual = max_res();
   if (!rep.residuals.empty()) rep.residuals.back() = rep.relative_residual;
-  if (!std::isfinite(rep.relative_residual)) return finish(SolveStatus::numerical_issue, "NaN/inf in the residual");
+  if (!std::isfinite(rep.relative_residual))
+    return finish(SolveStatus::numerical_issue, "NaN/inf in the residual");
   if (rep.relative_residual <= tol) return rep;
   return finish(SolveStatus::max_iterations,
                 "iteration cap " + std::to_string(options_.max_iterations) + " reached");

@@ -21,8 +21,9 @@ namespace mcf {
 enum class PcgPreconditioner {
   none,
   jacobi,               ///< inverse diagonal
-  incomplete_cholesky,  ///< Eigen IncompleteCholesky<double, Lower, AMDOrdering<int>> (diagonal shift)
-  external              ///< the hook set with PcgSolver::set_preconditioner (e.g. a multigrid cycle)
+  incomplete_cholesky,  ///< Eigen IncompleteCholesky<double, Lower, AMDOrdering<int>> (diagonal
+                        ///< shift)
+  external  ///< the hook set with PcgSolver::set_preconditioner (e.g. a multigrid cycle)
 };
 
 const char* to_string(PcgPreconditioner p);
@@ -73,7 +74,8 @@ class PcgSolver final : public LinearSolver {
  private:
   SolveReport build_preconditioner();
   SolveReport matrix_in_place();  ///< A_ holds the new matrix: finite check, preconditioner, status
-  bool keeps_pattern(const SparseRef& A, std::uint64_t key);  ///< A on A_'s pattern? (key or comparison)
+  bool keeps_pattern(const SparseRef& A,
+                     std::uint64_t key);  ///< A on A_'s pattern? (key or comparison)
   void apply_preconditioner(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) const;
 
   PcgOptions options_;

@@ -14,8 +14,8 @@ using Eigen::Index;
 // Rows [b, e) for a compile-time number of columns K: one pass over each row's entries feeds all
 // K sums (the flows' x, y, z).
 template <int K>
-void rows_fixed(const int* outer, const int* inner, const double* val, const double* X, double* Y, Index n,
-                Index b, Index e) {
+void rows_fixed(const int* outer, const int* inner, const double* val, const double* X, double* Y,
+                Index n, Index b, Index e) {
   for (Index i = b; i < e; ++i) {
     double s[K] = {};
     for (int p = outer[i]; p < outer[i + 1]; ++p) {
@@ -27,8 +27,8 @@ void rows_fixed(const int* outer, const int* inner, const double* val, const dou
   }
 }
 
-void rows_any(const int* outer, const int* inner, const double* val, const double* X, double* Y, Index n, Index k,
-              Index b, Index e) {
+void rows_any(const int* outer, const int* inner, const double* val, const double* X, double* Y,
+              Index n, Index k, Index b, Index e) {
   for (Index c = 0; c < k; ++c)
     for (Index i = b; i < e; ++i) {
       double s = 0.0;
@@ -40,8 +40,10 @@ void rows_any(const int* outer, const int* inner, const double* val, const doubl
 }  // namespace
 
 void symmetric_multiply(const SparseRef& A, const double* X, Index k, double* Y) {
-  if (A.rows() != A.cols()) throw std::invalid_argument("symmetric_multiply: the matrix is not square");
-  if (!A.isCompressed()) throw std::invalid_argument("symmetric_multiply: the matrix is not compressed");
+  if (A.rows() != A.cols())
+    throw std::invalid_argument("symmetric_multiply: the matrix is not square");
+  if (!A.isCompressed())
+    throw std::invalid_argument("symmetric_multiply: the matrix is not compressed");
   const Index n = A.rows();
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
@@ -50,18 +52,29 @@ void symmetric_multiply(const SparseRef& A, const double* X, Index k, double* Y)
   // anyway, but equal chunks balance the rows).
   constexpr Index kChunk = 4096;
   const Index chunks = (n + kChunk - 1) / kChunk;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, chunks, 1), [&](const tbb::blocked_range<Index>& r) {
-    for (Index ch = r.begin(); ch < r.end(); ++ch) {
-      const Index b = ch * kChunk, e = std::min(n, b + kChunk);
-      switch (k) {
-        case 1: rows_fixed<1>(outer, inner, val, X, Y, n, b, e); break;
-        case 2: rows_fixed<2>(outer, inner, val, X, Y, n, b, e); break;
-        case 3: rows_fixed<3>(outer, inner, val, X, Y, n, b, e); break;
-        case 4: rows_fixed<4>(outer, inner, val, X, Y, n, b, e); break;
-        default: rows_any(outer, inner, val, X, Y, n, k, b, e); break;
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<Index>(0, chunks, 1),
+                    [&](const tbb::blocked_range<Index>& r) {
+                      for (Index ch = r.begin(); ch < r.end(); ++ch) {
+                        const Index b = ch * kChunk, e = std::min(n, b + kChunk);
+                        switch (k) {
+                          case 1:
+                            rows_fixed<1>(outer, inner, val, X, Y, n, b, e);
+                            break;
+                          case 2:
+                            rows_fixed<2>(outer, inner, val, X, Y, n, b, e);
+                            break;
+                          case 3:
+                            rows_fixed<3>(outer, inner, val, X, Y, n, b, e);
+                            break;
+                          case 4:
+                            rows_fixed<4>(outer, inner, val, X, Y, n, b, e);
+                            break;
+                          default:
+                            rows_any(outer, inner, val, X, Y, n, k, b, e);
+                            break;
+                        }
+                      }
+                    });
 }
 
 }  // namespace mcf

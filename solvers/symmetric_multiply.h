@@ -24,7 +24,8 @@ void symmetric_multiply(const SparseRef& A, const double* X, Eigen::Index k, dou
 /// Eigen::Ref); Y must be resizable.
 template <class In, class Out>
 void symmetric_multiply(const SparseRef& A, const In& X, Out& Y) {
-  static_assert(!In::IsRowMajor && !Out::IsRowMajor, "symmetric_multiply: column-major dense matrices only");
+  static_assert(!In::IsRowMajor && !Out::IsRowMajor,
+                "symmetric_multiply: column-major dense matrices only");
   if (X.rows() != A.cols()) throw std::invalid_argument("symmetric_multiply: sizes do not match");
   Y.resize(A.rows(), X.cols());
   if (X.outerStride() == X.rows()) {

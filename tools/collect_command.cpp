@@ -38,8 +38,8 @@ struct Group {  // results of one study variant at one commit
   std::map<int, std::vector<std::string>> files_by_index;
   std::vector<int> without_distance;  ///< candidates; reference cells themselves are filtered below
   std::vector<int> errored;           ///< cells whose result is {"status": "error"}
-  std::map<int, json> planned;        ///< index -> {repetition, assignment[, hash]} from `run`'s plans
-  std::vector<std::string> plans;     ///< the plan files read
+  std::map<int, json> planned;     ///< index -> {repetition, assignment[, hash]} from `run`'s plans
+  std::vector<std::string> plans;  ///< the plan files read
 };
 
 std::string group_name(const std::string& study, bool quick, const std::string& commit) {
@@ -65,7 +65,8 @@ std::vector<fs::path> json_files(const fs::path& dir) {
   std::vector<fs::path> paths;
   if (fs::is_directory(dir))
     for (const auto& entry : fs::directory_iterator(dir))
-      if (entry.is_regular_file() && entry.path().extension() == ".json" && entry.path().filename() != "index.json")
+      if (entry.is_regular_file() && entry.path().extension() == ".json" &&
+          entry.path().filename() != "index.json")
         paths.push_back(entry.path());
   std::sort(paths.begin(), paths.end());
   return paths;
@@ -75,7 +76,8 @@ std::vector<fs::path> json_files(const fs::path& dir) {
 std::optional<fs::path> temporary_plan(const fs::path& plans) {
   if (!fs::is_directory(plans)) return std::nullopt;
   for (const auto& entry : fs::directory_iterator(plans))
-    if (entry.path().filename().string().find(".json.tmp.") != std::string::npos) return entry.path();
+    if (entry.path().filename().string().find(".json.tmp.") != std::string::npos)
+      return entry.path();
   return std::nullopt;
 }
 
@@ -92,7 +94,9 @@ std::string describe_cell(int index, const json& c) {
 
 void add_collect_command(CLI::App& app, std::function<int()>& run) {
   auto a = std::make_shared<CollectArgs>();
-  CLI::App* cmd = app.add_subcommand("collect", "Merge result folders (shards) into an index file; check for missing and duplicate cells.");
+  CLI::App* cmd = app.add_subcommand(
+      "collect",
+      "Merge result folders (shards) into an index file; check for missing and duplicate cells.");
   cmd->add_option("dirs", a->dirs, "Result folders")->required();
   cmd->add_option("--out", a->out, "Index file (default FIRST_DIR/index.json)");
   cmd->callback([a, &run] {
@@ -106,7 +110,8 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         size_t found = 0;  // cell results, unreadable files and plans in this folder
         // The plans `run` wrote before its first cell: the cells owed even if none finished.
         for (const auto& path : json_files(fs::path(dir) / kPlanFolder)) {
-          const std::optional<json> read = read_or_list(path, unreadable, "rerun `mcfbench run` to rewrite it");
+          const std::optional<json> read =
+              read_or_list(path, unreadable, "rerun `mcfbench run` to rewrite it");
           if (!read) {
             ++found;
             continue;
@@ -130,7 +135,8 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           }
         }
         for (const auto& path : json_files(dir)) {
-          const std::optional<json> read = read_or_list(path, unreadable, "rerun `mcfbench run` to redo its cell");
+          const std::optional<json> read =
+              read_or_list(path, unreadable, "rerun `mcfbench run` to redo its cell");
           if (!read) {
             ++found;
             continue;
@@ -139,18 +145,26 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           if (!r.is_object() || !r.contains("cell")) continue;
           ++found;
           const json& c = r["cell"];
-          const std::string commit = r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
+          const std::string commit =
+              r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
           const std::string hash = c.value("hash", path.stem().string());
-          json entry = {{"file", path.string()},        {"hash", hash},
-                        {"key", c.value("key", "")},     {"config_key", c.value("config_key", "")},
-                        {"index", c.value("index", -1)}, {"repetition", c.value("repetition", 0)},
-                        {"study", c.value("study", "")}, {"quick", c.value("quick", false)},
-                        {"commit", commit},              {"status", r.value("status", "")},
+          json entry = {{"file", path.string()},
+                        {"hash", hash},
+                        {"key", c.value("key", "")},
+                        {"config_key", c.value("config_key", "")},
+                        {"index", c.value("index", -1)},
+                        {"repetition", c.value("repetition", 0)},
+                        {"study", c.value("study", "")},
+                        {"quick", c.value("quick", false)},
+                        {"commit", commit},
+                        {"status", r.value("status", "")},
                         {"assignment", c.value("assignment", json::object())}};
-          if (r.contains("frames")) entry["frames"] = (path.parent_path() / r["frames"].value("dir", "")).string();
+          if (r.contains("frames"))
+            entry["frames"] = (path.parent_path() / r["frames"].value("dir", "")).string();
           files.push_back(entry);
           // The same hash in two folders is the same cell computed twice (overlapping shards).
-          if (!seen_hash.insert(hash).second) duplicates.push_back({{"hash", hash}, {"file", path.string()}});
+          if (!seen_hash.insert(hash).second)
+            duplicates.push_back({{"hash", hash}, {"file", path.string()}});
           Group& g = groups[group_name(entry["study"], entry["quick"], commit)];
           if (g.study_config.is_null() && r.contains("study_config")) {
             g.study_config = r["study_config"];
@@ -164,8 +178,9 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           // Cells of a study with a reference flow that still lack their distances (their
           // reference was not finished when they ran; an unsharded rerun fills them in).
           if (r.contains("study_config") && r["study_config"].contains("metrics") &&
-              r["study_config"]["metrics"].contains("reference") && !r.contains("reference_distance") &&
-              !r.contains("reference_cell") && r.value("status", "") != "error")
+              r["study_config"]["metrics"].contains("reference") &&
+              !r.contains("reference_distance") && !r.contains("reference_cell") &&
+              r.value("status", "") != "error")
             g.without_distance.push_back(c.value("index", -1));
         }
         if (found == 0) {
@@ -175,18 +190,26 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
           empty_dirs.push_back(dir);
           const std::optional<fs::path> partial = temporary_plan(fs::path(dir) / kPlanFolder);
           if (partial)
-            std::printf("%s: no cell results, and the run plan was never published (%s is its unfinished temporary "
-                        "file): the run was stopped while planning; rerun `mcfbench run` into this folder\n",
-                        dir.c_str(), partial->string().c_str());
+            std::printf(
+                "%s: no cell results, and the run plan was never published (%s is its unfinished "
+                "temporary "
+                "file): the run was stopped while planning; rerun `mcfbench run` into this "
+                "folder\n",
+                dir.c_str(), partial->string().c_str());
           else
-            std::printf("%s: no cell results and no run plan (%s/): not a folder `mcfbench run` wrote into\n",
-                        dir.c_str(), kPlanFolder);
+            std::printf(
+                "%s: no cell results and no run plan (%s/): not a folder `mcfbench run` wrote "
+                "into\n",
+                dir.c_str(), kPlanFolder);
         }
       }
       json studies = json::array();
       bool problems = !duplicates.empty() || !unreadable.empty() || !empty_dirs.empty();
       for (auto& [name, g] : groups) {
-        json s = {{"study", g.study}, {"quick", g.quick}, {"commit", g.commit}, {"cells_found", g.files_by_index.size()}};
+        json s = {{"study", g.study},
+                  {"quick", g.quick},
+                  {"commit", g.commit},
+                  {"cells_found", g.files_by_index.size()}};
         json missing = json::array(), dup = json::array();
         for (const auto& [index, list] : g.files_by_index)
           if (list.size() > 1) dup.push_back({{"index", index}, {"files", list}});
@@ -205,7 +228,8 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         // the re-expanded matrix.
         std::map<int, json> expected = g.planned;
         if (expected.empty() && e)
-          for (const Cell& c : e->cells) expected[c.index] = {{"repetition", c.repetition}, {"assignment", c.assignment}};
+          for (const Cell& c : e->cells)
+            expected[c.index] = {{"repetition", c.repetition}, {"assignment", c.assignment}};
         if (!g.plans.empty()) s["plans"] = g.plans;
         if (!g.planned.empty() || e) {
           s["cells_expected"] = expected.size();
@@ -215,12 +239,15 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         if (e && !g.without_distance.empty()) {
           json lacking = json::array();
           for (int index : g.without_distance)
-            if (index >= 0 && index < int(e->cells.size()) && !matches_assignment(e->cells[size_t(index)], e->metrics.reference))
+            if (index >= 0 && index < int(e->cells.size()) &&
+                !matches_assignment(e->cells[size_t(index)], e->metrics.reference))
               lacking.push_back(index);
           if (!lacking.empty()) {
             s["without_reference_distance"] = lacking;
-            std::printf("%s: %zu cells lack their reference distance (rerun `mcfbench run` without --shard to add them)\n",
-                        name.c_str(), lacking.size());
+            std::printf(
+                "%s: %zu cells lack their reference distance (rerun `mcfbench run` without --shard "
+                "to add them)\n",
+                name.c_str(), lacking.size());
           }
         }
         s["missing"] = missing;
@@ -228,26 +255,43 @@ void add_collect_command(CLI::App& app, std::function<int()>& run) {
         s["errors"] = g.errored;
         // An errored cell is there but holds no result: as incomplete as a missing one.
         problems = problems || !missing.empty() || !dup.empty() || !g.errored.empty();
-        std::printf("%s: %zu cells found%s, %zu missing, %zu duplicated, %zu errored\n", name.c_str(), g.files_by_index.size(),
-                    s.contains("cells_expected") ? (" of " + std::to_string(s["cells_expected"].get<size_t>())).c_str() : "",
+        std::printf("%s: %zu cells found%s, %zu missing, %zu duplicated, %zu errored\n",
+                    name.c_str(), g.files_by_index.size(),
+                    s.contains("cells_expected")
+                        ? (" of " + std::to_string(s["cells_expected"].get<size_t>())).c_str()
+                        : "",
                     missing.size(), dup.size(), g.errored.size());
         if (!missing.empty()) {
           constexpr size_t shown = 5;
           std::string list;
           for (size_t i = 0; i < std::min(shown, missing.size()); ++i)
-            list += (i ? ", " : "") + describe_cell(missing[i].get<int>(), expected[missing[i].get<int>()]);
-          if (missing.size() > shown) list += ", ... and " + std::to_string(missing.size() - shown) + " more";
-          std::printf("  missing cells (%zu): %s (rerun `mcfbench run` to compute them)\n", missing.size(), list.c_str());
+            list += (i ? ", " : "") +
+                    describe_cell(missing[i].get<int>(), expected[missing[i].get<int>()]);
+          if (missing.size() > shown)
+            list += ", ... and " + std::to_string(missing.size() - shown) + " more";
+          std::printf("  missing cells (%zu): %s (rerun `mcfbench run` to compute them)\n",
+                      missing.size(), list.c_str());
         }
         if (!g.errored.empty())
-          std::printf("  errored cell indices: %s (rerun `mcfbench run` to retry them)\n", json(g.errored).dump().c_str());
+          std::printf("  errored cell indices: %s (rerun `mcfbench run` to retry them)\n",
+                      json(g.errored).dump().c_str());
         studies.push_back(s);
       }
-      const std::string out = !a->out.empty() ? a->out : (fs::path(a->dirs.front()) / "index.json").string();
-      write_file_atomic(out, json{{"schema", 1}, {"dirs", a->dirs}, {"studies", studies}, {"duplicates", duplicates},
-                                   {"unreadable", unreadable}, {"empty_dirs", empty_dirs}, {"files", files}}.dump(1) + "\n");
+      const std::string out =
+          !a->out.empty() ? a->out : (fs::path(a->dirs.front()) / "index.json").string();
+      write_file_atomic(out, json{{"schema", 1},
+                                  {"dirs", a->dirs},
+                                  {"studies", studies},
+                                  {"duplicates", duplicates},
+                                  {"unreadable", unreadable},
+                                  {"empty_dirs", empty_dirs},
+                                  {"files", files}}
+                                     .dump(1) +
+                                 "\n");
       std::printf("wrote %s (%zu result files)%s\n", out.c_str(), files.size(),
-                  problems ? "; INCOMPLETE (missing, errored or unreadable cells, or a folder with nothing to collect) or DUPLICATED cells" : "");
+                  problems ? "; INCOMPLETE (missing, errored or unreadable cells, or a folder with "
+                             "nothing to collect) or DUPLICATED cells"
+                           : "");
       return problems ? 1 : 0;
     };
   });

@@ -21,15 +21,26 @@ struct CompareArgs {
 
 void add_compare_command(CLI::App& app, std::function<int()>& run) {
   auto a = std::make_shared<CompareArgs>();
-  CLI::App* cmd = app.add_subcommand("compare", "Compare two result sets cell by cell (speed and accuracy); exit 1 on a regression.");
-  cmd->footer("OLD and NEW are result folders, optionally DIR@COMMIT to pick one commit's results from a shared folder.");
+  CLI::App* cmd = app.add_subcommand(
+      "compare",
+      "Compare two result sets cell by cell (speed and accuracy); exit 1 on a regression.");
+  cmd->footer(
+      "OLD and NEW are result folders, optionally DIR@COMMIT to pick one commit's results from a "
+      "shared folder.");
   cmd->add_option("old", a->old_dir, "Baseline results folder[@commit]")->required();
   cmd->add_option("new", a->new_dir, "New results folder[@commit]")->required();
-  cmd->add_option("--threshold", a->options.threshold, "Relative change that counts (default 0.1 = 10%)")->check(CLI::PositiveNumber);
-  cmd->add_option("--alpha", a->options.alpha, "Significance level of the Mann-Whitney U test (default 0.05)")->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--metric", a->options.metric, "Per-step value compared (dotted path in steps[]; default seconds.total; e.g. seconds.solve)");
+  cmd->add_option("--threshold", a->options.threshold,
+                  "Relative change that counts (default 0.1 = 10%)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--alpha", a->options.alpha,
+                  "Significance level of the Mann-Whitney U test (default 0.05)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--metric", a->options.metric,
+                  "Per-step value compared (dotted path in steps[]; default seconds.total; e.g. "
+                  "seconds.solve)");
   cmd->add_flag("--all", a->options.show_all, "List unchanged cells in the table too");
-  cmd->add_option("--history", a->history, "Append one JSON line for NEW to this file (no value: results/history.jsonl)")
+  cmd->add_option("--history", a->history,
+                  "Append one JSON line for NEW to this file (no value: results/history.jsonl)")
       ->expected(0, 1);
   cmd->callback([cmd, a, &run] {
     run = [cmd, a]() -> int {

@@ -31,24 +31,32 @@ void add_distance_command(CLI::App& app, std::function<int()>& run) {
     std::uint64_t seed = 1;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand(
-      "distance",
-      "Metro-style distance between two surfaces: uniform area sampling of each, exact point-to-triangle "
-      "distance to the other through a BVH. Prints JSON {rms_forward, max_forward, rms_backward, max_backward, "
-      "rms, max, samples} (forward: samples of A to B; max = Hausdorff).");
-  cmd->footer("A and B: an existing mesh file is read as is, NOT scaled into the unit cube (a flow's output is\n"
-              "already in its flow's frame); anything else is a mesh spec, handled as everywhere else:\n" +
-              mesh_spec_help());
+  CLI::App* cmd =
+      app.add_subcommand("distance",
+                         "Metro-style distance between two surfaces: uniform area sampling of "
+                         "each, exact point-to-triangle "
+                         "distance to the other through a BVH. Prints JSON {rms_forward, "
+                         "max_forward, rms_backward, max_backward, "
+                         "rms, max, samples} (forward: samples of A to B; max = Hausdorff).");
+  cmd->footer(
+      "A and B: an existing mesh file is read as is, NOT scaled into the unit cube (a flow's "
+      "output is\n"
+      "already in its flow's frame); anything else is a mesh spec, handled as everywhere else:\n" +
+      mesh_spec_help());
   cmd->add_option("A", args->a, "First surface: file or mesh spec")->required();
   cmd->add_option("B", args->b, "Second surface: file or mesh spec")->required();
-  cmd->add_option("--samples", args->samples, "Samples per surface")->check(CLI::Range(1LL, 1000000000LL))->capture_default_str();
-  cmd->add_option("--seed", args->seed, "Random seed (same seed, same samples, same answer)")->capture_default_str();
+  cmd->add_option("--samples", args->samples, "Samples per surface")
+      ->check(CLI::Range(1LL, 1000000000LL))
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed, "Random seed (same seed, same samples, same answer)")
+      ->capture_default_str();
   cmd->callback([args, &run] {
     run = [args]() -> int {
       const TriangleMesh a = load_surface(args->a), b = load_surface(args->b);
       const auto start = std::chrono::steady_clock::now();
       const MeshDistance d = mesh_distance(a, b, args->samples, args->seed);
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const nlohmann::json j = {{"a", args->a},
                                 {"b", args->b},
                                 {"rms_forward", d.rms_forward},

@@ -38,7 +38,8 @@ struct FlowArgs {
   // Every flag maps to one key of the flow config; only flags given on the command line are
   // set, so --config FILE supplies the rest.
   std::string mesh, flow, basis, mass, tracking, cube, solver, preconditioner, cycle, integrator;
-  int depth = 0, cubature = 0, max_iterations = 0, cycles = 0, smooth = 0, steps = 0, threads = 0, save_every = 0;
+  int depth = 0, cubature = 0, max_iterations = 0, cycles = 0, smooth = 0, steps = 0, threads = 0,
+      save_every = 0;
   double dt = 0, tolerance = 0;
   bool refine_input = false, normalize_area = false, frozen = false;
 };
@@ -47,35 +48,56 @@ struct FlowArgs {
 
 void add_flow_command(CLI::App& app, std::function<int()>& run) {
   auto args = std::make_shared<FlowArgs>();
-  CLI::App* cmd = app.add_subcommand("flow", "Run one flow and write OUT/result.json, OUT/final.ply (and frames).");
+  CLI::App* cmd = app.add_subcommand(
+      "flow", "Run one flow and write OUT/result.json, OUT/final.ply (and frames).");
   cmd->footer("Mesh specs:\n" + mesh_spec_help() +
-              "\nExample:\n  mcfbench flow --mesh sphere:vertices=2000 --flow mcf --basis hat --solver cholmod "
+              "\nExample:\n  mcfbench flow --mesh sphere:vertices=2000 --flow mcf --basis hat "
+              "--solver cholmod "
               "--dt 1e-3 --steps 20 --out out/sphere\n");
-  cmd->add_option("--config", args->config_file, "JSON flow config (same keys as result.json's \"config\"); flags override it");
-  cmd->add_option("--mesh", args->mesh, "Mesh spec: generator, cgal:MODEL[@faces=N] or a file path");
-  cmd->add_option("--flow", args->flow, "mcf | cmcf (stiffness of t=0 kept) | heat (both operators of t=0)");
+  cmd->add_option("--config", args->config_file,
+                  "JSON flow config (same keys as result.json's \"config\"); flags override it");
+  cmd->add_option("--mesh", args->mesh,
+                  "Mesh spec: generator, cgal:MODEL[@faces=N] or a file path");
+  cmd->add_option("--flow", args->flow,
+                  "mcf | cmcf (stiffness of t=0 kept) | heat (both operators of t=0)");
   cmd->add_option("--basis", args->basis, "hat (P1, cotangent) | octree (trilinear B-splines)");
   cmd->add_option("--mass", args->mass, "Hat basis mass matrix: consistent (default) | lumped");
-  cmd->add_option("--tracking", args->tracking, "Octree: tracked (default; built once, metric re-integrated) | rebuilt (every step)");
+  cmd->add_option(
+      "--tracking", args->tracking,
+      "Octree: tracked (default; built once, metric re-integrated) | rebuilt (every step)");
   cmd->add_option("--depth", args->depth, "Octree depth (finest level), 4..10 (default 8)");
-  cmd->add_option("--cubature", args->cubature, "Octree cubature rule per split triangle: 1 | 3 (default) | 6");
-  cmd->add_option("--cube", args->cube, "Octree bounding cube: auto (default: unit cube if the mesh fits) | unit | tight");
-  cmd->add_flag("--refine-input", args->refine_input, "Octree: split the input mesh 1-to-4 once first");
-  cmd->add_option("--solver", args->solver, "cholmod (default) | pcg | multigrid | dense (LLT of the dense matrix: a reference for small meshes)");
-  cmd->add_option("--tolerance", args->tolerance, "Relative residual to stop at (PCG default 1e-10; multigrid default 0 = run --cycles)");
+  cmd->add_option("--cubature", args->cubature,
+                  "Octree cubature rule per split triangle: 1 | 3 (default) | 6");
+  cmd->add_option(
+      "--cube", args->cube,
+      "Octree bounding cube: auto (default: unit cube if the mesh fits) | unit | tight");
+  cmd->add_flag("--refine-input", args->refine_input,
+                "Octree: split the input mesh 1-to-4 once first");
+  cmd->add_option("--solver", args->solver,
+                  "cholmod (default) | pcg | multigrid | dense (LLT of the dense matrix: a "
+                  "reference for small meshes)");
+  cmd->add_option(
+      "--tolerance", args->tolerance,
+      "Relative residual to stop at (PCG default 1e-10; multigrid default 0 = run --cycles)");
   cmd->add_option("--max-iterations", args->max_iterations, "PCG iteration cap (default 1000)");
-  cmd->add_option("--preconditioner", args->preconditioner, "PCG: none | jacobi (default) | ichol | multigrid");
+  cmd->add_option("--preconditioner", args->preconditioner,
+                  "PCG: none | jacobi (default) | ichol | multigrid");
   cmd->add_option("--cycle", args->cycle, "Multigrid cycle: V | W (default)");
   cmd->add_option("--cycles", args->cycles, "Multigrid cycles per solve (default 1)");
-  cmd->add_option("--smooth", args->smooth, "Gauss-Seidel sweeps before and after each coarse correction (default 5)");
-  cmd->add_option("--integrator", args->integrator,
-                  "explicit-euler | semi-implicit (default) | crank-nicolson | bdf2 | taylor2 | neumann2");
-  cmd->add_flag("--frozen", args->frozen, "CN/BDF2: evaluate operators at X_n instead of the extrapolated X* (first order)");
+  cmd->add_option("--smooth", args->smooth,
+                  "Gauss-Seidel sweeps before and after each coarse correction (default 5)");
+  cmd->add_option(
+      "--integrator", args->integrator,
+      "explicit-euler | semi-implicit (default) | crank-nicolson | bdf2 | taylor2 | neumann2");
+  cmd->add_flag("--frozen", args->frozen,
+                "CN/BDF2: evaluate operators at X_n instead of the extrapolated X* (first order)");
   cmd->add_option("--dt", args->dt, "Time step (default 1e-3)");
   cmd->add_option("--steps", args->steps, "Number of steps (default 10)");
-  cmd->add_flag("--normalize-area", args->normalize_area, "Unit total area, centroid at the origin, before and after every step");
+  cmd->add_flag("--normalize-area", args->normalize_area,
+                "Unit total area, centroid at the origin, before and after every step");
   cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores, default)");
-  cmd->add_option("--save-every", args->save_every, "Write OUT/frame_NNNNN.ply every K steps (0 = never)");
+  cmd->add_option("--save-every", args->save_every,
+                  "Write OUT/frame_NNNNN.ply every K steps (0 = never)");
   cmd->add_option("--out", args->out, "Output folder")->required();
 
   run = nullptr;
@@ -125,7 +147,8 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       set("--save-every", "save_every", args->save_every);
 
       const FlowConfig config = flow_config_from_json(j, source);
-      const MeshSource mesh = load_mesh_spec(config.mesh);  // throws naming the file: nothing written yet
+      const MeshSource mesh =
+          load_mesh_spec(config.mesh);  // throws naming the file: nothing written yet
       const double line_seconds = progress_line_seconds();  // a bad MCFBENCH_PROGRESS_SECONDS too
 
       namespace fs = std::filesystem;
@@ -148,7 +171,8 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
           if (config.save_every > 0 && step % config.save_every == 0) {
             char name[32];
             std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-            write_mesh((staging / name).string(), TriangleMesh{V, mesh.mesh.faces}, true, FaceCheck::trusted);
+            write_mesh((staging / name).string(), TriangleMesh{V, mesh.mesh.faces}, true,
+                       FaceCheck::trusted);
             frames.insert(name);
           }
         };
@@ -170,7 +194,8 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
       // (rename: each appears whole), and result.json comes last, atomically.
       fs::remove(out / "result.json");
       for (const auto& entry : fs::directory_iterator(out))
-        if (entry.is_regular_file() && is_frame_file(entry.path()) && !frames.count(entry.path().filename().string()))
+        if (entry.is_regular_file() && is_frame_file(entry.path()) &&
+            !frames.count(entry.path().filename().string()))
           fs::remove(entry.path());
       for (const std::string& name : frames) fs::rename(staging / name, out / name);
       fs::rename(staging / "final.ply", out / "final.ply");

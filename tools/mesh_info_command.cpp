@@ -14,15 +14,20 @@ namespace mcf {
 void add_mesh_info_command(CLI::App& app, std::function<int()>& run) {
   auto spec = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();
-  CLI::App* cmd = app.add_subcommand("mesh-info", "Load and validate a mesh spec; print vertices, faces, boundary loops, components, genus, area as JSON.");
+  CLI::App* cmd = app.add_subcommand("mesh-info",
+                                     "Load and validate a mesh spec; print vertices, faces, "
+                                     "boundary loops, components, genus, area as JSON.");
   cmd->footer("Mesh specs:\n" + mesh_spec_help());
   cmd->add_option("spec", *spec, "Mesh spec or file")->required();
-  cmd->add_option("--write", *out, "Also write the (generated / scaled / subdivided) mesh to this file (.off .ply .obj .stl)");
+  cmd->add_option(
+      "--write", *out,
+      "Also write the (generated / scaled / subdivided) mesh to this file (.off .ply .obj .stl)");
   cmd->callback([spec, out, &run] {
     run = [spec, out]() -> int {
       const MeshSource m = load_mesh_spec(*spec);
       const MeshReport& r = m.report;
-      const Eigen::Vector3d lo = m.mesh.vertices.colwise().minCoeff(), hi = m.mesh.vertices.colwise().maxCoeff();
+      const Eigen::Vector3d lo = m.mesh.vertices.colwise().minCoeff(),
+                            hi = m.mesh.vertices.colwise().maxCoeff();
       nlohmann::json j = {{"spec", m.spec},
                           {"kind", m.kind},
                           {"analytic", m.analytic},

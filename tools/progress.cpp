@@ -1,9 +1,9 @@
 #include "tools/progress.h"
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace mcf {
 
@@ -13,22 +13,28 @@ double progress_line_seconds() {
   char* end = nullptr;
   const double seconds = std::strtod(text, &end);
   if (*end != '\0' || !std::isfinite(seconds) || seconds < 0)
-    throw std::invalid_argument(std::string("MCFBENCH_PROGRESS_SECONDS: expected seconds >= 0, got '") + text + "'");
+    throw std::invalid_argument(
+        std::string("MCFBENCH_PROGRESS_SECONDS: expected seconds >= 0, got '") + text + "'");
   return seconds;
 }
 
-Progress::Progress(std::string what, long long total, double line_seconds, Mode mode, std::FILE* out)
+Progress::Progress(std::string what, long long total, double line_seconds, Mode mode,
+                   std::FILE* out)
     : what_(std::move(what)),
       total_(total),
-      terminal_(mode == Mode::terminal || (mode == Mode::automatic && ::isatty(::fileno(out)) != 0)),
+      terminal_(mode == Mode::terminal ||
+                (mode == Mode::automatic && ::isatty(::fileno(out)) != 0)),
       out_(out),
       line_seconds_(line_seconds),
       start_(std::chrono::steady_clock::now()) {}
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+  finish();
+}
 
 void Progress::update(long long done, const std::string& extra) {
-  update_at(std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(), done, extra);
+  update_at(std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(), done,
+            extra);
 }
 
 void Progress::update_at(double seconds, long long done, const std::string& extra) {
@@ -44,8 +50,9 @@ void Progress::update_at(double seconds, long long done, const std::string& extr
 
 void Progress::print(double seconds, long long done, const std::string& extra) {
   const double left = done > 0 ? seconds * double(total_ - done) / double(done) : 0.0;
-  std::fprintf(out_, "%s%s %lld/%lld  %.1f s  left %.1f s%s%s%s", terminal_ ? "\r" : "", what_.c_str(), done, total_,
-               seconds, left, extra.empty() ? "" : "  ", extra.c_str(), terminal_ ? "\033[K" : "\n");
+  std::fprintf(out_, "%s%s %lld/%lld  %.1f s  left %.1f s%s%s%s", terminal_ ? "\r" : "",
+               what_.c_str(), done, total_, seconds, left, extra.empty() ? "" : "  ", extra.c_str(),
+               terminal_ ? "\033[K" : "\n");
   std::fflush(out_);
   open_ = terminal_;
 }

@@ -2,8 +2,8 @@
 // piece frame against an Eigen construction, the 8x8 blocks against a plain triple loop.
 #include "bases/cell_blocks.h"
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <random>
 
@@ -14,7 +14,8 @@ TEST(PieceFrame, IsTheScaledOrthonormalFrameOfThePlane) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 200; ++trial) {
-    const Eigen::Vector3d p0(u(rng), u(rng), u(rng)), p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
+    const Eigen::Vector3d p0(u(rng), u(rng), u(rng)), p1(u(rng), u(rng), u(rng)),
+        p2(u(rng), u(rng), u(rng));
     const double scale = 1.0 + 10.0 * std::abs(u(rng));
     double f1[3], f2[3];
     const double len = piece_frame(p0.data(), p1.data(), p2.data(), scale, f1, f2);

@@ -14,7 +14,8 @@ using mcf::GridCube;
 
 // Sum of piece areas per source triangle must equal the triangle's area; every piece's centroid
 // lies in its (closed) cell; returns the total piece area.
-double check_pieces(const mcf::TriangleMesh& m, const GridCube& cube, const std::vector<ClippedTriangle>& pieces) {
+double check_pieces(const mcf::TriangleMesh& m, const GridCube& cube,
+                    const std::vector<ClippedTriangle>& pieces) {
   std::vector<double> area(static_cast<std::size_t>(m.num_faces()), 0.0);
   const double h = cube.cell_size();
   int prev = -1;
@@ -78,9 +79,12 @@ TEST(Clip, TrianglesInsideGridPlanesAreNotDoubled) {
   // The surface of the box [0.25,0.75]^3: every face lies in a grid plane (depth 4).
   mcf::TriangleMesh m;
   m.vertices.resize(8, 3);
-  for (int c = 0; c < 8; ++c) m.vertices.row(c) << 0.25 + 0.5 * (c & 1), 0.25 + 0.5 * ((c >> 1) & 1), 0.25 + 0.5 * ((c >> 2) & 1);
+  for (int c = 0; c < 8; ++c)
+    m.vertices.row(c) << 0.25 + 0.5 * (c & 1), 0.25 + 0.5 * ((c >> 1) & 1),
+        0.25 + 0.5 * ((c >> 2) & 1);
   m.faces.resize(12, 3);
-  m.faces << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5;
+  m.faces << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4,
+      6, 1, 3, 5, 3, 7, 5;
   const GridCube cube = mcf::choose_cube(m, 4, mcf::OctreeCube::unit);
   const auto pieces = mcf::clip_mesh(m.vertices, m.faces, cube);
   const double total = check_pieces(m, cube, pieces);
@@ -125,8 +129,9 @@ TEST(Clip, DeterministicAndEqualToSerial) {
   const auto pieces = mcf::clip_mesh(m.vertices, m.faces, cube);
   std::vector<ClippedTriangle> serial;
   for (Eigen::Index f = 0; f < m.num_faces(); ++f)
-    mcf::clip_triangle(m.vertices.row(m.faces(f, 0)).transpose(), m.vertices.row(m.faces(f, 1)).transpose(),
-                       m.vertices.row(m.faces(f, 2)).transpose(), static_cast<int>(f), cube, serial);
+    mcf::clip_triangle(
+        m.vertices.row(m.faces(f, 0)).transpose(), m.vertices.row(m.faces(f, 1)).transpose(),
+        m.vertices.row(m.faces(f, 2)).transpose(), static_cast<int>(f), cube, serial);
   ASSERT_EQ(pieces.size(), serial.size());
   for (std::size_t i = 0; i < pieces.size(); ++i) {
     EXPECT_EQ(pieces[i].triangle, serial[i].triangle);

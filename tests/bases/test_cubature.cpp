@@ -11,14 +11,19 @@
 
 namespace {
 
-double factorial(int n) { return n <= 1 ? 1.0 : n * factorial(n - 1); }
+double factorial(int n) {
+  return n <= 1 ? 1.0 : n * factorial(n - 1);
+}
 
 // ∫ x^a y^b over the reference triangle (0,0),(1,0),(0,1).
-double reference_exact(int a, int b) { return factorial(a) * factorial(b) / factorial(a + b + 2); }
+double reference_exact(int a, int b) {
+  return factorial(a) * factorial(b) / factorial(a + b + 2);
+}
 
 double reference_cubature(const mcf::CubatureRule& r, int a, int b) {
   double s = 0.0;
-  for (int q = 0; q < r.size(); ++q) s += r.weights[q] * std::pow(r.points[q][1], a) * std::pow(r.points[q][2], b);
+  for (int q = 0; q < r.size(); ++q)
+    s += r.weights[q] * std::pow(r.points[q][1], a) * std::pow(r.points[q][2], b);
   return 0.5 * s;
 }
 
@@ -37,20 +42,26 @@ Poly mul(const Poly& p, const Poly& q) {
 // the reference triangle: ∫_T f = 2|T| ∫_ref f∘F.
 double triangle_exact(const Eigen::Vector2d v[3], int a, int b) {
   Poly X = Poly::Zero(2, 2), Y = Poly::Zero(2, 2);
-  X(0, 0) = v[0].x(); X(1, 0) = v[1].x() - v[0].x(); X(0, 1) = v[2].x() - v[0].x();
-  Y(0, 0) = v[0].y(); Y(1, 0) = v[1].y() - v[0].y(); Y(0, 1) = v[2].y() - v[0].y();
+  X(0, 0) = v[0].x();
+  X(1, 0) = v[1].x() - v[0].x();
+  X(0, 1) = v[2].x() - v[0].x();
+  Y(0, 0) = v[0].y();
+  Y(1, 0) = v[1].y() - v[0].y();
+  Y(0, 1) = v[2].y() - v[0].y();
   Poly f = Poly::Ones(1, 1);
   for (int i = 0; i < a; ++i) f = mul(f, X);
   for (int i = 0; i < b; ++i) f = mul(f, Y);
   double s = 0.0;
   for (int i = 0; i < f.rows(); ++i)
     for (int j = 0; j < f.cols(); ++j) s += f(i, j) * reference_exact(i, j);
-  const double jac = std::abs((v[1] - v[0]).x() * (v[2] - v[0]).y() - (v[1] - v[0]).y() * (v[2] - v[0]).x());
+  const double jac =
+      std::abs((v[1] - v[0]).x() * (v[2] - v[0]).y() - (v[1] - v[0]).y() * (v[2] - v[0]).x());
   return jac * s;
 }
 
 double triangle_cubature(const mcf::CubatureRule& r, const Eigen::Vector2d v[3], int a, int b) {
-  const double area = 0.5 * std::abs((v[1] - v[0]).x() * (v[2] - v[0]).y() - (v[1] - v[0]).y() * (v[2] - v[0]).x());
+  const double area =
+      0.5 * std::abs((v[1] - v[0]).x() * (v[2] - v[0]).y() - (v[1] - v[0]).y() * (v[2] - v[0]).x());
   double s = 0.0;
   for (int q = 0; q < r.size(); ++q) {
     const Eigen::Vector2d p = r.points[q][0] * v[0] + r.points[q][1] * v[1] + r.points[q][2] * v[2];
@@ -95,7 +106,8 @@ TEST(Cubature, ExactOnReferenceTriangleUpToDegree) {
     const auto& r = mcf::cubature_rule(order);
     for (int a = 0; a <= r.degree; ++a)
       for (int b = 0; a + b <= r.degree; ++b)
-        EXPECT_NEAR(reference_cubature(r, a, b), reference_exact(a, b), 1e-13 * reference_exact(a, b))
+        EXPECT_NEAR(reference_cubature(r, a, b), reference_exact(a, b),
+                    1e-13 * reference_exact(a, b))
             << "order " << order << " x^" << a << " y^" << b;
   }
 }
@@ -107,7 +119,8 @@ TEST(Cubature, NotExactBeyondDegree) {
     double worst = 0.0;
     for (int a = 0; a <= r.degree + 1; ++a) {
       const int b = r.degree + 1 - a;
-      worst = std::max(worst, std::abs(reference_cubature(r, a, b) - reference_exact(a, b)) / reference_exact(a, b));
+      worst = std::max(worst, std::abs(reference_cubature(r, a, b) - reference_exact(a, b)) /
+                                  reference_exact(a, b));
     }
     EXPECT_GT(worst, 1e-6) << "order " << order;
   }
@@ -125,7 +138,8 @@ TEST(Cubature, ExactOnRandomTriangles) {
           const double exact = triangle_exact(v, a, b);
           // Scale for the tolerance: ∫|x|^a|y|^b ≤ area · max|x|^a|y|^b ≤ area · 2^(a+b).
           const double scale = triangle_exact(v, 0, 0) * std::pow(2.0, a + b);
-          EXPECT_NEAR(triangle_cubature(r, v, a, b), exact, 1e-12 * scale) << "order " << order << " a " << a << " b " << b;
+          EXPECT_NEAR(triangle_cubature(r, v, a, b), exact, 1e-12 * scale)
+              << "order " << order << " a " << a << " b " << b;
         }
     }
   }

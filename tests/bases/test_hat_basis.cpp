@@ -5,8 +5,8 @@
 #include "bases/hat_basis.h"
 #include "datasets/generators.h"
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include <random>
 
@@ -98,7 +98,8 @@ TEST(HatBasis, LumpedMassIsTheRowSumsOfTheConsistentOne) {
   const Eigen::VectorXd row_sums = reference_mass(m).rowwise().sum();
   EXPECT_LT((Eigen::MatrixXd(M.diagonal().asDiagonal()) - M).norm(), 1e-15 * M.norm());
   EXPECT_LT((M.diagonal() - row_sums).norm(), 1e-12 * row_sums.norm());
-  EXPECT_EQ((Eigen::MatrixXd(lumped.stiffness()) - Eigen::MatrixXd(consistent.stiffness())).norm(), 0.0);
+  EXPECT_EQ((Eigen::MatrixXd(lumped.stiffness()) - Eigen::MatrixXd(consistent.stiffness())).norm(),
+            0.0);
 }
 
 TEST(HatBasis, SphereDirichletEnergyConverges) {
@@ -135,7 +136,8 @@ TEST(HatBasis, MassAndStiffnessShareOnePattern) {
   EXPECT_EQ(M.outerIndexPtr(), K.outerIndexPtr());
   EXPECT_EQ(M.innerIndexPtr(), K.innerIndexPtr());
   EXPECT_NE(M.valuePtr(), K.valuePtr());
-  EXPECT_EQ(M.nonZeros(), 8 + 2 * 14);  // the diagonal and both directions of 7 spokes and 7 rim edges
+  EXPECT_EQ(M.nonZeros(),
+            8 + 2 * 14);  // the diagonal and both directions of 7 spokes and 7 rim edges
   const SparseMatrix M0 = M;
   basis.update(2.0 * mesh.vertices, true, true);
   EXPECT_EQ(basis.mass().valuePtr(), M.valuePtr());

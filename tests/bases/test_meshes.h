@@ -18,11 +18,13 @@ namespace {
 inline mcf::TriangleMesh test_icosphere(int level, double radius = 1.0,
                                         const Eigen::Vector3d& center = Eigen::Vector3d::Zero()) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> V = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<std::array<int, 3>> F = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                                       {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                                       {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  std::vector<Eigen::Vector3d> V = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                    {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                    {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::array<int, 3>> F = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (auto& v : V) v.normalize();
   for (int l = 0; l < level; ++l) {
     std::map<std::pair<int, int>, int> mid;
@@ -47,9 +49,11 @@ inline mcf::TriangleMesh test_icosphere(int level, double radius = 1.0,
   }
   mcf::TriangleMesh m;
   m.vertices.resize(static_cast<Eigen::Index>(V.size()), 3);
-  for (std::size_t i = 0; i < V.size(); ++i) m.vertices.row(static_cast<Eigen::Index>(i)) = (center + radius * V[i]).transpose();
+  for (std::size_t i = 0; i < V.size(); ++i)
+    m.vertices.row(static_cast<Eigen::Index>(i)) = (center + radius * V[i]).transpose();
   m.faces.resize(static_cast<Eigen::Index>(F.size()), 3);
-  for (std::size_t i = 0; i < F.size(); ++i) m.faces.row(static_cast<Eigen::Index>(i)) << F[i][0], F[i][1], F[i][2];
+  for (std::size_t i = 0; i < F.size(); ++i)
+    m.faces.row(static_cast<Eigen::Index>(i)) << F[i][0], F[i][1], F[i][2];
   return m;
 }
 

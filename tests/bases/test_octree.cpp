@@ -38,7 +38,8 @@ Fixture make_fixture(int depth, mcf::OctreeCube cube_kind = mcf::OctreeCube::tig
 
 // The system's mass and stiffness as matrices of their own (assemble() gives values on the
 // system's pattern, view() shows them as matrices).
-std::pair<mcf::SparseMatrix, mcf::SparseMatrix> assembled(const mcf::OctreeSystem& sys, const mcf::CubatureRule& rule) {
+std::pair<mcf::SparseMatrix, mcf::SparseMatrix> assembled(const mcf::OctreeSystem& sys,
+                                                          const mcf::CubatureRule& rule) {
   std::vector<double> m, k;
   sys.assemble(rule, m, k);
   return {mcf::SparseMatrix(sys.view(m)), mcf::SparseMatrix(sys.view(k))};
@@ -150,7 +151,8 @@ TEST(Octree, ProlongationReproducesCoarseFunctions) {
       Eigen::VectorXd coarse_from_fine = Pl.transpose() * fine;  // Σ_f P_fc B_f(p)
       Eigen::VectorXd coarse = Eigen::VectorXd::Zero(Pl.cols());
       for (int q = 0; q < 8; ++q) coarse[bc.functions[q]] += bc.weights[q];
-      EXPECT_LT((coarse_from_fine - coarse).cwiseAbs().maxCoeff(), 1e-14) << "level " << l << " point " << i;
+      EXPECT_LT((coarse_from_fine - coarse).cwiseAbs().maxCoeff(), 1e-14)
+          << "level " << l << " point " << i;
       cell[i] = coarse_cell;
     }
   }
@@ -189,7 +191,8 @@ TEST(Octree, PatternIsSymmetricAndColoursSeparateNeighbours) {
   EXPECT_TRUE(A.isCompressed());
   const auto& col = colours.back();
   for (int J = 0; J < A.outerSize(); ++J) {
-    EXPECT_TRUE(std::is_sorted(A.innerIndexPtr() + A.outerIndexPtr()[J], A.innerIndexPtr() + A.outerIndexPtr()[J + 1]));
+    EXPECT_TRUE(std::is_sorted(A.innerIndexPtr() + A.outerIndexPtr()[J],
+                               A.innerIndexPtr() + A.outerIndexPtr()[J + 1]));
     for (mcf::SparseMatrix::InnerIterator it(A, J); it; ++it) {
       if (it.row() != J) {
         EXPECT_NE(col[it.row()], col[J]);
@@ -199,7 +202,8 @@ TEST(Octree, PatternIsSymmetricAndColoursSeparateNeighbours) {
   const mcf::SparseMatrix At = A.transpose();
   EXPECT_EQ(At.nonZeros(), A.nonZeros());
   for (int J = 0; J < A.outerSize(); ++J)
-    for (int s = A.outerIndexPtr()[J]; s < A.outerIndexPtr()[J + 1]; ++s) EXPECT_EQ(A.innerIndexPtr()[s], At.innerIndexPtr()[s]);
+    for (int s = A.outerIndexPtr()[J]; s < A.outerIndexPtr()[J + 1]; ++s)
+      EXPECT_EQ(A.innerIndexPtr()[s], At.innerIndexPtr()[s]);
 }
 
 }  // namespace

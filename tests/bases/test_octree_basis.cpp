@@ -59,8 +59,12 @@ TEST(OctreeBasis, MassAndStiffnessIdentities) {
     // Partition of unity: Σ_IJ M_IJ = area.
     EXPECT_NEAR(M.sum(), area, 1e-12 * area) << "order " << order;
     // Symmetry (full storage).
-    EXPECT_LT(mcf::SparseMatrix(M - mcf::SparseMatrix(M.transpose())).coeffs().cwiseAbs().maxCoeff(), 1e-15);
-    EXPECT_LT(mcf::SparseMatrix(K - mcf::SparseMatrix(K.transpose())).coeffs().cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT(
+        mcf::SparseMatrix(M - mcf::SparseMatrix(M.transpose())).coeffs().cwiseAbs().maxCoeff(),
+        1e-15);
+    EXPECT_LT(
+        mcf::SparseMatrix(K - mcf::SparseMatrix(K.transpose())).coeffs().cwiseAbs().maxCoeff(),
+        1e-12);
     // Constants are in the kernel of K.
     const Eigen::VectorXd one = Eigen::VectorXd::Ones(K.rows());
     const double kscale = K.coeffs().cwiseAbs().maxCoeff();
@@ -83,7 +87,8 @@ TEST(OctreeBasis, MassAndStiffnessIdentities) {
     EXPECT_EQ(s.split_triangles, static_cast<long long>(basis.pieces().size()));
     EXPECT_EQ(s.cubature_points, s.split_triangles * mcf::cubature_rule(order).size());
     EXPECT_EQ(s.levels, 5);
-    for (const char* phase : {"octree", "clip", "integrate", "hierarchy"}) EXPECT_EQ(s.setup_seconds.count(phase), 1u) << phase;
+    for (const char* phase : {"octree", "clip", "integrate", "hierarchy"})
+      EXPECT_EQ(s.setup_seconds.count(phase), 1u) << phase;
   }
 }
 
@@ -118,7 +123,8 @@ TEST(OctreeBasis, RebuildFollowsTheMesh) {
   EXPECT_NEAR(basis.mass().sum(), area, 1e-12 * area);
   // Tight cube follows the mesh: same relative resolution, about the same dimension.
   EXPECT_NEAR(static_cast<double>(basis.dimension()), static_cast<double>(dim0), 0.05 * dim0);
-  EXPECT_LT((basis.evaluate_vertices(basis.initial_coefficients()) - v).cwiseAbs().maxCoeff(), 1e-13);
+  EXPECT_LT((basis.evaluate_vertices(basis.initial_coefficients()) - v).cwiseAbs().maxCoeff(),
+            1e-13);
   EXPECT_THROW(basis.rebuild(mcf::Positions::Zero(4, 3)), std::invalid_argument);
 }
 
@@ -144,7 +150,9 @@ TEST(OctreeBasis, MassAndStiffnessShareTheSystemsPattern) {
     ASSERT_EQ(Mf.nonZeros(), M.nonZeros()) << build;
     ASSERT_NE(Mf.innerIndexPtr(), M.innerIndexPtr()) << build;
     const auto n = std::size_t(M.nonZeros());
-    EXPECT_TRUE(std::equal(Mf.outerIndexPtr(), Mf.outerIndexPtr() + M.cols() + 1, M.outerIndexPtr())) << build;
+    EXPECT_TRUE(
+        std::equal(Mf.outerIndexPtr(), Mf.outerIndexPtr() + M.cols() + 1, M.outerIndexPtr()))
+        << build;
     EXPECT_TRUE(std::equal(Mf.innerIndexPtr(), Mf.innerIndexPtr() + n, M.innerIndexPtr())) << build;
     EXPECT_TRUE(std::equal(Mf.valuePtr(), Mf.valuePtr() + n, M.valuePtr())) << build;
     EXPECT_TRUE(std::equal(Kf.valuePtr(), Kf.valuePtr() + n, K.valuePtr())) << build;
@@ -166,7 +174,8 @@ TEST(OctreeBasis, OpenSurfaceLocksBoundaryFunctions) {
     if (z > 0.58) keep.push_back(static_cast<int>(f));
   }
   mcf::TriangleMesh cap{full.vertices, mcf::Triangles(static_cast<Eigen::Index>(keep.size()), 3)};
-  for (std::size_t i = 0; i < keep.size(); ++i) cap.faces.row(static_cast<Eigen::Index>(i)) = full.faces.row(keep[i]);
+  for (std::size_t i = 0; i < keep.size(); ++i)
+    cap.faces.row(static_cast<Eigen::Index>(i)) = full.faces.row(keep[i]);
   const auto bedges = mcf::boundary_edges(cap.faces);
   ASSERT_FALSE(bedges.empty());
   // Only the vertices used by the cap must be located: drop unused ones by remapping.
@@ -193,7 +202,8 @@ TEST(OctreeBasis, OpenSurfaceLocksBoundaryFunctions) {
   for (int I : locked) {
     double best = 1e9;
     for (const auto& e : be) {
-      const Eigen::Vector3d a = m.vertices.row(e[0]).transpose(), b = m.vertices.row(e[1]).transpose();
+      const Eigen::Vector3d a = m.vertices.row(e[0]).transpose(),
+                            b = m.vertices.row(e[1]).transpose();
       const Eigen::Vector3d p = c.row(I).transpose();
       const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
       best = std::min(best, (a + t * (b - a) - p).norm());
@@ -204,7 +214,9 @@ TEST(OctreeBasis, OpenSurfaceLocksBoundaryFunctions) {
   for (int I : locked) is_locked[static_cast<std::size_t>(I)] = 1;
   const auto st = mcf::point_stencils(basis.octree(), m.vertices);
   for (const auto& e : be)
-    for (int q = 0; q < 8; ++q) EXPECT_TRUE(is_locked[static_cast<std::size_t>(st[static_cast<std::size_t>(e[0])].functions[q])]);
+    for (int q = 0; q < 8; ++q)
+      EXPECT_TRUE(
+          is_locked[static_cast<std::size_t>(st[static_cast<std::size_t>(e[0])].functions[q])]);
 }
 
 TEST(OctreeBasis, RefinedInput) {
@@ -253,12 +265,14 @@ TEST(OctreeBasis, SizesOfA40kSphereAtDepth7) {
   const auto mesh = test_icosphere(6, 1.0);
   RebuiltOctreeBasis basis(mesh, OctreeOptions{.depth = 7});
   const auto& s = basis.stats();
-  std::printf("[sizes] sphere V=%lld F=%lld depth 7 cube side %.4f: split_triangles=%lld dimension=%lld "
-              "cubature_points=%lld levels=%d nnz(M)=%lld setup octree %.3fs clip %.3fs integrate %.3fs hierarchy %.3fs\n",
-              static_cast<long long>(mesh.num_vertices()), static_cast<long long>(mesh.num_faces()), basis.octree().cube.side,
-              s.split_triangles, s.dimension, s.cubature_points, s.levels, static_cast<long long>(basis.mass().nonZeros()),
-              s.setup_seconds.at("octree"), s.setup_seconds.at("clip"), s.setup_seconds.at("integrate"),
-              s.setup_seconds.at("hierarchy"));
+  std::printf(
+      "[sizes] sphere V=%lld F=%lld depth 7 cube side %.4f: split_triangles=%lld dimension=%lld "
+      "cubature_points=%lld levels=%d nnz(M)=%lld setup octree %.3fs clip %.3fs integrate %.3fs "
+      "hierarchy %.3fs\n",
+      static_cast<long long>(mesh.num_vertices()), static_cast<long long>(mesh.num_faces()),
+      basis.octree().cube.side, s.split_triangles, s.dimension, s.cubature_points, s.levels,
+      static_cast<long long>(basis.mass().nonZeros()), s.setup_seconds.at("octree"),
+      s.setup_seconds.at("clip"), s.setup_seconds.at("integrate"), s.setup_seconds.at("hierarchy"));
   // Pinned (measured 2026-11-24: 664,112 split triangles, dimension 148,828, 2,678,744
   // nonzeros, 6 levels) to 0.1%, so a change in the clipping or in which functions the surface
   // supports shows up here, not only in the README's numbers; the 3-point rule gives three
@@ -310,10 +324,12 @@ TEST(OctreeBasis, SemiImplicitStepOnTheSphereConverges) {
     const Eigen::ArrayXd err = r - target, err_poly = r - target * rbar;
     const double rms = std::sqrt(err.square().mean()), mx = err.abs().maxCoeff();
     const double rms_poly = std::sqrt(err_poly.square().mean());
-    std::printf("[sphere step] V=%lld dt=%g depth %d dim %lld: radial error vs r^3/(r^2+2dt): rms %.3e max %.3e mean %.3e; "
-                "vs polyhedral target (rbar-1=%.3e): rms %.3e\n",
-                static_cast<long long>(mesh.num_vertices()), dt, depth, static_cast<long long>(basis.dimension()), rms, mx,
-                err.mean(), rbar - 1.0, rms_poly);
+    std::printf(
+        "[sphere step] V=%lld dt=%g depth %d dim %lld: radial error vs r^3/(r^2+2dt): rms %.3e max "
+        "%.3e mean %.3e; "
+        "vs polyhedral target (rbar-1=%.3e): rms %.3e\n",
+        static_cast<long long>(mesh.num_vertices()), dt, depth,
+        static_cast<long long>(basis.dimension()), rms, mx, err.mean(), rbar - 1.0, rms_poly);
     EXPECT_LT(rms, 2e-4);
     EXPECT_LT(mx, 1e-3);
     EXPECT_LT(rms_poly, 0.9 * prev) << "error does not shrink with depth";
@@ -332,7 +348,8 @@ TEST(OctreeBasis, UnreferencedAndDegenerateVertices) {
   const Eigen::Index n = mesh.num_vertices();
   mesh.vertices.conservativeResize(n + 2, 3);
   mesh.vertices.row(n) << 0.05, 0.05, 0.05;
-  mesh.vertices.row(n + 1) = 0.5 * (mesh.vertices.row(mesh.faces(0, 0)) + mesh.vertices.row(mesh.faces(0, 1)));
+  mesh.vertices.row(n + 1) =
+      0.5 * (mesh.vertices.row(mesh.faces(0, 0)) + mesh.vertices.row(mesh.faces(0, 1)));
   const Eigen::Index m = mesh.num_faces();
   mesh.faces.conservativeResize(m + 1, 3);
   mesh.faces.row(m) << mesh.faces(0, 0), n + 1, mesh.faces(0, 1);

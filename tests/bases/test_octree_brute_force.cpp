@@ -12,8 +12,8 @@
 #include "bases/tracked_octree_basis.h"
 #include "test_meshes.h"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include <cmath>
 #include <map>
@@ -51,7 +51,8 @@ Reference brute_force(const RebuiltOctreeBasis& basis, int cubature, const Coeff
       std::vector<int> ids;
       std::vector<double> values;
       std::vector<Eigen::Vector3d> grads;
-      const int i0 = int(std::floor(u[0])) - 1, j0 = int(std::floor(u[1])) - 1, k0 = int(std::floor(u[2])) - 1;
+      const int i0 = int(std::floor(u[0])) - 1, j0 = int(std::floor(u[1])) - 1,
+                k0 = int(std::floor(u[2])) - 1;
       for (int k = k0; k <= k0 + 3; ++k)
         for (int j = j0; j <= j0 + 3; ++j)
           for (int i = i0; i <= i0 + 3; ++i) {
@@ -66,24 +67,29 @@ Reference brute_force(const RebuiltOctreeBasis& basis, int cubature, const Coeff
             if (!inside) continue;
             const int I = L.find_function(i, j, k);
             if (I < 0) {
-              ADD_FAILURE() << "function (" << i << "," << j << "," << k << ") has support at a surface point but is inactive";
+              ADD_FAILURE() << "function (" << i << "," << j << "," << k
+                            << ") has support at a surface point but is inactive";
               continue;
             }
             ids.push_back(I);
             values.push_back(f[0] * f[1] * f[2]);
-            grads.push_back(tangent * Eigen::Vector3d(df[0] * f[1] * f[2], f[0] * df[1] * f[2], f[0] * f[1] * df[2]));
+            grads.push_back(tangent * Eigen::Vector3d(df[0] * f[1] * f[2], f[0] * df[1] * f[2],
+                                                      f[0] * f[1] * df[2]));
           }
       double wm = area * rule.weights[std::size_t(q)];
       Eigen::Matrix3d S = wm * Eigen::Matrix3d::Identity();
       if (x != nullptr) {
         Eigen::Matrix3d dX = Eigen::Matrix3d::Zero();  // dX v = Σ x_I (∇_T B_I · v)
-        for (std::size_t a = 0; a < ids.size(); ++a) dX += x->row(ids[a]).transpose() * grads[a].transpose();
+        for (std::size_t a = 0; a < ids.size(); ++a)
+          dX += x->row(ids[a]).transpose() * grads[a].transpose();
         const Eigen::Matrix3d g = tangent * dX.transpose() * dX * tangent;
         // Restricted to the plane: eigenvalues of g on the plane give det and the pseudo-inverse.
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(g + n * n.transpose());  // n ↦ 1 off the plane
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(
+            g + n * n.transpose());  // n ↦ 1 off the plane
         const double det = es.eigenvalues().prod();
         wm *= std::sqrt(det);
-        const Eigen::Matrix3d inv = es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
+        const Eigen::Matrix3d inv = es.eigenvectors() *
+                                    es.eigenvalues().cwiseInverse().asDiagonal() *
                                     es.eigenvectors().transpose();
         S = wm * tangent * inv * tangent;
       }
@@ -134,14 +140,16 @@ TEST(OctreeBruteForce, TrackedAtADeformedEmbedding) {
     std::uniform_real_distribution<double> noise(-0.01, 0.01);
     for (Eigen::Index i = 0; i < x.rows(); ++i) {
       const Eigen::Vector3d c = x.row(i);
-      x.row(i) = Eigen::Vector3d(1.3 * c[0] + 0.2 * c[1] * c[1], 0.7 * c[1] + 0.1 * c[2], c[2] + 0.3 * c[0] * c[1]) +
+      x.row(i) = Eigen::Vector3d(1.3 * c[0] + 0.2 * c[1] * c[1], 0.7 * c[1] + 0.1 * c[2],
+                                 c[2] + 0.3 * c[0] * c[1]) +
                  Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
     }
     tracked.update(x, true, true);
     ASSERT_EQ(tracked.degenerate_points(), 0);
     // The tracked basis freed its pieces; a rebuilt basis with the same options has the same
     // pieces and function numbering.
-    const Reference ref = brute_force(RebuiltOctreeBasis(mesh, OctreeOptions{.depth = 4, .cubature = cubature}), cubature, &x);
+    const Reference ref = brute_force(
+        RebuiltOctreeBasis(mesh, OctreeOptions{.depth = 4, .cubature = cubature}), cubature, &x);
     EXPECT_LT(max_relative_error(tracked.mass(), ref.mass), 1e-11) << cubature;
     EXPECT_LT(max_relative_error(tracked.stiffness(), ref.stiffness), 1e-11) << cubature;
     // Mass only and stiffness only give the same values (the cMCF and heat paths).

@@ -8,17 +8,18 @@
 #include "test_meshes.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 #include <algorithm>
 #include <cstring>
 #include <vector>
-#include <tbb/global_control.h>
 
 namespace mcf {
 namespace {
 
 // Any two sparse matrices: the bases hand out views (SparseView), released values are copied.
 template <class A, class B>
-double relative_difference(const Eigen::SparseMatrixBase<A>& a, const Eigen::SparseMatrixBase<B>& b) {
+double relative_difference(const Eigen::SparseMatrixBase<A>& a,
+                           const Eigen::SparseMatrixBase<B>& b) {
   return SparseMatrix(a.derived() - b.derived()).norm() / b.derived().norm();
 }
 
@@ -39,7 +40,9 @@ TEST(TrackedOctree, StepZeroEqualsRebuilt) {
     EXPECT_TRUE(tracked.initial().pieces().empty()) << cubature;
     EXPECT_EQ(tracked.mass().nonZeros(), fresh.mass().nonZeros()) << cubature;
     std::vector<double> M, K;
-    EXPECT_THROW(tracked.initial().system().assemble(cubature_rule(cubature), M, K), std::logic_error) << cubature;
+    EXPECT_THROW(tracked.initial().system().assemble(cubature_rule(cubature), M, K),
+                 std::logic_error)
+        << cubature;
     EXPECT_TRUE(M.empty() && K.empty()) << cubature;  // outputs untouched by the refusal
     // What only the assembly read is freed too (OctreeSystem::release_pieces): the piece order and
     // cells and the initial basis's stencils. The pattern stays: mass and stiffness are values on
@@ -57,9 +60,15 @@ TEST(TrackedOctree, StepZeroEqualsRebuilt) {
                 std::equal(pattern.outerIndexPtr(), pattern.outerIndexPtr() + pattern.cols() + 1,
                            fresh.mass().outerIndexPtr()))
         << cubature;
-    EXPECT_THROW((void)tracked.initial().evaluate_vertices(tracked.initial_coefficients()), std::logic_error) << cubature;
-    EXPECT_EQ(tracked.evaluate_vertices(tracked.initial_coefficients()).rows(), mesh.num_vertices());
-    EXPECT_LT((tracked.evaluate_vertices(tracked.initial_coefficients()) - mesh.vertices).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_THROW((void)tracked.initial().evaluate_vertices(tracked.initial_coefficients()),
+                 std::logic_error)
+        << cubature;
+    EXPECT_EQ(tracked.evaluate_vertices(tracked.initial_coefficients()).rows(),
+              mesh.num_vertices());
+    EXPECT_LT((tracked.evaluate_vertices(tracked.initial_coefficients()) - mesh.vertices)
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-12);
   }
 }
 
@@ -88,7 +97,8 @@ TEST(TrackedOctree, InitialMetricIsIdentity) {
   o.depth = 5;
   TrackedOctreeBasis tracked(mesh, o);
   EXPECT_LT(tracked.max_metric_deviation(tracked.initial_coefficients()), 1e-12);
-  EXPECT_NEAR(tracked.max_metric_deviation(2.0 * tracked.initial_coefficients()), 3.0, 1e-12);  // g = 4 I
+  EXPECT_NEAR(tracked.max_metric_deviation(2.0 * tracked.initial_coefficients()), 3.0,
+              1e-12);  // g = 4 I
   EXPECT_EQ(tracked.degenerate_points(), 0);
 }
 
@@ -102,7 +112,8 @@ TEST(TrackedOctree, MetricInvariances) {
   tracked.update(2.5 * x0, true, true);
   EXPECT_LT(relative_difference(tracked.mass(), 6.25 * M0), 1e-12);
   EXPECT_LT(relative_difference(tracked.stiffness(), K0), 1e-12);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   tracked.update((x0 * R.transpose()).rowwise() + Eigen::RowVector3d(1, -2, 3), true, true);
   EXPECT_LT(relative_difference(tracked.mass(), M0), 1e-12);
   EXPECT_LT(relative_difference(tracked.stiffness(), K0), 1e-12);
@@ -188,11 +199,13 @@ TEST(TrackedOctree, FansHoldEveryPiecesCornersBitwise) {
     for (int s = start[c]; s < start[c + 1]; ++s, ++pieces) {
       const ClippedTriangle& t = fresh.pieces()[std::size_t(order[std::size_t(s)])];
       for (int v = 0; v < 3; ++v)
-        for (int a = 0; a < 3; ++a) expected.push_back((t.corners[v][a] - cube.origin[a]) * inv_h - ijk[a]);
+        for (int a = 0; a < 3; ++a)
+          expected.push_back((t.corners[v][a] - cube.origin[a]) * inv_h - ijk[a]);
     }
     const std::vector<double> decoded = tracked.cell_local_corners(int(c));
     ASSERT_EQ(decoded.size(), expected.size()) << "cell " << c;
-    EXPECT_EQ(std::memcmp(decoded.data(), expected.data(), expected.size() * sizeof(double)), 0) << "cell " << c;
+    EXPECT_EQ(std::memcmp(decoded.data(), expected.data(), expected.size() * sizeof(double)), 0)
+        << "cell " << c;
   }
   EXPECT_EQ(pieces, tracked.stats().split_triangles);
   EXPECT_GT(tracked.fan_continuations(), 0);

@@ -26,7 +26,8 @@ TEST(Compare, MannWhitney) {
   EXPECT_DOUBLE_EQ(mann_whitney_p({}, {1}), 1.0);
   // Reference values: scipy.stats.mannwhitneyu(a, b, method="asymptotic", use_continuity=True).
   EXPECT_NEAR(mann_whitney_p({1, 2, 3, 5, 8}, {4, 6, 7, 9, 10}), 0.09469294259947589, 1e-12);
-  EXPECT_NEAR(mann_whitney_p({1, 2, 2, 5, 8, 8}, {2, 6, 8, 9, 10}), 0.16304505585423734, 1e-12);  // ties
+  EXPECT_NEAR(mann_whitney_p({1, 2, 2, 5, 8, 8}, {2, 6, 8, 9, 10}), 0.16304505585423734,
+              1e-12);  // ties
   EXPECT_DOUBLE_EQ(median({3, 1, 2}), 2);
   EXPECT_DOUBLE_EQ(median({4, 1, 3, 2}), 2.5);
 }
@@ -34,8 +35,8 @@ TEST(Compare, MannWhitney) {
 /// A synthetic result set: 3 cells, 2 repetitions, 15 steps each; per-step seconds scaled by
 /// `slow` with multiplicative noise of +-noise; final radial error scaled by `error`.
 /// With `steal` >= 0 each cell also records run_seconds 1 and steal_seconds `steal`.
-void make_set(const fs::path& dir, const std::string& commit, double slow, double noise, double error, unsigned seed,
-              double steal = -1) {
+void make_set(const fs::path& dir, const std::string& commit, double slow, double noise,
+              double error, unsigned seed, double steal = -1) {
   fs::create_directories(dir);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(1 - noise, 1 + noise);
@@ -43,21 +44,28 @@ void make_set(const fs::path& dir, const std::string& commit, double slow, doubl
     for (int rep = 0; rep < 2; ++rep) {
       json steps = json::array();
       for (int s = 1; s <= 15; ++s)
-        steps.push_back({{"step", s},
-                         {"seconds", {{"total", 0.01 * (cell + 1) * (1 + 0.2 * std::sin(s)) * slow * jitter(rng)}}},
-                         {"radial_error", {{"rms", 1e-3 * (cell + 1) * s * error}}}});
+        steps.push_back(
+            {{"step", s},
+             {"seconds",
+              {{"total", 0.01 * (cell + 1) * (1 + 0.2 * std::sin(s)) * slow * jitter(rng)}}},
+             {"radial_error", {{"rms", 1e-3 * (cell + 1) * s * error}}}});
       const std::string key = "cellkey" + std::to_string(cell);
       json r = {{"status", "ok"},
-                      {"environment", {{"commit", commit}}},
-                      {"cell", {{"key", key + "r" + std::to_string(rep)}, {"config_key", key}, {"index", cell * 2 + rep},
-                                {"repetition", rep}, {"study", "synthetic"},
-                                {"assignment", {{"solver.name", "solver" + std::to_string(cell)}}}}},
-                      {"steps", steps}};
+                {"environment", {{"commit", commit}}},
+                {"cell",
+                 {{"key", key + "r" + std::to_string(rep)},
+                  {"config_key", key},
+                  {"index", cell * 2 + rep},
+                  {"repetition", rep},
+                  {"study", "synthetic"},
+                  {"assignment", {{"solver.name", "solver" + std::to_string(cell)}}}}},
+                {"steps", steps}};
       if (steal >= 0) {
         r["run_seconds"] = 1.0;
         r["steal_seconds"] = steal;
       }
-      std::ofstream(dir / (commit + std::to_string(cell) + std::to_string(rep) + ".json")) << r.dump();
+      std::ofstream(dir / (commit + std::to_string(cell) + std::to_string(rep) + ".json"))
+          << r.dump();
     }
 }
 
@@ -80,7 +88,7 @@ TEST(CompareCli, ReportsTheHypervisorsStolenShareOfEachSet) {
 TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
   const fs::path dir = fresh_dir("compare");
   make_set(dir / "old", "aaaa", 1.0, 0.03, 1.0, 1);
-  make_set(dir / "same", "bbbb", 1.0, 0.03, 1.0, 2);   // a second run of the same code: tiny noise
+  make_set(dir / "same", "bbbb", 1.0, 0.03, 1.0, 2);  // a second run of the same code: tiny noise
   make_set(dir / "slow", "cccc", 2.0, 0.03, 1.0, 3);
   make_set(dir / "worse", "dddd", 1.0, 0.03, 1.5, 4);
   Command c = mcfbench("compare old old", dir);
@@ -88,14 +96,15 @@ TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
   EXPECT_NE(c.out.find("3 cells compared, 0 changed"), std::string::npos) << c.out;
   c = mcfbench("compare old same --all", dir);
   EXPECT_EQ(c.status, 0) << c.out << c.err;
-  EXPECT_NE(c.out.find("same |"), std::string::npos) << "unchanged rows are listed with --all: " << c.out;
+  EXPECT_NE(c.out.find("same |"), std::string::npos)
+      << "unchanged rows are listed with --all: " << c.out;
   EXPECT_NE(c.out.find("| solver.name=solver2 |"), std::string::npos) << c.out;
   c = mcfbench("compare old slow --history hist/h.jsonl", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(c.out.find("solver.name=solver1"), std::string::npos) << c.out;
   EXPECT_NE(c.out.find("**slower**"), std::string::npos) << c.out;
   EXPECT_NE(c.out.find("| 2.0"), std::string::npos) << c.out;  // the ratio column
-  c = mcfbench("compare slow old", dir);  // faster is not a regression
+  c = mcfbench("compare slow old", dir);                       // faster is not a regression
   EXPECT_EQ(c.status, 0) << c.out;
   EXPECT_NE(c.out.find("faster"), std::string::npos) << c.out;
   c = mcfbench("compare old worse --threshold 0.2", dir);
@@ -124,7 +133,8 @@ TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
   // "no regression", nor may a cell missing from NEW or a --metric that no step has.
   const fs::path dir = fresh_dir("compare_status");
   make_set(dir / "old", "aaaa", 1.0, 0.03, 1.0, 1);
-  auto variant = [&](const std::string& name, const std::function<void(json&)>& edit, const std::string& file) {
+  auto variant = [&](const std::string& name, const std::function<void(json&)>& edit,
+                     const std::string& file) {
     fs::create_directories(dir / name);
     for (const auto& f : result_files(dir / "old")) {
       json r = read_json(f);
@@ -133,17 +143,25 @@ TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
       std::ofstream(dir / name / f.filename()) << r.dump();
     }
   };
-  variant("errored", [](json& r) {
-    r["status"] = "error";
-    r["stop"] = {{"step", 0}, {"reason", "error: boom"}};
-    r["steps"] = json::array();
-  }, "aaaa10.json");
-  variant("stopped", [](json& r) {
-    r["status"] = "singular";
-    r["stop"] = {{"step", 5}, {"reason", "collapsed area"}};
-    r["steps"].erase(r["steps"].begin() + 5, r["steps"].end());
-  }, "aaaa21.json");
-  variant("shorter_ok", [](json& r) { r["steps"].erase(r["steps"].begin() + 5, r["steps"].end()); }, "aaaa00.json");
+  variant(
+      "errored",
+      [](json& r) {
+        r["status"] = "error";
+        r["stop"] = {{"step", 0}, {"reason", "error: boom"}};
+        r["steps"] = json::array();
+      },
+      "aaaa10.json");
+  variant(
+      "stopped",
+      [](json& r) {
+        r["status"] = "singular";
+        r["stop"] = {{"step", 5}, {"reason", "collapsed area"}};
+        r["steps"].erase(r["steps"].begin() + 5, r["steps"].end());
+      },
+      "aaaa21.json");
+  variant(
+      "shorter_ok", [](json& r) { r["steps"].erase(r["steps"].begin() + 5, r["steps"].end()); },
+      "aaaa00.json");
   Command c = mcfbench("compare old errored", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(c.out.find("**failed** (error: error: boom)"), std::string::npos) << c.out;
@@ -159,16 +177,20 @@ TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
   c = mcfbench("compare errored old", dir);
   EXPECT_EQ(c.status, 0) << c.out << c.err;
   // A cell that stopped as singular in OLD (say a pinch) and errors in NEW is still a failure.
-  variant("errored_where_stopped", [](json& r) {
-    r["status"] = "error";
-    r["stop"] = {{"step", 0}, {"reason", "error: boom"}};
-    r["steps"] = json::array();
-  }, "aaaa21.json");
+  variant(
+      "errored_where_stopped",
+      [](json& r) {
+        r["status"] = "error";
+        r["stop"] = {{"step", 0}, {"reason", "error: boom"}};
+        r["steps"] = json::array();
+      },
+      "aaaa21.json");
   c = mcfbench("compare stopped errored_where_stopped", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(c.out.find("**failed** (error: error: boom)"), std::string::npos) << c.out;
   // A NEW whose every cell errored (no steps at all) is a regression table, not a metric error.
-  variant("all_errored", [](json&) {}, "");
+  variant(
+      "all_errored", [](json&) {}, "");
   for (const auto& f : result_files(dir / "all_errored")) {
     json r = read_json(f);
     r["status"] = "error";
@@ -179,12 +201,16 @@ TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(c.out.find("3 cells compared, 3 changed"), std::string::npos) << c.out;
   // A cell missing from NEW.
-  variant("missing", [](json&) {}, "");
+  variant(
+      "missing", [](json&) {}, "");
   fs::remove(dir / "missing" / "aaaa20.json");
   fs::remove(dir / "missing" / "aaaa21.json");
   c = mcfbench("compare old missing", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
-  EXPECT_NE(c.out.find("1 cells only in OLD (missing from NEW: a regression): `solver.name=solver2`"), std::string::npos) << c.out;
+  EXPECT_NE(
+      c.out.find("1 cells only in OLD (missing from NEW: a regression): `solver.name=solver2`"),
+      std::string::npos)
+      << c.out;
   c = mcfbench("compare missing old", dir);  // a cell only in NEW is new work, not a regression
   EXPECT_EQ(c.status, 0) << c.out << c.err;
   // A metric no step has is an error naming it, not "0 changed".
@@ -205,7 +231,8 @@ TEST(CompareCli, AccuracyIsTheReferenceDistanceWhereThereIsOne) {
       json r = read_json(f);
       r["environment"]["commit"] = name;
       const double d = std::string(name) == "far" ? 2e-3 : 1e-3;
-      r["reference_distance"] = json::array({{{"step", 1}, {"rms", 9.0}}, {{"step", 15}, {"rms", d}}});
+      r["reference_distance"] =
+          json::array({{{"step", 1}, {"rms", 9.0}}, {{"step", 15}, {"rms", d}}});
       std::ofstream(dir / name / f.filename()) << r.dump();
     }
   }
@@ -233,7 +260,9 @@ TEST(CompareCli, AccuracyIsTheReferenceDistanceWhereThereIsOne) {
 
 TEST(CompareCli, InjectedSlowdownOnARealRun) {
   const fs::path dir = fresh_dir("compare_real");
-  write_text(dir / "c.json", R"({"name": "c", "defaults": {"mesh": "icosphere:level=3", "steps": 30, "dt": 1e-4, "threads": 1}})");
+  write_text(
+      dir / "c.json",
+      R"({"name": "c", "defaults": {"mesh": "icosphere:level=3", "steps": 30, "dt": 1e-4, "threads": 1}})");
   Command c = mcfbench("run c.json --out old", dir);
   ASSERT_EQ(c.status, 0) << c.err;
   fs::create_directories(dir / "new");

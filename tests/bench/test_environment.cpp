@@ -12,8 +12,9 @@ namespace {
 
 TEST(Environment, StealIsTheEighthValueOfTheAggregateCpuLine) {
   // proc(5): cpu user nice system idle iowait irq softirq steal guest guest_nice
-  EXPECT_DOUBLE_EQ(steal_seconds_from_proc_stat("cpu  7337056 73943 1480949 5784732 7154 0 1097 70074 0 0", 100),
-                   700.74);
+  EXPECT_DOUBLE_EQ(
+      steal_seconds_from_proc_stat("cpu  7337056 73943 1480949 5784732 7154 0 1097 70074 0 0", 100),
+      700.74);
   EXPECT_DOUBLE_EQ(steal_seconds_from_proc_stat("cpu 1 2 3 4 5 6 7 250", 250), 1.0);
   // Not the aggregate line, too few values, no tick rate: unknown.
   EXPECT_EQ(steal_seconds_from_proc_stat("cpu0 1 2 3 4 5 6 7 8", 100), -1);

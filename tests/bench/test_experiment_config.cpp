@@ -18,7 +18,9 @@ namespace {
 
 using nlohmann::json;
 
-ExperimentConfig expand(const json& j, bool quick = false) { return parse_experiment_config(j, "study.json", quick); }
+ExperimentConfig expand(const json& j, bool quick = false) {
+  return parse_experiment_config(j, "study.json", quick);
+}
 
 std::set<std::string> assignments(const ExperimentConfig& e) {
   std::set<std::string> s;
@@ -29,8 +31,9 @@ std::set<std::string> assignments(const ExperimentConfig& e) {
 const json base = {{"mesh", "icosphere:level=1"}, {"steps", 2}};
 
 TEST(ExperimentConfig, AxesAreACartesianProductInFixedOrder) {
-  const auto e = expand({{"defaults", base},
-                         {"axes", {{"solver.name", {"cholmod", "pcg", "dense"}}, {"dt", {1e-3, 2e-3}}}}});
+  const auto e =
+      expand({{"defaults", base},
+              {"axes", {{"solver.name", {"cholmod", "pcg", "dense"}}, {"dt", {1e-3, 2e-3}}}}});
   ASSERT_EQ(e.cells.size(), 6u);
   EXPECT_EQ(assignments(e).size(), 6u);
   // Axes in sorted key order ("dt" < "solver.name"), the last one fastest.
@@ -54,22 +57,28 @@ TEST(ExperimentConfig, ZipGroupsVaryTogether) {
                                                   "solver.preconditioner": ["none", "ichol", "jacobi"]}])")}});
   ASSERT_EQ(e.cells.size(), 6u);  // 2 x 3, not 2 x 3 x 3
   std::set<std::pair<std::string, std::string>> pairs;
-  for (const auto& c : e.cells) pairs.insert({c.config["solver"]["name"].get<std::string>(), c.config["solver"]["preconditioner"].get<std::string>()});
-  EXPECT_EQ(pairs, (std::set<std::pair<std::string, std::string>>{{"pcg", "none"}, {"pcg", "ichol"}, {"cholmod", "jacobi"}}));
+  for (const auto& c : e.cells)
+    pairs.insert({c.config["solver"]["name"].get<std::string>(),
+                  c.config["solver"]["preconditioner"].get<std::string>()});
+  EXPECT_EQ(pairs, (std::set<std::pair<std::string, std::string>>{
+                       {"pcg", "none"}, {"pcg", "ichol"}, {"cholmod", "jacobi"}}));
   EXPECT_EQ(e.cells[0].assignment.size(), 3u);
 }
 
 TEST(ExperimentConfig, ExcludeDropsMatchingCellsIncludingDefaults) {
-  const auto e = expand({{"defaults", base},
-                         {"axes", {{"solver.name", {"cholmod", "pcg", "dense"}}, {"dt", {1e-3, 2e-3}}}},
-                         {"exclude", {{{"solver.name", "pcg"}, {"dt", 2e-3}}, {{"solver.name", "dense"}}}}});
+  const auto e =
+      expand({{"defaults", base},
+              {"axes", {{"solver.name", {"cholmod", "pcg", "dense"}}, {"dt", {1e-3, 2e-3}}}},
+              {"exclude", {{{"solver.name", "pcg"}, {"dt", 2e-3}}, {{"solver.name", "dense"}}}}});
   ASSERT_EQ(e.cells.size(), 3u);  // 6 - 1 - 2
   for (const auto& c : e.cells) {
     EXPECT_NE(c.assignment["solver.name"], "dense");
     EXPECT_FALSE(c.assignment["solver.name"] == "pcg" && c.assignment["dt"] == 2e-3);
   }
   // An exclude entry on a key left at its default matches through the default (depth 8).
-  const auto all = expand({{"defaults", base}, {"axes", {{"dt", {1e-3, 2e-3}}}}, {"exclude", {{{"octree.depth", 8}, {"dt", 1e-3}}}}});
+  const auto all = expand({{"defaults", base},
+                           {"axes", {{"dt", {1e-3, 2e-3}}}},
+                           {"exclude", {{{"octree.depth", 8}, {"dt", 1e-3}}}}});
   ASSERT_EQ(all.cells.size(), 1u);
   EXPECT_EQ(all.cells[0].assignment["dt"], 2e-3);
   // Excluding invalid combinations is allowed: they are never validated.
@@ -119,10 +128,11 @@ TEST(ExperimentConfig, QuickOverridesTheFullMatrix) {
 // quick.defaults takes them too. (They were accepted by the check and then refused per cell.)
 TEST(ExperimentConfig, DottedKeysInDefaultsSetTheNestedOption) {
   const json j = {{"name", "s"},
-                  {"defaults", {{"mesh", "icosphere:level=1"},
-                                {"solver", {{"name", "cholmod"}, {"tolerance", 1e-6}}},
-                                {"solver.name", "pcg"},
-                                {"octree.depth", 5}}},
+                  {"defaults",
+                   {{"mesh", "icosphere:level=1"},
+                    {"solver", {{"name", "cholmod"}, {"tolerance", 1e-6}}},
+                    {"solver.name", "pcg"},
+                    {"octree.depth", 5}}},
                   {"axes", {{"flow", {"mcf"}}}},
                   {"quick", {{"defaults", {{"octree.tracking", "rebuilt"}}}}}};
   for (const bool quick : {false, true}) {
@@ -141,8 +151,12 @@ TEST(ExperimentConfig, MetricsAreReadStrictly) {
   defaults["steps"] = 100;
   const auto e = expand({{"defaults", defaults},
                          {"axes", {{"solver.name", {"cholmod", "pcg"}}}},
-                         {"metrics", {{"quasi_conformal", true}, {"sphericity", true}, {"every", 10},
-                                      {"frames", {100, 1, 10}}, {"reference", {{"solver.name", "cholmod"}}}}}});
+                         {"metrics",
+                          {{"quasi_conformal", true},
+                           {"sphericity", true},
+                           {"every", 10},
+                           {"frames", {100, 1, 10}},
+                           {"reference", {{"solver.name", "cholmod"}}}}}});
   EXPECT_TRUE(e.metrics.quasi_conformal);
   EXPECT_EQ(e.metrics.every, 10);
   EXPECT_EQ(e.metrics.frames, (std::vector<int>{1, 10, 100}));
@@ -161,29 +175,44 @@ void expect_error(const json& j, const std::string& path, bool quick = false) {
 }
 
 TEST(ExperimentConfig, ErrorsNameTheFileAndTheKeyPath) {
-  expect_error({{"defaults", base}, {"axis", {{"dt", {1e-3}}}}}, "axis");                       // unknown top-level key
-  expect_error({{"defaults", {{"mesh", "x"}, {"solver", {{"cycels", 2}}}}}}, "defaults.solver.cycels");
+  expect_error({{"defaults", base}, {"axis", {{"dt", {1e-3}}}}}, "axis");  // unknown top-level key
+  expect_error({{"defaults", {{"mesh", "x"}, {"solver", {{"cycels", 2}}}}}},
+               "defaults.solver.cycels");
   expect_error({{"defaults", {{"mesh", "x"}, {"stepz", 2}}}}, "defaults.stepz");
-  expect_error({{"defaults", base}, {"zip", json::parse(R"([{"solver.name": ["pcg", "cholmod"], "dt": [0.001]}])")}},
+  expect_error({{"defaults", base},
+                {"zip", json::parse(R"([{"solver.name": ["pcg", "cholmod"], "dt": [0.001]}])")}},
                "zip[0].solver.name");
   expect_error({{"defaults", base}, {"axes", {{"solver.cycels", {1, 2}}}}}, "axes.solver.cycels");
   expect_error({{"defaults", base}, {"axes", {{"dt", json::array()}}}}, "axes.dt");
-  expect_error({{"defaults", base}, {"axes", {{"dt", {1e-3}}}}, {"exclude", json::parse(R"([{"dtt": 0.001}])")}}, "exclude[0].dtt");
+  expect_error({{"defaults", base},
+                {"axes", {{"dt", {1e-3}}}},
+                {"exclude", json::parse(R"([{"dtt": 0.001}])")}},
+               "exclude[0].dtt");
   expect_error({{"defaults", base}, {"repetitions", 0}}, "repetitions");
   expect_error({{"defaults", base}, {"metrics", {{"every", 0}}}}, "metrics.every");
   expect_error({{"defaults", base}, {"metrics", {{"sphericty", true}}}}, "metrics.sphericty");
-  expect_error({{"defaults", base}, {"metrics", {{"frames", {1}}, {"reference", {{"solver.name", "pcg"}}}}}}, "metrics.reference");
-  expect_error({{"defaults", base}, {"metrics", {{"frames", {0, 50}}}}}, "metrics.frames");  // base has 2 steps
+  expect_error(
+      {{"defaults", base}, {"metrics", {{"frames", {1}}, {"reference", {{"solver.name", "pcg"}}}}}},
+      "metrics.reference");
+  expect_error({{"defaults", base}, {"metrics", {{"frames", {0, 50}}}}},
+               "metrics.frames");  // base has 2 steps
   expect_error({{"defaults", base}, {"quick", {{"axis", json::object()}}}}, "quick.axis");
-  expect_error({{"defaults", base}, {"quick", {{"defaults", {{"octree", {{"dept", 3}}}}}}}}, "quick.defaults.octree.dept");
+  expect_error({{"defaults", base}, {"quick", {{"defaults", {{"octree", {{"dept", 3}}}}}}}},
+               "quick.defaults.octree.dept");
   // Wrong type / out of range in a cell: the flow config's own message with the key path.
   expect_error({{"defaults", base}, {"axes", {{"solver.cycles", {1, 0}}}}}, "solver.cycles");
   expect_error({{"defaults", base}, {"axes", {{"steps", {"two"}}}}}, "steps");
-  expect_error({{"defaults", {{"steps", 2}}}}, "mesh");  // missing mesh
+  expect_error({{"defaults", {{"steps", 2}}}}, "mesh");                           // missing mesh
   expect_error({{"defaults", base}, {"axes", {{"dt", {1e-3, 0.001}}}}}, "axes");  // duplicate cells
   // An exclude entry that removes nothing: a typo in a value, or a value no axis has.
-  expect_error({{"defaults", base}, {"axes", {{"basis", {"hat"}}}}, {"exclude", json::parse(R"([{"basis": "hta"}])")}}, "exclude[0]");
-  expect_error({{"defaults", base}, {"axes", {{"dt", {1e-3}}}}, {"exclude", json::parse(R"([{"dt": 0.005}])")}}, "exclude[0]");
+  expect_error({{"defaults", base},
+                {"axes", {{"basis", {"hat"}}}},
+                {"exclude", json::parse(R"([{"basis": "hta"}])")}},
+               "exclude[0]");
+  expect_error({{"defaults", base},
+                {"axes", {{"dt", {1e-3}}}},
+                {"exclude", json::parse(R"([{"dt": 0.005}])")}},
+               "exclude[0]");
 }
 
 TEST(ExperimentConfig, ExcludeEntriesMustMatchInTheirOwnVariant) {
@@ -208,7 +237,8 @@ TEST(ExperimentConfig, ExcludeEntriesMustMatchInTheirOwnVariant) {
 TEST(ExperimentConfig, ConfigFilesAreReadStrictly) {
   // Duplicate keys (JSON keeps the last silently), numbers out of double range and a --quick
   // run of a config without a quick section are errors naming the file.
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mcfbench_config_files";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "mcfbench_config_files";
   std::filesystem::create_directories(dir);
   auto file = [&](const std::string& name, const std::string& text) {
     std::ofstream((dir / name).string()) << text;
@@ -222,18 +252,26 @@ TEST(ExperimentConfig, ConfigFilesAreReadStrictly) {
     }
     return "";
   };
-  const std::string dup = file("dup.json", R"({"defaults": {"mesh": "icosphere:level=1", "dt": 0.001, "dt": 0.01}})");
+  const std::string dup =
+      file("dup.json", R"({"defaults": {"mesh": "icosphere:level=1", "dt": 0.001, "dt": 0.01}})");
   std::string what = error_of([&] { load_experiment_config(dup, false); });
   EXPECT_NE(what.find("dup.json: defaults.dt: key appears twice"), std::string::npos) << what;
-  what = error_of([&] { read_config_file(file("dup2.json", R"({"axes": {"x": [1]}, "zip": [{"dt": [1], "dt": [2]}]})")); });
+  what = error_of([&] {
+    read_config_file(file("dup2.json", R"({"axes": {"x": [1]}, "zip": [{"dt": [1], "dt": [2]}]})"));
+  });
   EXPECT_NE(what.find("dup2.json: zip[].dt: key appears twice"), std::string::npos) << what;
   // The same key in two different objects is fine.
-  EXPECT_EQ(read_config_file(file("ok.json", R"({"a": {"x": 1}, "b": {"x": 2}, "x": [{"x": 1}, {"x": 2}]})"))["b"]["x"], 2);
-  const std::string big = file("big.json", R"({"defaults": {"mesh": "icosphere:level=1", "dt": 1e400}})");
+  EXPECT_EQ(
+      read_config_file(file(
+          "ok.json", R"({"a": {"x": 1}, "b": {"x": 2}, "x": [{"x": 1}, {"x": 2}]})"))["b"]["x"],
+      2);
+  const std::string big =
+      file("big.json", R"({"defaults": {"mesh": "icosphere:level=1", "dt": 1e400}})");
   what = error_of([&] { load_experiment_config(big, false); });
   EXPECT_NE(what.find("big.json: defaults.dt: "), std::string::npos) << what;
   EXPECT_NE(what.find("overflow"), std::string::npos) << what;
-  what = error_of([&] { read_config_file(file("big2.json", R"({"axes": {"dt": [0.1, -1e999]}})")); });
+  what =
+      error_of([&] { read_config_file(file("big2.json", R"({"axes": {"dt": [0.1, -1e999]}})")); });
   EXPECT_NE(what.find("big2.json: axes.dt[]: "), std::string::npos) << what;
   const std::string plain = file("plain.json", R"({"defaults": {"mesh": "icosphere:level=1"}})");
   EXPECT_EQ(load_experiment_config(plain, false).cells.size(), 1u);
@@ -245,11 +283,13 @@ TEST(ExperimentConfig, ConfigFilesAreReadStrictly) {
 TEST(ExperimentConfig, EveryShippedStudyConfigExpandsInBothVariants) {
   // bench/configs/*.json (not the *.reference.json tables the reports read): the studies the
   // README documents must load, full and quick, with this build's keys and checks.
-  const auto configs = std::filesystem::path(MCFBENCH_TEST_DATA).parent_path().parent_path() / "bench" / "configs";
+  const auto configs =
+      std::filesystem::path(MCFBENCH_TEST_DATA).parent_path().parent_path() / "bench" / "configs";
   int n = 0;
   for (const auto& entry : std::filesystem::directory_iterator(configs)) {
     const std::string name = entry.path().filename().string();
-    if (entry.path().extension() != ".json" || name.find(".reference.") != std::string::npos) continue;
+    if (entry.path().extension() != ".json" || name.find(".reference.") != std::string::npos)
+      continue;
     ++n;
     for (bool quick : {false, true}) {
       try {
@@ -263,17 +303,21 @@ TEST(ExperimentConfig, EveryShippedStudyConfigExpandsInBothVariants) {
 }
 
 TEST(ExperimentConfig, ShardsPartitionTheCells) {
-  const auto e = expand({{"defaults", base}, {"axes", {{"dt", {1e-3, 2e-3, 3e-3}}, {"steps", {1, 2, 3}}}}, {"repetitions", 2}});
+  const auto e = expand({{"defaults", base},
+                         {"axes", {{"dt", {1e-3, 2e-3, 3e-3}}, {"steps", {1, 2, 3}}}},
+                         {"repetitions", 2}});
   ASSERT_EQ(e.cells.size(), 18u);
   for (int n = 1; n <= 5; ++n) {
     std::vector<int> owner(e.cells.size(), -1);
     for (int i = 0; i < n; ++i)
       for (const auto& c : e.cells)
         if (in_shard(c.index, i, n)) {
-          EXPECT_EQ(owner[c.index], -1) << "cell " << c.index << " in shards " << owner[c.index] << " and " << i;
+          EXPECT_EQ(owner[c.index], -1)
+              << "cell " << c.index << " in shards " << owner[c.index] << " and " << i;
           owner[c.index] = i;
         }
-    for (size_t k = 0; k < owner.size(); ++k) EXPECT_GE(owner[k], 0) << "cell " << k << " in no shard of " << n;
+    for (size_t k = 0; k < owner.size(); ++k)
+      EXPECT_GE(owner[k], 0) << "cell " << k << " in no shard of " << n;
   }
   int i = -1, n = -1;
   parse_shard("3/16", i, n);
@@ -289,17 +333,20 @@ TEST(CellHash, StableAndSensitive) {
   const std::string fp = "0123456789abcdef";
   const std::string k0 = cell_key(e.cells[0].config, 0, fp);
   EXPECT_EQ(k0.size(), 16u);
-  EXPECT_EQ(k0, cell_key(e.cells[0].config, 0, fp));              // deterministic
-  EXPECT_EQ(k0, cell_key(json::parse(e.cells[0].config.dump()), 0, fp));  // independent of key order/roundtrip
-  EXPECT_NE(k0, cell_key(e.cells[0].config, 1, fp));              // repetition
-  EXPECT_NE(k0, cell_key(e.cells[2].config, 0, fp));              // config (dt)
+  EXPECT_EQ(k0, cell_key(e.cells[0].config, 0, fp));  // deterministic
+  EXPECT_EQ(k0, cell_key(json::parse(e.cells[0].config.dump()), 0,
+                         fp));                        // independent of key order/roundtrip
+  EXPECT_NE(k0, cell_key(e.cells[0].config, 1, fp));  // repetition
+  EXPECT_NE(k0, cell_key(e.cells[2].config, 0, fp));  // config (dt)
   EXPECT_NE(k0, cell_key(e.cells[0].config, 0, "fedcba9876543210"));  // input mesh
-  EXPECT_NE(cell_hash(k0, "abc"), cell_hash(k0, "abd"));           // code version
+  EXPECT_NE(cell_hash(k0, "abc"), cell_hash(k0, "abd"));              // code version
   EXPECT_EQ(cell_hash(k0, "abc"), cell_hash(k0, "abc"));
   // A default written out explicitly is the same cell as the default left implicit.
-  const auto explicit_default = expand({{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}, {"octree", {{"depth", 8}}}}}});
+  const auto explicit_default = expand(
+      {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}, {"octree", {{"depth", 8}}}}}});
   const auto implicit_default = expand({{"defaults", base}});
-  EXPECT_EQ(cell_key(explicit_default.cells[0].config, 0, fp), cell_key(implicit_default.cells[0].config, 0, fp));
+  EXPECT_EQ(cell_key(explicit_default.cells[0].config, 0, fp),
+            cell_key(implicit_default.cells[0].config, 0, fp));
   // Known FNV-1a test vector.
   EXPECT_EQ(hex16(fnv1a64("a")), "af63dc4c8601ec8c");
   TriangleMesh m;

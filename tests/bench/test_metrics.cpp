@@ -59,7 +59,8 @@ TEST(MeshDistance, ConcentricIcospheresDifferByTheGapUpToTheSagitta) {
   ASSERT_LT(s1, 2e-3);
   const MeshDistance d = mesh_distance(inner, outer, 20000, 7);
   EXPECT_EQ(d.samples, 20000);
-  for (const double x : {d.rms_forward, d.max_forward, d.rms_backward, d.max_backward, d.rms, d.max}) {
+  for (const double x :
+       {d.rms_forward, d.max_forward, d.rms_backward, d.max_backward, d.rms, d.max}) {
     EXPECT_GE(x, 0.1 - s2 - 1e-12);
     EXPECT_LE(x, 0.1 + s1 + 1e-12);
   }
@@ -70,7 +71,8 @@ TEST(MeshDistance, PatchTranslatedAlongItsNormalIsAtDistanceTEverywhere) {
   const double t = 0.0375;
   const TriangleMesh a = make_patch(12), b = make_patch(7, 0, 1, t);  // different triangulations
   const MeshDistance d = mesh_distance(a, b, 5000, 3);
-  for (const double x : {d.rms_forward, d.max_forward, d.rms_backward, d.max_backward, d.rms, d.max})
+  for (const double x :
+       {d.rms_forward, d.max_forward, d.rms_backward, d.max_backward, d.rms, d.max})
     EXPECT_NEAR(x, t, 1e-12);
 }
 
@@ -136,14 +138,16 @@ TEST(MeshDistance, RejectsEmptyMeshesAndNonPositiveSamples) {
 
 TEST(ClosestPoint, RegionsOfOneTriangle) {
   const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-  auto cp = [&](double x, double y, double z) { return closest_point_on_triangle({x, y, z}, a, b, c); };
-  EXPECT_TRUE(cp(-1, -1, 2).isApprox(a));                                 // vertex A
-  EXPECT_TRUE(cp(3, -1, 0).isApprox(b));                                  // vertex B
-  EXPECT_TRUE(cp(-0.5, 4, 1).isApprox(c));                                // vertex C
-  EXPECT_TRUE(cp(0.5, -2, 1).isApprox(Eigen::Vector3d(0.5, 0, 0)));       // edge AB
-  EXPECT_TRUE(cp(-3, 0.25, 0).isApprox(Eigen::Vector3d(0, 0.25, 0)));     // edge AC
-  EXPECT_TRUE(cp(1, 1, -5).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));       // edge BC
-  EXPECT_TRUE(cp(0.2, 0.3, 7).isApprox(Eigen::Vector3d(0.2, 0.3, 0)));    // face
+  auto cp = [&](double x, double y, double z) {
+    return closest_point_on_triangle({x, y, z}, a, b, c);
+  };
+  EXPECT_TRUE(cp(-1, -1, 2).isApprox(a));                               // vertex A
+  EXPECT_TRUE(cp(3, -1, 0).isApprox(b));                                // vertex B
+  EXPECT_TRUE(cp(-0.5, 4, 1).isApprox(c));                              // vertex C
+  EXPECT_TRUE(cp(0.5, -2, 1).isApprox(Eigen::Vector3d(0.5, 0, 0)));     // edge AB
+  EXPECT_TRUE(cp(-3, 0.25, 0).isApprox(Eigen::Vector3d(0, 0.25, 0)));   // edge AC
+  EXPECT_TRUE(cp(1, 1, -5).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));     // edge BC
+  EXPECT_TRUE(cp(0.2, 0.3, 7).isApprox(Eigen::Vector3d(0.2, 0.3, 0)));  // face
   // Degenerate (collinear) triangle: the nearest point of the segment.
   const Eigen::Vector3d q = closest_point_on_triangle({0.5, 1, 0}, a, b, Eigen::Vector3d(2, 0, 0));
   EXPECT_TRUE(q.isApprox(Eigen::Vector3d(0.5, 0, 0)));
@@ -152,7 +156,8 @@ TEST(ClosestPoint, RegionsOfOneTriangle) {
 /// Distance from p to the segment [s, e] in long double, by minimising |s + t(e - s) - p|² over
 /// t in [0, 1] in closed form (a zero-length segment is its point): the reference for
 /// degenerate triangles, whose point set is the union of their three edges.
-long double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& s, const Eigen::Vector3d& e) {
+long double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
+                             const Eigen::Vector3d& e) {
   long double dd = 0, dp = 0;
   for (int k = 0; k < 3; ++k) {
     const long double d = (long double)e[k] - s[k], w = (long double)p[k] - s[k];
@@ -168,9 +173,10 @@ long double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& s,
   return std::sqrt(r);
 }
 
-long double edges_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                           const Eigen::Vector3d& c) {
-  return std::min({segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
+long double edges_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                           const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  return std::min(
+      {segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
 }
 
 TEST(ClosestPoint, DegenerateTrianglesAreTheirEdges) {
@@ -185,7 +191,8 @@ TEST(ClosestPoint, DegenerateTrianglesAreTheirEdges) {
   auto random_point = [&] { return Eigen::Vector3d(u(rng), u(rng), u(rng)); };
   int checked = 0, wrong = 0;
   std::string first;
-  auto check = [&](const char* kind, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  auto check = [&](const char* kind, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                   const Eigen::Vector3d& c) {
     for (int i = 0; i < 4; ++i) {
       // Points around the triangle and next to it (on its line, and just off it).
       Eigen::Vector3d p = 2 * random_point();
@@ -197,8 +204,8 @@ TEST(ClosestPoint, DegenerateTrianglesAreTheirEdges) {
         if (wrong++ == 0) {
           std::ostringstream m;
           m.precision(17);
-          m << kind << ": distance " << got << ", want " << want << " (p " << p.transpose() << ", a "
-            << a.transpose() << ", b " << b.transpose() << ", c " << c.transpose() << ")";
+          m << kind << ": distance " << got << ", want " << want << " (p " << p.transpose()
+            << ", a " << a.transpose() << ", b " << b.transpose() << ", c " << c.transpose() << ")";
           first = m.str();
         }
       }
@@ -238,10 +245,13 @@ TEST(TriangleBvh, ClosestPointEqualsBruteForce) {
     if (i % 3 == 1) p = m.vertices.row(i % m.num_vertices()).transpose() * (1.0 + 0.01 * u(rng));
     const ClosestHit fast = bvh.closest(p), slow = bvh.closest_brute_force(p);
     ASSERT_GE(fast.triangle, 0);
-    EXPECT_NEAR(fast.squared_distance, slow.squared_distance, 1e-14 * (1 + slow.squared_distance)) << i;
-    const Eigen::Vector3d a = m.vertices.row(m.faces(fast.triangle, 0)), b = m.vertices.row(m.faces(fast.triangle, 1)),
+    EXPECT_NEAR(fast.squared_distance, slow.squared_distance, 1e-14 * (1 + slow.squared_distance))
+        << i;
+    const Eigen::Vector3d a = m.vertices.row(m.faces(fast.triangle, 0)),
+                          b = m.vertices.row(m.faces(fast.triangle, 1)),
                           c = m.vertices.row(m.faces(fast.triangle, 2));
-    EXPECT_NEAR((closest_point_on_triangle(p, a, b, c) - p).squaredNorm(), fast.squared_distance, 1e-15);
+    EXPECT_NEAR((closest_point_on_triangle(p, a, b, c) - p).squaredNorm(), fast.squared_distance,
+                1e-15);
   }
 }
 
@@ -250,17 +260,20 @@ TEST(TriangleBvh, BoundExcludesFartherTriangles) {
   const TriangleBvh bvh(m.vertices, m.faces);
   const ClosestHit none = bvh.closest(Eigen::Vector3d(3, 0, 0), 1.0);  // nearest is ~2 away
   EXPECT_EQ(none.triangle, -1);
-  EXPECT_EQ(TriangleBvh(Positions(0, 3), Triangles(0, 3)).closest(Eigen::Vector3d::Zero()).triangle, -1);
+  EXPECT_EQ(TriangleBvh(Positions(0, 3), Triangles(0, 3)).closest(Eigen::Vector3d::Zero()).triangle,
+            -1);
 }
 
 Eigen::Matrix3d rotation() {
-  return (Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()) * Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitX()))
+  return (Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()) *
+          Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
 
 TEST(QuasiConformal, SimilarityIsOne) {
   const TriangleMesh m = make_torus(1.0, 0.3, 32, 12);
-  const Positions moved = ((m.vertices * rotation().transpose()) * 2.5).rowwise() + Eigen::RowVector3d(1, -2, 0.5);
+  const Positions moved =
+      ((m.vertices * rotation().transpose()) * 2.5).rowwise() + Eigen::RowVector3d(1, -2, 0.5);
   EXPECT_NEAR(quasi_conformal_error(m, moved), 1.0, 1e-12);
   EXPECT_NEAR(quasi_conformal_error(m, m.vertices), 1.0, 1e-14);
 }
@@ -271,7 +284,8 @@ TEST(QuasiConformal, StretchOfAPlanarMeshIsTheStretchRatio) {
   // Irregular triangles, so the frames are not aligned with the stretch axis.
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> jitter(-0.03, 0.03);
-  for (Eigen::Index v = 0; v < m.num_vertices(); ++v) m.vertices.row(v) += Eigen::RowVector3d(jitter(rng), jitter(rng), 0);
+  for (Eigen::Index v = 0; v < m.num_vertices(); ++v)
+    m.vertices.row(v) += Eigen::RowVector3d(jitter(rng), jitter(rng), 0);
   Positions stretched = m.vertices;
   stretched.col(0) *= 2;
   EXPECT_NEAR(quasi_conformal_error(m, stretched), 2.0, 1e-12);
@@ -315,7 +329,8 @@ double ellipsoid_sphericity(double a) {
 TEST(Sphericity, SphereIsZeroEllipsoidMatchesTheIntegral) {
   const TriangleMesh sphere = make_icosphere(5, 2.0);
   EXPECT_LT(sphericity(sphere.vertices, sphere.faces), 1e-12);
-  const TriangleMesh shifted{sphere.vertices.rowwise() + Eigen::RowVector3d(5, -1, 2), sphere.faces};
+  const TriangleMesh shifted{sphere.vertices.rowwise() + Eigen::RowVector3d(5, -1, 2),
+                             sphere.faces};
   EXPECT_LT(sphericity(shifted.vertices, shifted.faces), 1e-12);  // centre is found, not assumed
 
   double previous = 0;

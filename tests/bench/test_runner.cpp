@@ -51,8 +51,13 @@ TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
   const json j = {{"name", "m"},
                   {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 4}, {"dt", 1e-3}}},
                   {"axes", {{"dt", {1e-3, 4e-3}}}},
-                  {"metrics", {{"quasi_conformal", true}, {"sphericity", true}, {"every", 2},
-                               {"frames", {0, 2, 4}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 500}}}};
+                  {"metrics",
+                   {{"quasi_conformal", true},
+                    {"sphericity", true},
+                    {"every", 2},
+                    {"frames", {0, 2, 4}},
+                    {"reference", {{"dt", 1e-3}}},
+                    {"distance_samples", 500}}}};
   const ExperimentConfig e = parse_experiment_config(j, "m.json", false);
   RunOptions o;
   o.out_dir = out.string();
@@ -91,7 +96,7 @@ TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
   ASSERT_EQ(d.size(), 3u);
   EXPECT_EQ(d[0]["step"], 0);
   EXPECT_NEAR(d[0]["rms"].get<double>(), 0.0, 1e-6);  // same input mesh (frames are float PLY)
-  EXPECT_GT(d[2]["rms"].get<double>(), 1e-4);          // 4x the time step: visibly further along
+  EXPECT_GT(d[2]["rms"].get<double>(), 1e-4);         // 4x the time step: visibly further along
   EXPECT_EQ(d[2]["samples"], 500);
   EXPECT_EQ(other["reference_cell"]["hash"], plans[0].hash);
 }
@@ -104,9 +109,13 @@ TEST(Runner, AFlowThatStopsEarlyHasMetricsAtItsLastCompletedStep) {
   HookGuard guard(fake_hooks());
   auto run_every = [](int every) {
     const fs::path out = fresh_dir("stopped_every_" + std::to_string(every));
-    const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"integrator", "explicit-euler"},
-                                  {"dt", 0.05}, {"steps", 50}}},
-                    {"metrics", {{"quasi_conformal", true}, {"sphericity", true}, {"every", every}}}};
+    const json j = {
+        {"defaults",
+         {{"mesh", "icosphere:level=1"},
+          {"integrator", "explicit-euler"},
+          {"dt", 0.05},
+          {"steps", 50}}},
+        {"metrics", {{"quasi_conformal", true}, {"sphericity", true}, {"every", every}}}};
     const ExperimentConfig e = parse_experiment_config(j, "stop.json", false);
     RunOptions o;
     o.out_dir = out.string();
@@ -118,7 +127,8 @@ TEST(Runner, AFlowThatStopsEarlyHasMetricsAtItsLastCompletedStep) {
   ASSERT_EQ(r["status"], "singular") << r["stop"].dump();
   ASSERT_EQ(r["stop"]["step"], 6) << r["stop"].dump();
   ASSERT_EQ(r["steps"].size(), 6u);
-  for (int i : {0, 1, 2, 5}) EXPECT_FALSE(r["steps"][size_t(i)].contains("metrics")) << "step " << i + 1;
+  for (int i : {0, 1, 2, 5})
+    EXPECT_FALSE(r["steps"][size_t(i)].contains("metrics")) << "step " << i + 1;
   ASSERT_TRUE(r["steps"][3].contains("metrics"));  // step 4: a multiple of every=4
   ASSERT_TRUE(r["steps"][4].contains("metrics"));  // step 5: the last completed step
   EXPECT_EQ(r["steps"][3]["metrics"], all["steps"][3]["metrics"]);
@@ -131,9 +141,10 @@ TEST(Runner, AFlowThatStopsEarlyHasMetricsAtItsLastCompletedStep) {
 TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
   HookGuard guard(fake_hooks());
   const fs::path out = fresh_dir("sharded_ref");
-  const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
-                  {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
-                  {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
+  const json j = {
+      {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
+      {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
+      {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
   const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
   RunOptions o;
   o.out_dir = out.string();
@@ -148,7 +159,8 @@ TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
   EXPECT_EQ(s.distances, 1);
   MeshCache meshes;
   const auto plans = plan_cells(e, out.string(), meshes);
-  for (int i : {1, 2}) EXPECT_EQ(read_json(plans[size_t(i)].file)["reference_distance"].size(), 1u) << i;
+  for (int i : {1, 2})
+    EXPECT_EQ(read_json(plans[size_t(i)].file)["reference_distance"].size(), 1u) << i;
   EXPECT_EQ(run_experiment(e, o).distances, 0);  // nothing stale any more
 }
 
@@ -180,11 +192,13 @@ TEST(Runner, ACellErrorIsRecordedAndTheRunGoesOn) {
 
 TEST(Runner, OnStepReportsEveryStepOfTheCellsThatRunAndNoneOfTheSkippedOnes) {
   const fs::path out = fresh_dir("on_step");
-  const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 3}}}, {"axes", {{"dt", {1e-3, 2e-3}}}}};
+  const json j = {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 3}}},
+                  {"axes", {{"dt", {1e-3, 2e-3}}}}};
   const ExperimentConfig e = parse_experiment_config(j, "s.json", false);
   RunOptions o;
   o.out_dir = out.string();
-  std::vector<std::tuple<int, int, int, int, int>> seen;  // cell number, total, cell index, step, steps
+  std::vector<std::tuple<int, int, int, int, int>>
+      seen;  // cell number, total, cell index, step, steps
   o.on_step = [&](const StepReport& r) {
     seen.emplace_back(r.cell_number, r.total, r.plan->cell.index, r.step, r.steps);
   };
@@ -206,8 +220,10 @@ TEST(Runner, OnStepReportsEveryStepOfTheCellsThatRunAndNoneOfTheSkippedOnes) {
 TEST(Runner, MissingMetricImplementationIsAConfigErrorBeforeAnything) {
   HookGuard guard(MetricHooks{});
   const fs::path out = fresh_dir("nohooks") / "out";
-  const ExperimentConfig e = parse_experiment_config(
-      {{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 1}}}, {"metrics", {{"quasi_conformal", true}}}}, "q.json", false);
+  const ExperimentConfig e =
+      parse_experiment_config({{"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 1}}},
+                               {"metrics", {{"quasi_conformal", true}}}},
+                              "q.json", false);
   RunOptions o;
   o.out_dir = out.string();
   EXPECT_THROW(run_experiment(e, o), ConfigError);
@@ -235,7 +251,9 @@ TEST(RunnerCli, RerunRetriesErroredAndUnreadableCellsAndCollectCountsErrors) {
   // An errored cell is not a result: a rerun runs it again (and exits 1 while it still fails),
   // `collect` reports it; a cell file that does not parse is replaced, not "skipped".
   const fs::path dir = fresh_dir("retry");
-  write_text(dir / "e.json", R"({"name": "e", "defaults": {"mesh": "icosphere:level=1", "steps": 1, "basis": "octree",
+  write_text(
+      dir / "e.json",
+      R"({"name": "e", "defaults": {"mesh": "icosphere:level=1", "steps": 1, "basis": "octree",
     "octree": {"depth": 4}, "solver": {"name": "cholmod"}}, "axes": {"octree.cube": ["tight", "unit"]}})");
   Command c = mcfbench("run e.json --out out", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;  // the unit cube does not hold a radius-1 sphere
@@ -247,7 +265,8 @@ TEST(RunnerCli, RerunRetriesErroredAndUnreadableCellsAndCollectCountsErrors) {
   EXPECT_EQ(read_json(dir / "out" / "index.json")["studies"][0]["errors"], json::array({1}));
   c = mcfbench("run e.json --out out", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
-  EXPECT_NE(c.out.find("1 ran (1 retried after an error), 1 skipped, 1 errors"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("1 ran (1 retried after an error), 1 skipped, 1 errors"), std::string::npos)
+      << c.out;
   // Truncate the good cell's file: the next run recomputes it.
   fs::path good;
   for (const auto& f : result_files(dir / "out"))
@@ -259,7 +278,8 @@ TEST(RunnerCli, RerunRetriesErroredAndUnreadableCellsAndCollectCountsErrors) {
   EXPECT_NE(c.out.find(good.filename().string() + ": unreadable"), std::string::npos) << c.out;
   EXPECT_EQ(read_json(dir / "out" / "index.json")["unreadable"].size(), 1u);
   c = mcfbench("run e.json --out out", dir);
-  EXPECT_NE(c.out.find("2 ran (2 retried after an error), 0 skipped, 1 errors"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("2 ran (2 retried after an error), 0 skipped, 1 errors"), std::string::npos)
+      << c.out;
   EXPECT_EQ(read_json(good)["status"], "ok");
 }
 
@@ -271,11 +291,13 @@ TEST(RunnerCli, LogsShowStepProgressEveryProgressSecondsAndABadValueWritesNothin
   ::setenv("MCFBENCH_PROGRESS_SECONDS", "0", 1);
   Command c = mcfbench("run tiny.json --out out", dir);
   ASSERT_EQ(c.status, 0) << c.err;
-  for (const char* line : {"[1/3] cell 0 step 0/2  ", "[1/3] cell 0 step 1/2  ", "[3/3] cell 2 step 1/2  "})
+  for (const char* line :
+       {"[1/3] cell 0 step 0/2  ", "[1/3] cell 0 step 1/2  ", "[3/3] cell 2 step 1/2  "})
     EXPECT_NE(c.err.find(line), std::string::npos) << line << " in " << c.err;
   EXPECT_EQ(c.err.find("step 2/2"), std::string::npos) << c.err;
   EXPECT_EQ(c.err.find('\r'), std::string::npos) << "a terminal's line in a log";
-  EXPECT_LT(c.err.find("[1/3] cell 0 step 1/2"), c.err.find(" ok ")) << c.err;  // before the cell's own line
+  EXPECT_LT(c.err.find("[1/3] cell 0 step 1/2"), c.err.find(" ok "))
+      << c.err;  // before the cell's own line
   c = mcfbench("flow --mesh icosphere:level=1 --steps 3 --out flow", dir);
   ASSERT_EQ(c.status, 0) << c.err;
   EXPECT_NE(c.err.find("step 2/3  "), std::string::npos) << c.err;
@@ -285,7 +307,8 @@ TEST(RunnerCli, LogsShowStepProgressEveryProgressSecondsAndABadValueWritesNothin
   ASSERT_EQ(c.status, 0) << c.err;
   EXPECT_EQ(c.err.find(" step "), std::string::npos) << c.err;
   ::setenv("MCFBENCH_PROGRESS_SECONDS", "often", 1);
-  for (const char* args : {"run tiny.json --out bad", "flow --mesh icosphere:level=1 --steps 3 --out bad"}) {
+  for (const char* args :
+       {"run tiny.json --out bad", "flow --mesh icosphere:level=1 --steps 3 --out bad"}) {
     c = mcfbench(args, dir);
     EXPECT_NE(c.status, 0) << args;
     EXPECT_NE(c.err.find("MCFBENCH_PROGRESS_SECONDS"), std::string::npos) << args << ": " << c.err;
@@ -319,8 +342,10 @@ TEST(RunnerCli, RerunRedoesExactlyTheMissingCell) {
   ASSERT_EQ(files.size(), 3u);
   for (const auto& f : files) {
     const std::string name = f.filename().string();
-    if (name == victim) EXPECT_GT(fs::last_write_time(f), before.begin()->second) << "not recomputed";
-    else EXPECT_EQ(fs::last_write_time(f), before[name]) << name << " recomputed";
+    if (name == victim)
+      EXPECT_GT(fs::last_write_time(f), before.begin()->second) << "not recomputed";
+    else
+      EXPECT_EQ(fs::last_write_time(f), before[name]) << name << " recomputed";
   }
   c = mcfbench("run tiny.json --out out --force", dir);
   EXPECT_NE(c.out.find("3 ran, 0 skipped"), std::string::npos) << c.out;
@@ -338,7 +363,8 @@ pid_t start_run(const fs::path& dir, const char* config, const char* out) {
     if (::chdir(dir.c_str()) != 0) _exit(127);
     std::freopen("/dev/null", "w", stderr);
     std::freopen("/dev/null", "w", stdout);
-    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", config, "--out", out, static_cast<char*>(nullptr));
+    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", config, "--out", out,
+          static_cast<char*>(nullptr));
     _exit(127);
   }
   return pid;
@@ -367,10 +393,13 @@ TEST(RunnerCli, KilledRunLosesNoFinishedCellAndRepeatsNone) {
   const Command c = mcfbench("run slow.json --out out", dir);
   ASSERT_EQ(c.status, 0) << c.err;
   const size_t redo = 6 - finished.size();
-  EXPECT_NE(c.out.find(std::to_string(redo) + " ran, " + std::to_string(finished.size()) + " skipped"), std::string::npos)
+  EXPECT_NE(
+      c.out.find(std::to_string(redo) + " ran, " + std::to_string(finished.size()) + " skipped"),
+      std::string::npos)
       << c.out;
   EXPECT_EQ(result_files(dir / "out").size(), 6u);
-  for (const auto& [name, t] : before) EXPECT_EQ(fs::last_write_time(dir / "out" / name), t) << name << " recomputed";
+  for (const auto& [name, t] : before)
+    EXPECT_EQ(fs::last_write_time(dir / "out" / name), t) << name << " recomputed";
 }
 
 TEST(RunnerCli, CollectFailsOnARunThatFinishedNothingAndOnAFolderWithNothingToCollect) {
@@ -421,7 +450,8 @@ TEST(RunnerCli, CollectAfterAKillBeforeAnyCellFinishedNamesTheMissingCells) {
     return false;
   };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!planned() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  while (!planned() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   ::kill(pid, SIGKILL);
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -431,10 +461,17 @@ TEST(RunnerCli, CollectAfterAKillBeforeAnyCellFinishedNamesTheMissingCells) {
   const Command c = mcfbench("collect out", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   const std::string missing = std::to_string(7 - finished);
-  EXPECT_NE(c.out.find(std::to_string(finished) + " cells found of 7, " + missing + " missing"), std::string::npos) << c.out;
-  EXPECT_NE(c.out.find("missing cells (" + missing + "): #" + std::to_string(finished) + " {\"dt\":"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find(std::to_string(finished) + " cells found of 7, " + missing + " missing"),
+            std::string::npos)
+      << c.out;
+  EXPECT_NE(
+      c.out.find("missing cells (" + missing + "): #" + std::to_string(finished) + " {\"dt\":"),
+      std::string::npos)
+      << c.out;
   if (7 - finished > 5) {  // the first five are named, the rest counted
-    EXPECT_NE(c.out.find("... and " + std::to_string(7 - finished - 5) + " more"), std::string::npos) << c.out;
+    EXPECT_NE(c.out.find("... and " + std::to_string(7 - finished - 5) + " more"),
+              std::string::npos)
+        << c.out;
   }
 }
 
@@ -454,7 +491,8 @@ TEST(RunnerCli, ShardsThenCollect) {
   const fs::path dir = fresh_dir("shards");
   write_text(dir / "tiny.json", tiny_config);
   for (int i = 0; i < 3; ++i) {
-    const Command c = mcfbench("run tiny.json --out s" + std::to_string(i) + " --shard " + std::to_string(i) + "/3", dir);
+    const Command c = mcfbench(
+        "run tiny.json --out s" + std::to_string(i) + " --shard " + std::to_string(i) + "/3", dir);
     ASSERT_EQ(c.status, 0) << c.err;
     EXPECT_EQ(result_files(dir / ("s" + std::to_string(i))).size(), 1u);
   }
@@ -477,11 +515,15 @@ TEST(RunnerCli, ShardsThenCollect) {
 TEST(RunnerCli, ConfigErrorsNameFileAndKeyAndWriteNothing) {
   const fs::path dir = fresh_dir("cfgerr");
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {R"({"defaults": {"mesh": "icosphere:level=1", "solver": {"cycels": 2}}})", "defaults.solver.cycels"},
-      {R"({"defaults": {"mesh": "icosphere:level=1"}, "zip": [{"dt": [0.1, 0.2], "steps": [1]}]})", "zip[0].steps"},
-      {R"({"defaults": {"mesh": "icosphere:level=1"}, "axes": {"octree.deep": [1]}})", "axes.octree.deep"},
+      {R"({"defaults": {"mesh": "icosphere:level=1", "solver": {"cycels": 2}}})",
+       "defaults.solver.cycels"},
+      {R"({"defaults": {"mesh": "icosphere:level=1"}, "zip": [{"dt": [0.1, 0.2], "steps": [1]}]})",
+       "zip[0].steps"},
+      {R"({"defaults": {"mesh": "icosphere:level=1"}, "axes": {"octree.deep": [1]}})",
+       "axes.octree.deep"},
       {R"({"defaults": {"mesh": "icosphere:level=1"}, "bogus": 1})", "bogus"},
-      {R"({"defaults": {"mesh": "icosphere:level=1"}, "axes": {"dt": [0.1]}, "exclude": [{"dtx": 0.1}]})", "exclude[0].dtx"},
+      {R"({"defaults": {"mesh": "icosphere:level=1"}, "axes": {"dt": [0.1]}, "exclude": [{"dtx": 0.1}]})",
+       "exclude[0].dtx"},
       {R"({"defaults": {"mesh": "no_such_generator:x=1"}})", "mesh"},
   };
   int n = 0;

@@ -7,11 +7,11 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <sys/wait.h>
-#include <unistd.h>
 
 namespace mcf {
 namespace {
@@ -43,7 +43,8 @@ TEST(AtomicFile, NextWriteRemovesTheTemporaryFilesOfDeadWritersOfThatFileOnly) {
   const std::string live = target + ".tmp." + std::to_string(::getppid());  // our parent is alive
   const std::string other = dir.file("other.json.tmp." + std::to_string(dead));
   const std::string not_pid = target + ".tmp.notes";
-  for (const std::string& f : {stale, live, other, not_pid}) dir.write(fs::path(f).filename().string(), "{\"trunc");
+  for (const std::string& f : {stale, live, other, not_pid})
+    dir.write(fs::path(f).filename().string(), "{\"trunc");
 
   write_file_atomic(target, "{}\n");
   EXPECT_EQ(read(target), "{}\n");
@@ -54,7 +55,8 @@ TEST(AtomicFile, NextWriteRemovesTheTemporaryFilesOfDeadWritersOfThatFileOnly) {
   EXPECT_FALSE(fs::exists(target + ".tmp." + std::to_string(::getpid())));
   EXPECT_EQ(remove_stale_temporaries(dir.file("other.json")), 1);
   EXPECT_FALSE(fs::exists(other));
-  EXPECT_EQ(remove_stale_temporaries(dir.file("missing/x.json")), 0);  // no folder: nothing, no throw
+  EXPECT_EQ(remove_stale_temporaries(dir.file("missing/x.json")),
+            0);  // no folder: nothing, no throw
 }
 
 }  // namespace

@@ -11,11 +11,11 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <climits>
 #include <filesystem>
 #include <string>
-#include <sys/syscall.h>
-#include <unistd.h>
 #include <vector>
 
 namespace {
@@ -66,7 +66,8 @@ void expect_file_then_folder(const std::vector<std::string>& syncs, const fs::pa
 TEST(DurableWrite, AResultIsSyncedBeforeItsRenameAndItsFolderAfter) {
   test::TempDir dir;
   const fs::path target = dir.file("cell.json");
-  const auto syncs = syncs_of([&] { write_file_atomic(target.string(), "{\"status\": \"ok\"}\n"); });
+  const auto syncs =
+      syncs_of([&] { write_file_atomic(target.string(), "{\"status\": \"ok\"}\n"); });
   expect_file_then_folder(syncs, target, "cell.json.tmp.");
   // Overwriting an existing result syncs the same way (rename over a file orders nothing either).
   const auto again = syncs_of([&] { write_file_atomic(target.string(), "{}\n"); });
@@ -78,7 +79,8 @@ TEST(DurableWrite, AMeshIsSyncedBeforeItsRenameAndItsFolderAfter) {
   const TriangleMesh sphere = make_icosphere(1);
   for (const std::string name : {"frame_00001.ply", "final.off", "final.obj", "final.stl"}) {
     const fs::path target = dir.file(name);
-    const auto syncs = syncs_of([&] { write_mesh(target.string(), sphere, true, FaceCheck::trusted); });
+    const auto syncs =
+        syncs_of([&] { write_mesh(target.string(), sphere, true, FaceCheck::trusted); });
     expect_file_then_folder(syncs, target, ".tmp");
     EXPECT_TRUE(fs::exists(target));
   }
@@ -90,7 +92,8 @@ TEST(DurableWrite, SyncingAMissingFileNamesIt) {
     sync_to_disk(dir.file("gone.json"));
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("gone.json: cannot open to sync"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("gone.json: cannot open to sync"), std::string::npos)
+        << e.what();
   }
 }
 

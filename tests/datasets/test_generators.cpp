@@ -52,7 +52,9 @@ TEST(Generators, SphereByVertexCount) {
     const TriangleMesh m = make_sphere(target, 1.5);
     const long long k = std::llround(std::sqrt((target - 2) / 10.0));
     EXPECT_EQ(m.num_vertices(), 10 * k * k + 2) << target;
-    EXPECT_NEAR(static_cast<double>(m.num_vertices()), static_cast<double>(target), 0.2 * target + 12) << target;
+    EXPECT_NEAR(static_cast<double>(m.num_vertices()), static_cast<double>(target),
+                0.2 * target + 12)
+        << target;
     expect_closed(m, 0, "sphere");
     EXPECT_NEAR(m.vertices.rowwise().norm().minCoeff(), 1.5, 1e-12);
   }
@@ -101,7 +103,8 @@ TEST(Generators, CatenoidHasTwoBoundaryLoops) {
   EXPECT_EQ(r.boundary_loops, 2);
   EXPECT_EQ(r.genus, 0);
   // Boundary circles have radius cosh(1).
-  for (int v : boundary_vertices(m)) EXPECT_NEAR(m.vertices.row(v).head<2>().norm(), std::cosh(1.0), 1e-12);
+  for (int v : boundary_vertices(m))
+    EXPECT_NEAR(m.vertices.row(v).head<2>().norm(), std::cosh(1.0), 1e-12);
   // Exact area: π (2h + sinh(2h)) for waist 1.
   EXPECT_NEAR(r.area, kPi * (2 + std::sinh(2.0)), 0.01 * r.area);
 }
@@ -148,7 +151,8 @@ double min_angle_degrees(const TriangleMesh& m) {
   double lo = 180;
   for (Eigen::Index f = 0; f < m.num_faces(); ++f)
     for (int c = 0; c < 3; ++c) {
-      const Eigen::Vector3d a = m.vertices.row(m.faces(f, c)), b = m.vertices.row(m.faces(f, (c + 1) % 3)),
+      const Eigen::Vector3d a = m.vertices.row(m.faces(f, c)),
+                            b = m.vertices.row(m.faces(f, (c + 1) % 3)),
                             d = m.vertices.row(m.faces(f, (c + 2) % 3));
       const double cosine = std::clamp((b - a).normalized().dot((d - a).normalized()), -1.0, 1.0);
       lo = std::min(lo, std::acos(cosine) * 180 / kPi);

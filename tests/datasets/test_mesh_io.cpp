@@ -28,7 +28,9 @@ namespace {
 using test::TempDir;
 
 // Reading and validating, as every user of a file does (load_mesh_spec does both).
-void load_checked(const std::string& path) { validate_mesh(read_mesh(path), path); }
+void load_checked(const std::string& path) {
+  validate_mesh(read_mesh(path), path);
+}
 
 // Expects a MeshError whose message names the file (its base name at least).
 void expect_error_naming(const std::string& path, const std::string& fragment = "") {
@@ -47,12 +49,14 @@ void expect_error_naming(const std::string& path, const std::string& fragment = 
     load_mesh_spec(path);
     FAIL() << "load_mesh_spec accepted " << path;
   } catch (const MeshError& e) {
-    EXPECT_NE(std::string(e.what()).find(std::filesystem::path(path).filename().string()), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find(std::filesystem::path(path).filename().string()),
+              std::string::npos)
         << e.what();
   }
 }
 
-const char* kTetraOff = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+const char* kTetraOff =
+    "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 TEST(MeshIo, ReadsValidOff) {
   TempDir dir;
@@ -77,34 +81,44 @@ TEST(MeshIo, OffKeywordPrefixes) {
   const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
   const Eigen::RowVector3d last(0, 0, 1);
   {
-    const TriangleMesh m =
-        read_mesh(dir.write("c.off", "COFF\n4 4 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n0 1 0 1 0 0 1\n0 0 1 1 0 0 1\n" + faces));
+    const TriangleMesh m = read_mesh(dir.write(
+        "c.off",
+        "COFF\n4 4 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n0 1 0 1 0 0 1\n0 0 1 1 0 0 1\n" + faces));
     EXPECT_EQ(m.vertices.row(3), last);
   }
   {
-    const TriangleMesh m = read_mesh(dir.write("h.off", "4OFF\n4 4 0\n0 0 0 2\n2 0 0 2\n0 3 0 3\n0 0 -0.5 -0.5\n" + faces));
+    const TriangleMesh m = read_mesh(
+        dir.write("h.off", "4OFF\n4 4 0\n0 0 0 2\n2 0 0 2\n0 3 0 3\n0 0 -0.5 -0.5\n" + faces));
     EXPECT_EQ(m.vertices.row(1), Eigen::RowVector3d(1, 0, 0));
     EXPECT_EQ(m.vertices.row(2), Eigen::RowVector3d(0, 1, 0));
     EXPECT_EQ(m.vertices.row(3), last);
   }
-  for (const char* header : {"nOFF\n3\n4 4 0\n", "nOFF 3 4 4 0\n", "CnOFF\n3 4 4 0\n", "STOFF\n4 4 0\n"}) {
+  for (const char* header :
+       {"nOFF\n3\n4 4 0\n", "nOFF 3 4 4 0\n", "CnOFF\n3 4 4 0\n", "STOFF\n4 4 0\n"}) {
     SCOPED_TRACE(header);
-    const TriangleMesh m = read_mesh(dir.write("n.off", std::string(header) + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces));
+    const TriangleMesh m =
+        read_mesh(dir.write("n.off", std::string(header) + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces));
     ASSERT_EQ(m.num_vertices(), 4);
     ASSERT_EQ(m.num_faces(), 4);
     EXPECT_EQ(m.vertices.row(3), last);
   }
-  expect_error_naming(dir.write("n4.off", "nOFF\n4\n4 4 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n" + faces),
-                      "dimension 4");
-  expect_error_naming(dir.write("w0.off", "4OFF\n4 4 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1 0\n" + faces),
-                      "vertex 3 has homogeneous coordinate w = 0");
+  expect_error_naming(
+      dir.write("n4.off", "nOFF\n4\n4 4 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n" + faces),
+      "dimension 4");
+  expect_error_naming(
+      dir.write("w0.off", "4OFF\n4 4 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1 0\n" + faces),
+      "vertex 3 has homogeneous coordinate w = 0");
   expect_error_naming(dir.write("w.off", "4OFF\n4 4 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1\n" + faces),
                       "vertex 3: cannot parse");
-  expect_error_naming(dir.write("x.off", "XOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces), "[ST][C][N][4][n]OFF");
-  expect_error_naming(dir.write("s.off", "SOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces), "[ST][C][N][4][n]OFF");
+  expect_error_naming(dir.write("x.off", "XOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces),
+                      "[ST][C][N][4][n]OFF");
+  expect_error_naming(dir.write("s.off", "SOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + faces),
+                      "[ST][C][N][4][n]OFF");
 }
 
-TEST(MeshIo, MissingFile) { expect_error_naming("/nonexistent_dir_xyz/missing_mesh.off", "no such file"); }
+TEST(MeshIo, MissingFile) {
+  expect_error_naming("/nonexistent_dir_xyz/missing_mesh.off", "no such file");
+}
 
 TEST(MeshIo, GarbageText) {
   TempDir dir;
@@ -125,28 +139,38 @@ TEST(MeshIo, EmptyFiles) {
 
 TEST(MeshIo, NanCoordinate) {
   TempDir dir;
-  expect_error_naming(dir.write("nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"), "vertex 1");
+  expect_error_naming(dir.write("nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
+                      "vertex 1");
   expect_error_naming(dir.write("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n"), "vertex 2");
 }
 
 TEST(MeshIo, IndexOutOfRange) {
   TempDir dir;
-  expect_error_naming(dir.write("range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"), "vertex 7");
-  expect_error_naming(dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "line 4: face refers to vertex 9");
-  expect_error_naming(dir.write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "line 4: face corner '0'");
-  expect_error_naming(dir.write("back.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n"), "face corner '-4'");
+  expect_error_naming(dir.write("range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
+                      "vertex 7");
+  expect_error_naming(dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+                      "line 4: face refers to vertex 9");
+  expect_error_naming(dir.write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"),
+                      "line 4: face corner '0'");
+  expect_error_naming(dir.write("back.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n"),
+                      "face corner '-4'");
   // Relative (negative) and textured/normal forms of valid indices still load.
-  EXPECT_EQ(read_mesh(dir.write("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf -3/1/1 2//1 3/1\n")).num_faces(), 1);
-  expect_error_naming(dir.write("range.ply",
-                                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
-                                "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n"));
+  EXPECT_EQ(read_mesh(dir.write("ok.obj",
+                                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf -3/1/1 2//1 3/1\n"))
+                .num_faces(),
+            1);
+  expect_error_naming(
+      dir.write("range.ply",
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n"));
 }
 
 TEST(MeshIo, ZeroAreaFace) {
   TempDir dir;
   // Three collinear points.
-  expect_error_naming(dir.write("flat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n"), "degenerate");
+  expect_error_naming(dir.write("flat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n"),
+                      "degenerate");
   expect_error_naming(dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"), "degenerate");
 }
 
@@ -156,42 +180,57 @@ TEST(MeshIo, NonManifoldEdge) {
   const std::string verts = "0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n";
   // The error names the first face that cannot be added and its edge, as the file numbers them.
   expect_error_naming(dir.write("fin.off", "OFF\n5 3 0\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"),
-                      "non-manifold mesh: face 2 (vertices 0, 1, 4) cannot be added: its edge (0, 1) already has a face");
-  expect_error_naming(dir.write("fin.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\n"
-                                           "f 1 2 3\nf 2 1 4\nf 1 2 5\n"),
+                      "non-manifold mesh: face 2 (vertices 0, 1, 4) cannot be added: its edge (0, "
+                      "1) already has a face");
+  expect_error_naming(dir.write("fin.obj",
+                                "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\n"
+                                "f 1 2 3\nf 2 1 4\nf 1 2 5\n"),
                       "the face on line 8 (vertices 1, 2, 5) cannot be added: its edge (1, 2)");
-  expect_error_naming(dir.write("fin.stl", "solid fin\n"
-                                           "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
-                                           "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 0 0 0\nvertex 0 -1 0\nendloop\nendfacet\n"
-                                           "facet normal 0 1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
-                                           "endsolid fin\n"), "non-manifold");
-  expect_error_naming(dir.write("fin.ply",
-                                "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
-                                "property float z\nelement face 3\nproperty list uchar int vertex_indices\n"
-                                "end_header\n" + verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"),
-                      "face 2 (vertices 0, 1, 4)");
+  expect_error_naming(dir.write("fin.stl",
+                                "solid fin\n"
+                                "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 "
+                                "0\nvertex 0 1 0\nendloop\nendfacet\n"
+                                "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 0 0 "
+                                "0\nvertex 0 -1 0\nendloop\nendfacet\n"
+                                "facet normal 0 1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 "
+                                "0\nvertex 0 0 1\nendloop\nendfacet\n"
+                                "endsolid fin\n"),
+                      "non-manifold");
+  expect_error_naming(
+      dir.write("fin.ply",
+                "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+                "property float z\nelement face 3\nproperty list uchar int vertex_indices\n"
+                "end_header\n" +
+                    verts + "3 0 1 2\n3 1 0 3\n3 0 1 4\n"),
+      "face 2 (vertices 0, 1, 4)");
 }
 
 TEST(MeshIo, InconsistentlyOrientedFaces) {
   TempDir dir;
   // Both triangles run along 0 -> 1: a half-edge mesh cannot hold them (nor can the flows).
-  expect_error_naming(dir.write("flip.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n3 0 1 2\n3 0 1 3\n"),
-                      "face 1 (vertices 0, 1, 3) cannot be added: its edge (0, 1) already has a face on the same side");
+  expect_error_naming(
+      dir.write("flip.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n3 0 1 2\n3 0 1 3\n"),
+      "face 1 (vertices 0, 1, 3) cannot be added: its edge (0, 1) already has a face on the same "
+      "side");
 }
 
 TEST(MeshIo, NonManifoldVertex) {
   TempDir dir;
   // Two closed tetrahedra sharing vertex 0: once the first is closed, vertex 0 has no free side.
-  const std::string off = "OFF\n7 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n-1 0 0\n0 -1 0\n0 0 -1\n"
-                          "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
-                          "3 0 4 5\n3 0 5 6\n3 0 6 4\n3 4 6 5\n";
-  expect_error_naming(dir.write("pinch.off", off), "face 4 (vertices 0, 4, 5) cannot be added: its vertex 0 is already surrounded");
+  const std::string off =
+      "OFF\n7 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n-1 0 0\n0 -1 0\n0 0 -1\n"
+      "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+      "3 0 4 5\n3 0 5 6\n3 0 6 4\n3 4 6 5\n";
+  expect_error_naming(
+      dir.write("pinch.off", off),
+      "face 4 (vertices 0, 4, 5) cannot be added: its vertex 0 is already surrounded");
 }
 
 TEST(MeshIo, OpenFansMeetingAtAVertexLoad) {
   TempDir dir;
   // A bow tie: two triangles sharing only vertex 0, which stays on the boundary of both.
-  const auto path = dir.write("bowtie.off", "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n-1 0 0\n-1 -1 0\n3 0 1 2\n3 0 3 4\n");
+  const auto path = dir.write(
+      "bowtie.off", "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n-1 0 0\n-1 -1 0\n3 0 1 2\n3 0 3 4\n");
   const MeshReport r = validate_mesh(read_mesh(path), path);
   EXPECT_EQ(r.faces, 2);
   EXPECT_EQ(r.boundary_loops, 1);  // the two holes touch at vertex 0 (validate.h)
@@ -200,8 +239,9 @@ TEST(MeshIo, OpenFansMeetingAtAVertexLoad) {
 TEST(MeshIo, NonManifoldPolygonNamesItsFan) {
   TempDir dir;
   // The quad 0 1 4 5 is fanned into (0 1 4) and (0 4 5); the first repeats edge 0 -> 1.
-  expect_error_naming(dir.write("quadfin.off", "OFF\n6 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 -1 0\n0 0 1\n"
-                                               "3 0 1 2\n4 0 1 4 5\n"),
+  expect_error_naming(dir.write("quadfin.off",
+                                "OFF\n6 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 -1 0\n0 0 1\n"
+                                "3 0 1 2\n4 0 1 4 5\n"),
                       "triangle 1 of 2 fanned from face 1 (vertices 0, 1, 4)");
 }
 
@@ -218,7 +258,8 @@ TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
     const int nv = 4 + static_cast<int>(rng() % 5), nf = 1 + static_cast<int>(rng() % 10);
     std::string off = "OFF\n" + std::to_string(nv) + " " + std::to_string(nf) + " 0\n";
     for (int v = 0; v < nv; ++v)
-      off += std::to_string(rng() % 100) + " " + std::to_string(rng() % 100) + " " + std::to_string(rng() % 100) + "\n";
+      off += std::to_string(rng() % 100) + " " + std::to_string(rng() % 100) + " " +
+             std::to_string(rng() % 100) + "\n";
     std::vector<std::array<int, 3>> fans;
     for (int f = 0; f < nf; ++f) {
       // Distinct corners but for one face in ten, so that most faces reach the half-edge mesh.
@@ -230,7 +271,8 @@ TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
       off += std::to_string(corner.size());
       for (int c : corner) (off += ' ') += std::to_string(c);
       off += "\n";
-      for (std::size_t j = 1; j + 1 < corner.size(); ++j) fans.push_back({corner[0], corner[j], corner[j + 1]});
+      for (std::size_t j = 1; j + 1 < corner.size(); ++j)
+        fans.push_back({corner[0], corner[j], corner[j + 1]});
     }
     const std::string path = dir.write("soup.off", off);
     try {
@@ -280,7 +322,9 @@ TEST(MeshIo, WritingANonManifoldMeshFails) {
       write_mesh(path, fin);
       FAIL() << "wrote " << path;
     } catch (const MeshError& e) {
-      EXPECT_NE(std::string(e.what()).find("cannot write: non-manifold mesh: face 2 (vertices 0, 1, 4)"), std::string::npos)
+      EXPECT_NE(
+          std::string(e.what()).find("cannot write: non-manifold mesh: face 2 (vertices 0, 1, 4)"),
+          std::string::npos)
           << e.what();
     }
     EXPECT_FALSE(std::filesystem::exists(path)) << path;
@@ -293,7 +337,9 @@ TEST(MeshIo, WritingANonManifoldMeshFails) {
     check_half_edge_faces(fin, "the fin");
     FAIL() << "no MeshError";
   } catch (const MeshError& e) {
-    EXPECT_NE(std::string(e.what()).find("the fin: non-manifold mesh: face 2 (vertices 0, 1, 4)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the fin: non-manifold mesh: face 2 (vertices 0, 1, 4)"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -327,8 +373,10 @@ TEST(MeshIo, TrustedFacesWriteTheSameBytes) {
 
 TEST(MeshIo, RepeatedIndexInFace) {
   TempDir dir;
-  expect_error_naming(dir.write("repeat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n"), "face 0 repeats vertex 1");
-  expect_error_naming(dir.write("repeat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n"), "the face on line 4 repeats vertex 2");
+  expect_error_naming(dir.write("repeat.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n"),
+                      "face 0 repeats vertex 1");
+  expect_error_naming(dir.write("repeat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n"),
+                      "the face on line 4 repeats vertex 2");
 }
 
 TEST(MeshIo, UnknownExtension) {
@@ -348,15 +396,17 @@ TEST(MeshIo, QuadsAreFanTriangulated) {
   const TriangleMesh m = read_mesh(path);
   EXPECT_EQ(m.num_faces(), 2);
   EXPECT_NEAR(surface_area(m), 1.0, 1e-12);
-  const auto obj = dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 2 3 4\nf 2 1 5\n");
+  const auto obj = dir.write(
+      "quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 2 3 4\nf 2 1 5\n");
   const TriangleMesh o = read_mesh(obj);
   EXPECT_EQ(o.num_faces(), 3);
   EXPECT_EQ(o.num_vertices(), 5);
   // A closed pyramid with a quad base: the PLY walk fans k - 2 triangles from each face.
-  const auto ply = dir.write("pyramid.ply",
-                             "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
-                             "property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n"
-                             "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n");
+  const auto ply = dir.write(
+      "pyramid.ply",
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n");
   EXPECT_EQ(read_mesh(ply).num_faces(), 6);
 }
 
@@ -367,7 +417,8 @@ TEST(MeshIo, AsciiKeepsDoublesExactly) {
   for (const char* name : {"x.off", "x.obj", "x.ply"}) {
     for (bool binary : {false, true}) {
       write_mesh(dir.file(name), m, binary);
-      EXPECT_EQ(read_mesh(dir.file(name)).vertices, m.vertices) << name << (binary ? " binary" : " ascii");
+      EXPECT_EQ(read_mesh(dir.file(name)).vertices, m.vertices)
+          << name << (binary ? " binary" : " ascii");
     }
   }
 }
@@ -375,39 +426,56 @@ TEST(MeshIo, AsciiKeepsDoublesExactly) {
 // --- PLY: every record is walked (ply_format.cpp), so errors name the line (ASCII) or byte. ---
 
 const std::string kTetraPlyHeader =
-    "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty "
+    "double z\n"
     "element face 4\nproperty list uchar int vertex_indices\nend_header\n";  // lines 1-9
 const std::string kTetraVertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";           // lines 10-13
-const std::string kTetraFaces = "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";     // lines 14-17
+const std::string kTetraFaces = "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";      // lines 14-17
 
 TEST(MeshIoPly, AsciiErrorsNameTheLine) {
   TempDir dir;
-  EXPECT_EQ(read_mesh(dir.write("ok.ply", kTetraPlyHeader + kTetraVertices + kTetraFaces)).num_faces(), 4);
+  EXPECT_EQ(
+      read_mesh(dir.write("ok.ply", kTetraPlyHeader + kTetraVertices + kTetraFaces)).num_faces(),
+      4);
   struct Case {
     const char* file;
     std::string vertices, faces;  // the body, lines 10-13 and 14-17
     const char* error;
   };
   const Case cases[] = {
-      {"nan.ply", "0 0 0\n1 0 0\n0 nan 0\n0 0 1\n", kTetraFaces, "line 12: vertex 2 has a non-finite coordinate y"},
+      {"nan.ply", "0 0 0\n1 0 0\n0 nan 0\n0 0 1\n", kTetraFaces,
+       "line 12: vertex 2 has a non-finite coordinate y"},
       {"range.ply", kTetraVertices, "3 0 2 1\n3 0 1 3\n3 1 2 9\n3 0 3 2\n",
        "line 16: face 2 references vertex 9 but the mesh has 4 vertices"},
-      {"short.ply", kTetraVertices, "3 0 2 1\n3 0 1 3\n", "the file ends at line 16 before face 2 of 4 is complete"},
+      {"short.ply", kTetraVertices, "3 0 2 1\n3 0 1 3\n",
+       "the file ends at line 16 before face 2 of 4 is complete"},
       // A value missing or one too many: the error is on that line, not a misread of the rest.
-      {"missing.ply", "0 0 0\n1 0\n0 1 0\n0 0 1\n", kTetraFaces, "line 11: vertex 1 of 4 ends after 2 values"},
-      {"extra.ply", "0 0 0\n1 0 0 7\n0 1 0\n0 0 1\n", kTetraFaces, "line 11: vertex 1 of 4 has more values than its 3"},
-      {"two.ply", kTetraVertices, "3 0 2 1\n3 0 1\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 of 4 ends after 3 values"},
-      {"word.ply", kTetraVertices, "3 0 2 1\n3 0 1 x\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 corner 2: 'x' is not an integer"},
-      {"corners.ply", kTetraVertices, "3 0 2 1\n2 0 1\n3 1 2 3\n3 0 3 2\n", "line 15: face 1 has 2 corners"},
-      {"letters.ply", "0 0 0\n1 0 zz\n0 1 0\n0 0 1\n", kTetraFaces, "line 11: vertex 1 of 4: 'zz' cannot be parsed as a number"},
+      {"missing.ply", "0 0 0\n1 0\n0 1 0\n0 0 1\n", kTetraFaces,
+       "line 11: vertex 1 of 4 ends after 2 values"},
+      {"extra.ply", "0 0 0\n1 0 0 7\n0 1 0\n0 0 1\n", kTetraFaces,
+       "line 11: vertex 1 of 4 has more values than its 3"},
+      {"two.ply", kTetraVertices, "3 0 2 1\n3 0 1\n3 1 2 3\n3 0 3 2\n",
+       "line 15: face 1 of 4 ends after 3 values"},
+      {"word.ply", kTetraVertices, "3 0 2 1\n3 0 1 x\n3 1 2 3\n3 0 3 2\n",
+       "line 15: face 1 corner 2: 'x' is not an integer"},
+      {"corners.ply", kTetraVertices, "3 0 2 1\n2 0 1\n3 1 2 3\n3 0 3 2\n",
+       "line 15: face 1 has 2 corners"},
+      {"letters.ply", "0 0 0\n1 0 zz\n0 1 0\n0 0 1\n", kTetraFaces,
+       "line 11: vertex 1 of 4: 'zz' cannot be parsed as a number"},
   };
-  for (const Case& c : cases) expect_error_naming(dir.write(c.file, kTetraPlyHeader + c.vertices + c.faces), c.error);
+  for (const Case& c : cases)
+    expect_error_naming(dir.write(c.file, kTetraPlyHeader + c.vertices + c.faces), c.error);
   // A CRLF file reads as its LF twin.
   std::string crlf;
-  for (char c : kTetraPlyHeader + kTetraVertices + kTetraFaces) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
-  EXPECT_EQ(read_mesh(dir.write("crlf.ply", crlf)).vertices, read_mesh(dir.file("ok.ply")).vertices);
+  for (char c : kTetraPlyHeader + kTetraVertices + kTetraFaces)
+    crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  EXPECT_EQ(read_mesh(dir.write("crlf.ply", crlf)).vertices,
+            read_mesh(dir.file("ok.ply")).vertices);
   // Blank lines between records and trailing blanks are fine.
-  EXPECT_EQ(read_mesh(dir.write("blank.ply", kTetraPlyHeader + "0 0 0\n\n1 0 0  \n0 1 0\n0 0 1\n" + kTetraFaces + "\n")).num_faces(), 4);
+  EXPECT_EQ(read_mesh(dir.write("blank.ply", kTetraPlyHeader + "0 0 0\n\n1 0 0  \n0 1 0\n0 0 1\n" +
+                                                 kTetraFaces + "\n"))
+                .num_faces(),
+            4);
 }
 
 TEST(MeshIoPly, HeaderErrorsNameTheLine) {
@@ -417,13 +485,20 @@ TEST(MeshIoPly, HeaderErrorsNameTheLine) {
     h.replace(h.find(from), from.size(), to);
     return h + kTetraVertices + kTetraFaces;
   };
-  expect_error_naming(dir.write("format.ply", with("format ascii", "format utf8")), "line 2: unknown format 'utf8'");
-  expect_error_naming(dir.write("type.ply", with("property double y", "property real y")), "line 5: unknown property type 'real'");
-  expect_error_naming(dir.write("noz.ply", with("property double z", "property double w")), "no scalar property 'z'");
-  expect_error_naming(dir.write("nolist.ply", with("vertex_indices", "corners")), "no list property 'vertex_indices'");
-  expect_error_naming(dir.write("huge.ply", with("element vertex 4", "element vertex 4000000000000")),
-                      "declares 4000000000000 vertices, more than the file's body can hold");
-  expect_error_naming(dir.write("noend.ply", kTetraPlyHeader.substr(0, kTetraPlyHeader.find("end_header"))), "no end_header");
+  expect_error_naming(dir.write("format.ply", with("format ascii", "format utf8")),
+                      "line 2: unknown format 'utf8'");
+  expect_error_naming(dir.write("type.ply", with("property double y", "property real y")),
+                      "line 5: unknown property type 'real'");
+  expect_error_naming(dir.write("noz.ply", with("property double z", "property double w")),
+                      "no scalar property 'z'");
+  expect_error_naming(dir.write("nolist.ply", with("vertex_indices", "corners")),
+                      "no list property 'vertex_indices'");
+  expect_error_naming(
+      dir.write("huge.ply", with("element vertex 4", "element vertex 4000000000000")),
+      "declares 4000000000000 vertices, more than the file's body can hold");
+  expect_error_naming(
+      dir.write("noend.ply", kTetraPlyHeader.substr(0, kTetraPlyHeader.find("end_header"))),
+      "no end_header");
 }
 
 // Little- or big-endian bytes of a value, to write binary test files by hand.
@@ -438,10 +513,11 @@ std::string bytes(T value, bool big_endian) {
 // A binary tetrahedron with float coordinates, an extra per-vertex property and an extra element
 // after the faces: what scanners and laser-scan exports write.
 std::string binary_tetra(bool big_endian, int bad_index = 2, int faces_written = 4) {
-  std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
-                  " 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
-                  "property uchar red\nelement face 4\nproperty list uchar int vertex_indices\n"
-                  "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n";
+  std::string s =
+      std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+      " 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nelement face 4\nproperty list uchar int vertex_indices\n"
+      "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n";
   const float v[4][3] = {{0, 0, 0}, {0.1f, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   for (const auto& p : v) {
     for (float c : p) s += bytes(c, big_endian);
@@ -452,7 +528,8 @@ std::string binary_tetra(bool big_endian, int bad_index = 2, int faces_written =
     s += bytes(std::uint8_t{3}, big_endian);
     for (int c : f[i]) s += bytes(std::int32_t{c}, big_endian);
   }
-  if (faces_written == 4) s += bytes(std::int32_t{0}, big_endian) + bytes(std::int32_t{1}, big_endian);
+  if (faces_written == 4)
+    s += bytes(std::int32_t{0}, big_endian) + bytes(std::int32_t{1}, big_endian);
   return s;
 }
 
@@ -469,21 +546,24 @@ TEST(MeshIoPly, BinaryBothByteOrders) {
   // Vertex records take 13 bytes, face records 13 (count, then three indices).
   auto header_bytes = [](bool big) { return binary_tetra(big).find("end_header\n") + 11; };
   expect_error_naming(dir.write("range_bin.ply", binary_tetra(false, 6)),
-                      "byte " + std::to_string(header_bytes(false) + 4 * 13 + 2 * 13 + 5) + ": face 2 references vertex 6");
+                      "byte " + std::to_string(header_bytes(false) + 4 * 13 + 2 * 13 + 5) +
+                          ": face 2 references vertex 6");
   expect_error_naming(dir.write("short_bin.ply", binary_tetra(true, 2, 3)),
-                      "the file ends at byte " + std::to_string(header_bytes(true) + 4 * 13 + 3 * 13) + " before face 3 of 4");
+                      "the file ends at byte " +
+                          std::to_string(header_bytes(true) + 4 * 13 + 3 * 13) +
+                          " before face 3 of 4");
 }
 
 // A binary tetrahedron whose coordinates are of type T (spelled `name` in the header) and whose
 // faces are a list of index type I with count type C: every scalar type, either spelling, read
 // in either byte order. Signed types get the negative corner -1 (a sign-extension check).
 template <typename T, typename C, typename I>
-void expect_binary_types(const TempDir& dir, const std::string& name, const std::string& count, const std::string& index,
-                         bool big) {
-  const std::string header = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
-                             " 1.0\nelement vertex 4\nproperty " + name + " x\nproperty " + name + " y\nproperty " +
-                             name + " z\nelement face 4\nproperty list " + count + " " + index +
-                             " vertex_indices\nend_header\n";
+void expect_binary_types(const TempDir& dir, const std::string& name, const std::string& count,
+                         const std::string& index, bool big) {
+  const std::string header =
+      std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+      " 1.0\nelement vertex 4\nproperty " + name + " x\nproperty " + name + " y\nproperty " + name +
+      " z\nelement face 4\nproperty list " + count + " " + index + " vertex_indices\nend_header\n";
   const int low = std::is_signed_v<T> ? -1 : 0;
   const int v[4][3] = {{low, low, low}, {2, low, low}, {low, 2, low}, {low, low, 2}};
   std::string body;
@@ -499,8 +579,10 @@ void expect_binary_types(const TempDir& dir, const std::string& name, const std:
   ASSERT_EQ(m.num_vertices(), 4) << label;
   ASSERT_EQ(m.num_faces(), 4) << label;
   for (int i = 0; i < 4; ++i) {
-    EXPECT_EQ(m.vertices.row(i), Eigen::RowVector3d(v[i][0], v[i][1], v[i][2])) << label << " vertex " << i;
-    EXPECT_EQ(m.faces.row(i), Eigen::RowVector3i(f[i][0], f[i][1], f[i][2])) << label << " face " << i;
+    EXPECT_EQ(m.vertices.row(i), Eigen::RowVector3d(v[i][0], v[i][1], v[i][2]))
+        << label << " vertex " << i;
+    EXPECT_EQ(m.faces.row(i), Eigen::RowVector3i(f[i][0], f[i][1], f[i][2]))
+        << label << " face " << i;
   }
 }
 
@@ -508,17 +590,28 @@ TEST(MeshIoPly, EveryScalarTypeInBothSpellingsAndByteOrders) {
   TempDir dir;
   for (bool big : {false, true}) {
     expect_binary_types<std::int8_t, std::uint8_t, std::int32_t>(dir, "char", "uchar", "int", big);
-    expect_binary_types<std::int8_t, std::uint16_t, std::uint32_t>(dir, "int8", "ushort", "uint32", big);
-    expect_binary_types<std::uint8_t, std::int8_t, std::int16_t>(dir, "uchar", "char", "short", big);
-    expect_binary_types<std::uint8_t, std::uint32_t, std::uint16_t>(dir, "uint8", "uint", "uint16", big);
-    expect_binary_types<std::int16_t, std::int16_t, std::uint8_t>(dir, "short", "int16", "uint8", big);
-    expect_binary_types<std::int16_t, std::int32_t, std::int8_t>(dir, "int16", "int32", "int8", big);
-    expect_binary_types<std::uint16_t, std::uint8_t, std::int32_t>(dir, "ushort", "uint8", "int", big);
-    expect_binary_types<std::uint16_t, std::uint8_t, std::int32_t>(dir, "uint16", "uchar", "int32", big);
-    expect_binary_types<std::int32_t, std::uint8_t, std::uint32_t>(dir, "int", "uchar", "uint", big);
-    expect_binary_types<std::int32_t, std::uint8_t, std::int32_t>(dir, "int32", "uchar", "int", big);
-    expect_binary_types<std::uint32_t, std::uint8_t, std::int32_t>(dir, "uint", "uchar", "int", big);
-    expect_binary_types<std::uint32_t, std::uint8_t, std::int32_t>(dir, "uint32", "uchar", "int", big);
+    expect_binary_types<std::int8_t, std::uint16_t, std::uint32_t>(dir, "int8", "ushort", "uint32",
+                                                                   big);
+    expect_binary_types<std::uint8_t, std::int8_t, std::int16_t>(dir, "uchar", "char", "short",
+                                                                 big);
+    expect_binary_types<std::uint8_t, std::uint32_t, std::uint16_t>(dir, "uint8", "uint", "uint16",
+                                                                    big);
+    expect_binary_types<std::int16_t, std::int16_t, std::uint8_t>(dir, "short", "int16", "uint8",
+                                                                  big);
+    expect_binary_types<std::int16_t, std::int32_t, std::int8_t>(dir, "int16", "int32", "int8",
+                                                                 big);
+    expect_binary_types<std::uint16_t, std::uint8_t, std::int32_t>(dir, "ushort", "uint8", "int",
+                                                                   big);
+    expect_binary_types<std::uint16_t, std::uint8_t, std::int32_t>(dir, "uint16", "uchar", "int32",
+                                                                   big);
+    expect_binary_types<std::int32_t, std::uint8_t, std::uint32_t>(dir, "int", "uchar", "uint",
+                                                                   big);
+    expect_binary_types<std::int32_t, std::uint8_t, std::int32_t>(dir, "int32", "uchar", "int",
+                                                                  big);
+    expect_binary_types<std::uint32_t, std::uint8_t, std::int32_t>(dir, "uint", "uchar", "int",
+                                                                   big);
+    expect_binary_types<std::uint32_t, std::uint8_t, std::int32_t>(dir, "uint32", "uchar", "int",
+                                                                   big);
     expect_binary_types<float, std::uint8_t, std::int32_t>(dir, "float", "uchar", "int", big);
     expect_binary_types<float, std::uint8_t, std::int32_t>(dir, "float32", "uchar", "int", big);
     expect_binary_types<double, std::uint8_t, std::int32_t>(dir, "double", "uchar", "int", big);
@@ -529,14 +622,17 @@ TEST(MeshIoPly, EveryScalarTypeInBothSpellingsAndByteOrders) {
 // Round trip of a torus (irrational coordinates) through every format.
 // STL stores triangle soups: the reader merges equal corners in order of first appearance, so
 // only the face order and each face's corner positions can be compared.
-void expect_round_trip(const std::string& name, bool binary, double tol, bool keeps_vertex_order = true) {
+void expect_round_trip(const std::string& name, bool binary, double tol,
+                       bool keeps_vertex_order = true) {
   TempDir dir;
   const TriangleMesh m = make_torus(1.0, 0.3, 24, 12);
   const auto path = dir.file(name);
   write_mesh(path, m, binary);
   // Atomic write: only the target is left in the folder.
   int files = 0;
-  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(std::filesystem::path(path).parent_path())) ++files;
+  for ([[maybe_unused]] const auto& e :
+       std::filesystem::directory_iterator(std::filesystem::path(path).parent_path()))
+    ++files;
   EXPECT_EQ(files, 1);
   const TriangleMesh r = read_mesh(path);
   ASSERT_EQ(r.num_vertices(), m.num_vertices()) << name;
@@ -551,7 +647,10 @@ void expect_round_trip(const std::string& name, bool binary, double tol, bool ke
       for (int rot = 0; rot < 3 && !match; ++rot) {
         double err = 0;
         for (int c = 0; c < 3; ++c)
-          err = std::max(err, (r.vertices.row(r.faces(f, c)) - m.vertices.row(m.faces(f, (c + rot) % 3))).cwiseAbs().maxCoeff());
+          err = std::max(err,
+                         (r.vertices.row(r.faces(f, c)) - m.vertices.row(m.faces(f, (c + rot) % 3)))
+                             .cwiseAbs()
+                             .maxCoeff());
         match = err <= tol;
       }
       ASSERT_TRUE(match) << name << " face " << f;
@@ -559,12 +658,24 @@ void expect_round_trip(const std::string& name, bool binary, double tol, bool ke
   }
 }
 
-TEST(MeshIo, RoundTripOff) { expect_round_trip("t.off", false, 1e-15); }
-TEST(MeshIo, RoundTripPlyAscii) { expect_round_trip("t.ply", false, 0.0); }  // property double
-TEST(MeshIo, RoundTripPlyBinary) { expect_round_trip("t.ply", true, 0.0); }
-TEST(MeshIo, RoundTripObj) { expect_round_trip("t.obj", false, 1e-15); }
-TEST(MeshIo, RoundTripStlAscii) { expect_round_trip("t.stl", false, 1e-6, false); }
-TEST(MeshIo, RoundTripStlBinary) { expect_round_trip("t.stl", true, 1e-6, false); }
+TEST(MeshIo, RoundTripOff) {
+  expect_round_trip("t.off", false, 1e-15);
+}
+TEST(MeshIo, RoundTripPlyAscii) {
+  expect_round_trip("t.ply", false, 0.0);
+}  // property double
+TEST(MeshIo, RoundTripPlyBinary) {
+  expect_round_trip("t.ply", true, 0.0);
+}
+TEST(MeshIo, RoundTripObj) {
+  expect_round_trip("t.obj", false, 1e-15);
+}
+TEST(MeshIo, RoundTripStlAscii) {
+  expect_round_trip("t.stl", false, 1e-6, false);
+}
+TEST(MeshIo, RoundTripStlBinary) {
+  expect_round_trip("t.stl", true, 1e-6, false);
+}
 
 // The first read-chunk boundary of an ASCII STL (mesh_io.cpp reads an 84-byte head, then 1 MiB
 // chunks), and `m` written as ASCII STL, as text (the tests assert that it reaches past it).
@@ -588,7 +699,8 @@ TEST(MeshIo, AsciiStlCountedAcrossReadChunks) {
   std::string text = ascii_stl_past_the_first_chunk(dir, m);
   ASSERT_GT(text.size(), kBoundary + 1000);
   text.insert(text.rfind("endsolid"),
-              "facet normal 0 0 1\nouter loop\nvertex 7 7 7\nvertex 7 7 7\nvertex 8 7 7\nendloop\nendfacet\n");
+              "facet normal 0 0 1\nouter loop\nvertex 7 7 7\nvertex 7 7 7\nvertex 8 7 "
+              "7\nendloop\nendfacet\n");
   const std::string expected = "only " + std::to_string(m.num_faces()) + " of the file's " +
                                std::to_string(m.num_faces() + 1) + " triangles could be added";
   // Blanks before the last `word` that fits, so that its "facet" starts at byte `facet_at`.
@@ -610,10 +722,12 @@ TEST(MeshIo, AsciiStlCountedAcrossReadChunks) {
 // The tetrahedron of kTetraOff as ASCII STL, one keyword per line: line 3 opens the first facet,
 // lines 4-6 are its corners (then 11-13, 18-20, 25-27).
 const char* kTetraStl =
-    "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+    "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 "
+    "0\nendloop\nendfacet\n"
     "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
     "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n"
-    "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1\nendloop\nendfacet\nendsolid t\n";
+    "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 "
+    "1\nendloop\nendfacet\nendsolid t\n";
 
 // text with its line `number` (from 1) replaced by `line` (which may hold several lines, or none).
 std::string with_line(const std::string& text, int number, const std::string& line) {
@@ -631,19 +745,30 @@ TEST(MeshIo, AsciiStlVertexLinesChecked) {
   const std::string tetra = kTetraStl;
   ASSERT_EQ(read_mesh(dir.write("tetra.stl", tetra)).num_faces(), 4);
   const std::pair<std::string, std::string> bad[] = {
-      {with_line(tetra, 6, "vertex 1 0 zz"), "line 6: vertex coordinate 'zz' is not a number: 'vertex 1 0 zz'"},
-      {with_line(tetra, 5, "  vertex 0 1"), "line 5: vertex line with 2 of 3 coordinates: 'vertex 0 1'"},
+      {with_line(tetra, 6, "vertex 1 0 zz"),
+       "line 6: vertex coordinate 'zz' is not a number: 'vertex 1 0 zz'"},
+      {with_line(tetra, 5, "  vertex 0 1"),
+       "line 5: vertex line with 2 of 3 coordinates: 'vertex 0 1'"},
       {with_line(tetra, 12, "vertex 1e999 0 0"), "line 12: non-finite vertex coordinate '1e999'"},
-      {with_line(tetra, 12, "vertex 1e39 0 0"), "line 12: non-finite vertex coordinate '1e39' (STL coordinates are 32-bit floats"},
+      {with_line(tetra, 12, "vertex 1e39 0 0"),
+       "line 12: non-finite vertex coordinate '1e39' (STL coordinates are 32-bit floats"},
       {with_line(tetra, 12, "vertex -inf 0 0"), "line 12: non-finite vertex coordinate '-inf'"},
       {with_line(tetra, 27, "vertex 0 0 nan"), "line 27: non-finite vertex coordinate 'nan'"},
-      {with_line(tetra, 12, "vertex 0x1p0 0 0"), "line 12: vertex coordinate '0x1p0' is not a number"},
+      {with_line(tetra, 12, "vertex 0x1p0 0 0"),
+       "line 12: vertex coordinate '0x1p0' is not a number"},
       {with_line(tetra, 12, "vertex 1 0 0 0"), "line 12: vertex line with more than 3 coordinates"},
-      {with_line(tetra, 6, "endloop"), "line 6: expected 'vertex x y z', corner 3 of the facet opened by 'outer' on line 3, found 'endloop'"},
-      {with_line(tetra, 3, "outer loop\n"), "line 4: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 3, found an empty line"},
-      {with_line(tetra, 6, "vertex 1 0 0\nvertex 1 1 0"), "line 7: a vertex line outside a facet's three corners"},
-      {with_line(tetra, 1, "solid outer_shell"), "line 2: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 1"},
-      {tetra.substr(0, tetra.find("vertex 1 0 0")), "the file ends 1 vertex line(s) short of the facet opened on line 3"},
+      {with_line(tetra, 6, "endloop"),
+       "line 6: expected 'vertex x y z', corner 3 of the facet opened by 'outer' on line 3, found "
+       "'endloop'"},
+      {with_line(tetra, 3, "outer loop\n"),
+       "line 4: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 3, found "
+       "an empty line"},
+      {with_line(tetra, 6, "vertex 1 0 0\nvertex 1 1 0"),
+       "line 7: a vertex line outside a facet's three corners"},
+      {with_line(tetra, 1, "solid outer_shell"),
+       "line 2: expected 'vertex x y z', corner 1 of the facet opened by 'outer' on line 1"},
+      {tetra.substr(0, tetra.find("vertex 1 0 0")),
+       "the file ends 1 vertex line(s) short of the facet opened on line 3"},
   };
   for (const auto& [text, message] : bad) {
     SCOPED_TRACE(message);
@@ -651,7 +776,8 @@ TEST(MeshIo, AsciiStlVertexLinesChecked) {
   }
   // What `>>` reads as the same numbers still loads: signs, exponents, tabs, an underflow to 0,
   // CR LF line ends, no newline at the end.
-  std::string good = with_line(with_line(tetra, 4, "vertex 0 0 1e-50"), 6, "\tvertex\t+1.0E+0\t0.0\t-0e-3 ");
+  std::string good =
+      with_line(with_line(tetra, 4, "vertex 0 0 1e-50"), 6, "\tvertex\t+1.0E+0\t0.0\t-0e-3 ");
   good.pop_back();
   std::string crlf;
   for (char c : good) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
@@ -675,14 +801,17 @@ TEST(MeshIo, AsciiStlVertexLinesChecked) {
 TEST(MeshIo, AsciiStlInCapitals) {
   TempDir dir;
   // kTetraStl's tetrahedron, with corners whose text is not their digits alone.
-  const std::string a = "0.5 0.25 -1", b = "2.75 0.25 -1", c = "0.5 3.125e0 -1", d = "0.1 0.25 1.5e1";
+  const std::string a = "0.5 0.25 -1", b = "2.75 0.25 -1", c = "0.5 3.125e0 -1",
+                    d = "0.1 0.25 1.5e1";
   const auto facet = [](const std::string& p, const std::string& q, const std::string& r) {
-    return "facet normal 0 0 0\nouter loop\nvertex " + p + "\nvertex " + q + "\nvertex " + r + "\nendloop\nendfacet\n";
+    return "facet normal 0 0 0\nouter loop\nvertex " + p + "\nvertex " + q + "\nvertex " + r +
+           "\nendloop\nendfacet\n";
   };
-  const std::string lower =
-      "solid t\n" + facet(a, c, b) + facet(a, b, d) + facet(a, d, c) + facet(b, c, d) + "endsolid t\n";
+  const std::string lower = "solid t\n" + facet(a, c, b) + facet(a, b, d) + facet(a, d, c) +
+                            facet(b, c, d) + "endsolid t\n";
   std::string upper = lower;
-  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char ch) { return std::toupper(ch); });
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char ch) { return std::toupper(ch); });
   ASSERT_NE(upper.find("VERTEX 0.5 3.125E0 -1\n"), std::string::npos);
   const TriangleMesh twin = read_mesh(dir.write("lower.stl", lower));
   const TriangleMesh m = read_mesh(dir.write("upper.stl", upper));
@@ -698,12 +827,16 @@ TEST(MeshIo, AsciiStlInCapitals) {
   EXPECT_TRUE(report.closed());
 
   std::string mixed = lower;
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"solid", "Solid"}, {"facet normal", "Facet Normal"},
-                                 {"outer loop", "Outer Loop"}, {"vertex", "Vertex"}}) {
-    for (auto p = mixed.find(from); p != std::string::npos; p = mixed.find(from, p + 1)) mixed.replace(p, from.size(), to);
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"solid", "Solid"},
+                                 {"facet normal", "Facet Normal"},
+                                 {"outer loop", "Outer Loop"},
+                                 {"vertex", "Vertex"}}) {
+    for (auto p = mixed.find(from); p != std::string::npos; p = mixed.find(from, p + 1))
+      mixed.replace(p, from.size(), to);
   }
-  expect_error_naming(dir.write("mixed.stl", mixed),
-                      "line 3: 'Outer Loop': OpenMesh's reader opens a facet only at 'outer' or 'OUTER'");
+  expect_error_naming(
+      dir.write("mixed.stl", mixed),
+      "line 3: 'Outer Loop': OpenMesh's reader opens a facet only at 'outer' or 'OUTER'");
 }
 
 // The lines are checked in the same 1 MiB chunks the facets are counted in, so a line, a keyword
@@ -719,12 +852,15 @@ TEST(MeshIo, AsciiStlLinesCheckedAcrossReadChunks) {
   // `line`, indented so that its byte `split` falls on the boundary.
   const std::size_t at = text.rfind("\nvertex", kBoundary - 200) + 1, end = text.find('\n', at);
   const std::string original = text.substr(at, end - at);
-  const long long number = std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1;
+  const long long number =
+      std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1;
   const auto place = [&](const std::string& line, std::size_t split, const std::string& message) {
     ASSERT_LE(at + split, kBoundary);
-    const std::string placed = text.substr(0, at) + std::string(kBoundary - split - at, ' ') + line + text.substr(end);
+    const std::string placed =
+        text.substr(0, at) + std::string(kBoundary - split - at, ' ') + line + text.substr(end);
     ASSERT_EQ(placed.compare(kBoundary - split, line.size() + 1, line + "\n"), 0);
-    SCOPED_TRACE("'" + line + "' split at " + std::to_string(split) + ", line " + std::to_string(number));
+    SCOPED_TRACE("'" + line + "' split at " + std::to_string(split) + ", line " +
+                 std::to_string(number));
     const auto path = dir.write("chunks.stl", placed);
     if (message.empty()) {
       EXPECT_EQ(read_mesh(path).num_faces(), m.num_faces());
@@ -737,9 +873,9 @@ TEST(MeshIo, AsciiStlLinesCheckedAcrossReadChunks) {
   place(original, 10, "");                   // inside its first number
   place(original, original.size(), "");      // its newline starts the chunk
   place(original, original.size() + 1, "");  // its newline ends the chunk
-  place("vertex 0 0 1e999", 13, "non-finite vertex coordinate '1e999'");   // "1e|999"
-  place("vertex 0 1 zz", 12, "vertex coordinate 'zz' is not a number");    // "z|z"
-  place("vertex 0 1", 10, "vertex line with 2 of 3 coordinates");         // its newline starts the chunk
+  place("vertex 0 0 1e999", 13, "non-finite vertex coordinate '1e999'");  // "1e|999"
+  place("vertex 0 1 zz", 12, "vertex coordinate 'zz' is not a number");   // "z|z"
+  place("vertex 0 1", 10, "vertex line with 2 of 3 coordinates");  // its newline starts the chunk
   place("vertex 0 1 0 0", 3, "vertex line with more than 3 coordinates");  // "ver|tex"
 }
 
@@ -756,7 +892,8 @@ TEST(MeshIo, BinaryStlHeaderAndLength) {
 
   expect_error_naming(dir.write("truncated.stl", bytes.substr(0, bytes.size() - 10)),
                       "binary STL announces " + std::to_string(m.num_faces()) + " triangles");
-  expect_error_naming(dir.write("short.stl", bytes.substr(0, 60)), "shorter than its 84-byte header");
+  expect_error_naming(dir.write("short.stl", bytes.substr(0, 60)),
+                      "shorter than its 84-byte header");
 
   std::string solid = bytes;
   solid.replace(0, 12, "solid binary");
@@ -781,7 +918,8 @@ TEST(MeshIo, BinaryStlTrailingBytes) {
   std::string solid = bytes;
   solid.replace(0, 16, "solid facet_mesh");  // header words an ASCII STL would start with
   for (const std::string& body : {bytes, solid}) {
-    for (const std::string& tail : {std::string("\n"), std::string(49, 'x'), std::string(4096, '\0')}) {
+    for (const std::string& tail :
+         {std::string("\n"), std::string(49, 'x'), std::string(4096, '\0')}) {
       SCOPED_TRACE(body.substr(0, 5) + " header, " + std::to_string(tail.size()) + " bytes after");
       const TriangleMesh r = read_mesh(dir.write("padded.stl", body + tail));
       ASSERT_EQ(r.num_faces(), expected.num_faces());
@@ -795,13 +933,15 @@ TEST(MeshIo, BinaryStlTrailingBytes) {
                                 std::to_string(bytes.size()) + " bytes) but the file has ";
   const std::string record = bytes.substr(84, 50);  // a triangle's, nonzero
   expect_error_naming(dir.write("extra.stl", bytes + record),
-                      announced + std::to_string(bytes.size() + 50) + " bytes: the 50 bytes after its last triangle");
+                      announced + std::to_string(bytes.size() + 50) +
+                          " bytes: the 50 bytes after its last triangle");
   expect_error_naming(dir.write("extra.stl", bytes + std::string(60, '\0') + record),
                       announced + std::to_string(bytes.size() + 110) + " bytes");
   expect_error_naming(dir.write("truncated.stl", bytes.substr(0, bytes.size() - 10)),
                       announced + std::to_string(bytes.size() - 10) + " bytes");
-  expect_error_naming(dir.write("truncated.stl", solid.substr(0, bytes.size() - 10)),
-                      announced + std::to_string(bytes.size() - 10) + " bytes (it starts with 'solid'");
+  expect_error_naming(
+      dir.write("truncated.stl", solid.substr(0, bytes.size() - 10)),
+      announced + std::to_string(bytes.size() - 10) + " bytes (it starts with 'solid'");
 }
 
 // A binary OFF: its header line, then 32-bit words, little-endian (as OpenMesh writes it on
@@ -819,7 +959,8 @@ struct BinaryOff {
 
 // The tetrahedron of kTetraOff with vertex 3 at z = 0.1f, its faces followed by Geomview's colour
 // count 0 where colour_counts, and with a normal after each point where normals.
-BinaryOff binary_off_tetra(bool colour_counts = false, bool normals = false, bool big_endian = false) {
+BinaryOff binary_off_tetra(bool colour_counts = false, bool normals = false,
+                           bool big_endian = false) {
   BinaryOff off(normals ? "NOFF BINARY" : "OFF BINARY");
   off.big_endian = big_endian;
   off.word(4).word(4).word(0);
@@ -841,7 +982,8 @@ TEST(MeshIo, BinaryOffInOpenMeshsLayout) {
   TempDir dir;
   for (bool normals : {false, true}) {
     SCOPED_TRACE(normals ? "NOFF" : "OFF");
-    const auto path = dir.write(normals ? "tetra_n.off" : "tetra.off", binary_off_tetra(false, normals).bytes);
+    const auto path =
+        dir.write(normals ? "tetra_n.off" : "tetra.off", binary_off_tetra(false, normals).bytes);
     const TriangleMesh m = read_mesh(path);
     ASSERT_EQ(m.num_vertices(), 4);
     ASSERT_EQ(m.num_faces(), 4);
@@ -855,12 +997,14 @@ TEST(MeshIo, BinaryOffInOpenMeshsLayout) {
   // A pyramid with a quad base: 6 triangles, as the ASCII file gives them.
   BinaryOff pyramid;
   pyramid.word(5).word(5).word(0);
-  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 0.f, 0.f, 1.f, 0.f, 0.5f, 0.5f, 1.f}) pyramid.real(x);
+  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 0.f, 0.f, 1.f, 0.f, 0.5f, 0.5f, 1.f})
+    pyramid.real(x);
   pyramid.word(4).word(0).word(3).word(2).word(1);
   for (std::uint32_t a = 0; a < 4; ++a) pyramid.word(3).word(a).word((a + 1) % 4).word(4);
   const TriangleMesh b = read_mesh(dir.write("pyramid.off", pyramid.bytes));
-  const TriangleMesh a = read_mesh(dir.write("pyramid_ascii.off", "OFF\n5 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n"
-                                                                 "4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n"));
+  const TriangleMesh a = read_mesh(dir.write("pyramid_ascii.off",
+                                             "OFF\n5 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n"
+                                             "4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n"));
   EXPECT_EQ(b.faces, a.faces);
   EXPECT_EQ(b.vertices, a.vertices);
   EXPECT_EQ(b.num_faces(), 6);
@@ -871,8 +1015,9 @@ TEST(MeshIo, BinaryOffInOpenMeshsLayout) {
 // tetrahedron loaded as 2 faces with a boundary). Every such mismatch is an error naming the file.
 TEST(MeshIo, BinaryOffLosesNoFace) {
   TempDir dir;
-  expect_error_naming(dir.write("colours.off", binary_off_tetra(true).bytes),
-                      "face 1 (byte 87) has 0 corners (a Geomview colour count after face 0's indices?");
+  expect_error_naming(
+      dir.write("colours.off", binary_off_tetra(true).bytes),
+      "face 1 (byte 87) has 0 corners (a Geomview colour count after face 0's indices?");
   expect_error_naming(dir.write("big.off", binary_off_tetra(false, false, true).bytes),
                       "read big-endian (Geomview's byte order) the counts would be 4 and 4");
   expect_error_naming(dir.write("trailing.off", binary_off_tetra().word(0).bytes),
@@ -880,19 +1025,26 @@ TEST(MeshIo, BinaryOffLosesNoFace) {
   std::string bytes = binary_off_tetra().bytes;
   // Counts are checked against the length before anything is read (layout: 11 header bytes, 12
   // of counts, 12 per vertex from byte 23, 16 per triangle from byte 71).
-  expect_error_naming(dir.write("truncated.off", bytes.substr(0, bytes.size() - 2)),
-                      "announces 4 vertices and 4 faces, at least 124 bytes, but has 122 after its header line");
+  expect_error_naming(
+      dir.write("truncated.off", bytes.substr(0, bytes.size() - 2)),
+      "announces 4 vertices and 4 faces, at least 124 bytes, but has 122 after its header line");
   std::string seven = bytes;
   seven[119] = 7;
-  expect_error_naming(dir.write("seven.off", seven), "face 3 (byte 119) announces 7 corners, more than the rest of the file holds");
+  expect_error_naming(
+      dir.write("seven.off", seven),
+      "face 3 (byte 119) announces 7 corners, more than the rest of the file holds");
   BinaryOff range = binary_off_tetra();
   range.bytes.resize(range.bytes.size() - 4);
-  expect_error_naming(dir.write("range.off", range.word(9).bytes), "face 3 (byte 119) references vertex 9 but the mesh has 4");
+  expect_error_naming(dir.write("range.off", range.word(9).bytes),
+                      "face 3 (byte 119) references vertex 9 but the mesh has 4");
   BinaryOff nan = binary_off_tetra();
-  nan.bytes.replace(23 + 12 + 4, 4, BinaryOff("").real(std::numeric_limits<float>::quiet_NaN()).bytes.substr(1));
-  expect_error_naming(dir.write("nan.off", nan.bytes), "vertex 1 has a non-finite coordinate (byte 35)");
+  nan.bytes.replace(23 + 12 + 4, 4,
+                    BinaryOff("").real(std::numeric_limits<float>::quiet_NaN()).bytes.substr(1));
+  expect_error_naming(dir.write("nan.off", nan.bytes),
+                      "vertex 1 has a non-finite coordinate (byte 35)");
   // OpenMesh takes the first line for the header, and reads no 4D or nOFF binary file.
-  expect_error_naming(dir.write("comment.off", "# made by hand\n" + bytes), "header must be the first line");
+  expect_error_naming(dir.write("comment.off", "# made by hand\n" + bytes),
+                      "header must be the first line");
   expect_error_naming(dir.write("4d.off", "4" + bytes), "other than 3 coordinates per vertex");
 }
 

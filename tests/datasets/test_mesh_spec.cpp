@@ -1,6 +1,6 @@
+#include "datasets/generators.h"
 #include "datasets/mesh_io.h"
 #include "datasets/mesh_spec.h"
-#include "datasets/generators.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -54,13 +54,15 @@ TEST(MeshSpec, Errors) {
 TEST(MeshSpec, SizesBeyondTheLimitsAreRefusedBeforeBuilding) {
   expect_spec_error("spiral:turns=1073741825,segments_per_turn=4,profile_segments=1",
                     "key 'turns' is out of range (at most 1000000000), got 1073741825");
-  expect_spec_error("icosphere:level=4294967299", "key 'level' is out of range (at most 12), got 4294967299");
+  expect_spec_error("icosphere:level=4294967299",
+                    "key 'level' is out of range (at most 12), got 4294967299");
   expect_spec_error("sphere:vertices=9223372036854775807", "key 'vertices' is out of range");
   expect_spec_error("sphere:vertices=-9223372036854775807", "key 'vertices' is out of range");
   expect_spec_error("sphere:vertices=99999999999", "key 'vertices' is out of range");
   expect_spec_error("sphere:vertices=300000000", "about 600000000 faces, more than the 200000000");
   expect_spec_error("torus:n_major=100000,n_minor=100000", "about 20000000000 faces");
-  expect_spec_error("spiral:turns=100000,segments_per_turn=1000,profile_segments=8", "faces, more than the");
+  expect_spec_error("spiral:turns=100000,segments_per_turn=1000,profile_segments=8",
+                    "faces, more than the");
   expect_spec_error("rounded_cylinder:radius=1e-9", "faces, more than the");
   expect_spec_error("icosphere:level=12", "about 335544320 faces");
   // Below the limit, and the generators' own lower bounds still name themselves.
@@ -125,7 +127,8 @@ TEST(MeshSpec, FilesAreScaledIntoTheUnitCube) {
   EXPECT_EQ(s.kind, "file");
   EXPECT_FALSE(s.analytic);
   EXPECT_EQ(s.mesh.num_faces(), 4 * 576);
-  const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff(), hi = s.mesh.vertices.colwise().maxCoeff();
+  const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff(),
+                           hi = s.mesh.vertices.colwise().maxCoeff();
   EXPECT_NEAR(lo(0), 0.0, 1e-6);
   EXPECT_NEAR(hi(0), 1.0, 1e-6);
   EXPECT_NEAR(lo(2) + hi(2), 1.0, 1e-6);  // short axis centred
@@ -151,7 +154,8 @@ TEST(MeshSpec, FittedMeshesLieInTheClosedUnitCube) {
     m.faces.resize(2, 3);
     m.faces << 0, 1, 2, 0, 2, 3;  // every vertex used: the fit sizes the surface
     // What the fit computes before it clamps (kept here to show the test sees the rounding).
-    const Eigen::RowVector3d lo = m.vertices.colwise().minCoeff(), hi = m.vertices.colwise().maxCoeff();
+    const Eigen::RowVector3d lo = m.vertices.colwise().minCoeff(),
+                             hi = m.vertices.colwise().maxCoeff();
     const double s = 1.0 / (hi - lo).maxCoeff();
     const Eigen::RowVector3d offset = 0.5 * (Eigen::RowVector3d::Ones() - s * (hi - lo));
     const Positions raw = ((m.vertices.rowwise() - lo) * s).rowwise() + offset;
@@ -182,9 +186,12 @@ TEST(MeshSpec, UnusedVerticesDoNotSizeTheModel) {
   EXPECT_EQ(b.mesh.vertices.topRows(n), a.mesh.vertices);
   EXPECT_NEAR(b.report.area, a.report.area, 1e-12 * a.report.area);
   // The stray vertex keeps its place relative to the surface: the fit's scale and translation.
-  const double scale = 1.0 / (plain.vertices.colwise().maxCoeff() - plain.vertices.colwise().minCoeff()).maxCoeff();
-  const Eigen::RowVector3d expected = a.mesh.vertices.row(0) + scale * (stray.vertices.row(n) - plain.vertices.row(0));
-  EXPECT_LT((b.mesh.vertices.row(n) - expected).norm(), 1e-12 * expected.norm()) << b.mesh.vertices.row(n);
+  const double scale =
+      1.0 / (plain.vertices.colwise().maxCoeff() - plain.vertices.colwise().minCoeff()).maxCoeff();
+  const Eigen::RowVector3d expected =
+      a.mesh.vertices.row(0) + scale * (stray.vertices.row(n) - plain.vertices.row(0));
+  EXPECT_LT((b.mesh.vertices.row(n) - expected).norm(), 1e-12 * expected.norm())
+      << b.mesh.vertices.row(n);
 }
 
 }  // namespace

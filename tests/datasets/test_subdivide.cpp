@@ -14,7 +14,8 @@ TEST(Subdivide, CountsAndAreaOfAFlatMesh) {
   EXPECT_EQ(s.num_faces(), 4 * m.num_faces());
   const MeshReport a = validate_mesh(m, "m"), b = validate_mesh(s, "s");
   // V' = V + E; E from Euler: E = V + F - χ.
-  EXPECT_EQ(s.num_vertices(), m.num_vertices() + (m.num_vertices() + m.num_faces() - a.euler_characteristic));
+  EXPECT_EQ(s.num_vertices(),
+            m.num_vertices() + (m.num_vertices() + m.num_faces() - a.euler_characteristic));
   EXPECT_NEAR(b.area, a.area, 1e-10 * a.area);
   EXPECT_EQ(b.boundary_loops, a.boundary_loops);
   EXPECT_EQ(b.genus, a.genus);

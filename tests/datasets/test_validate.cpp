@@ -85,7 +85,7 @@ TEST(Validate, UnreferencedAndComponents) {
   TriangleMesh m;
   m.vertices.resize(9, 3);
   m.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1,  //
-      5, 0, 0, 6, 0, 0, 5, 1, 0, 5, 0, 1,           //
+      5, 0, 0, 6, 0, 0, 5, 1, 0, 5, 0, 1,            //
       9, 9, 9;
   m.faces.resize(8, 3);
   m.faces << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3,  //

@@ -19,6 +19,8 @@ inline double last(const FlowOutcome& o, const char* group, const char* key) {
 }
 
 /// Mean distance of the vertices to the origin.
-inline double mean_radius(const Positions& V) { return V.rowwise().norm().mean(); }
+inline double mean_radius(const Positions& V) {
+  return V.rowwise().norm().mean();
+}
 
 }  // namespace mcf::testing

@@ -1,7 +1,7 @@
+#include "datasets/mesh_spec.h"
 #include "flows/config_reader.h"
 #include "flows/flow.h"
 #include "flows/flow_config.h"
-#include "datasets/mesh_spec.h"
 #include "solvers/blas_threads.h"
 
 #include <gtest/gtest.h>
@@ -27,46 +27,61 @@ TEST(FlowConfig, DefaultsFilledAndRoundTrip) {
   const FlowConfig again = flow_config_from_json(to_json(c), "again");
   EXPECT_EQ(to_json(again), to_json(c));
   const FlowConfig mg = flow_config_from_json(
-      json{{"mesh", "x.off"}, {"basis", "octree"}, {"solver", {{"name", "multigrid"}}}}, "cfg.json");
+      json{{"mesh", "x.off"}, {"basis", "octree"}, {"solver", {{"name", "multigrid"}}}},
+      "cfg.json");
   EXPECT_EQ(mg.solver.tolerance, 0.0);
 }
 
 TEST(FlowConfig, ErrorsNameFileAndKey) {
   EXPECT_NE(error_of(json::object()).find("cfg.json: mesh: missing"), std::string::npos);
-  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"cycels", 2}}}}).find("cfg.json: solver.cycels: unknown key"),
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"cycels", 2}}}})
+                .find("cfg.json: solver.cycels: unknown key"),
             std::string::npos);
-  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"cycles", "two"}}}}).find("solver.cycles: expected an integer"),
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"cycles", "two"}}}})
+                .find("solver.cycles: expected an integer"),
             std::string::npos);
-  EXPECT_NE(error_of(json{{"mesh", "a"}, {"octree", {{"depth", 42}}}}).find("octree.depth: value 42 out of range"),
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"octree", {{"depth", 42}}}})
+                .find("octree.depth: value 42 out of range"),
             std::string::npos);
-  EXPECT_NE(error_of(json{{"mesh", "a"}, {"octree", {{"cubature", 4}}}}).find("octree.cubature"), std::string::npos);
-  EXPECT_NE(error_of(json{{"mesh", "a"}, {"flow", "wilmore"}}).find("flow: unknown value"), std::string::npos);
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"octree", {{"cubature", 4}}}}).find("octree.cubature"),
+            std::string::npos);
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"flow", "wilmore"}}).find("flow: unknown value"),
+            std::string::npos);
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"dt", -1.0}}).find("dt"), std::string::npos);
-  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"name", "multigrid"}}}}).find("hierarchy"), std::string::npos);
-  EXPECT_NE(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"octree", {{"tracking", "rebuilt"}}}, {"flow", "cmcf"}})
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"name", "multigrid"}}}}).find("hierarchy"),
+            std::string::npos);
+  EXPECT_NE(error_of(json{{"mesh", "a"},
+                          {"basis", "octree"},
+                          {"octree", {{"tracking", "rebuilt"}}},
+                          {"flow", "cmcf"}})
                 .find("flow"),
             std::string::npos);
   // A lumped mass the octree basis would ignore while the result recorded it.
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"mass", "lumped"}})
                 .find("cfg.json: mass: \"lumped\" applies to the hat basis only"),
             std::string::npos);
-  EXPECT_NO_THROW(flow_config_from_json(json{{"mesh", "a"}, {"basis", "hat"}, {"mass", "lumped"}}, "cfg.json"));
+  EXPECT_NO_THROW(
+      flow_config_from_json(json{{"mesh", "a"}, {"basis", "hat"}, {"mass", "lumped"}}, "cfg.json"));
 }
 
 // Unit-area normalisation rescales the whole surface every step, an open surface's boundary is
 // held fixed: refused before the flow starts, naming the key, for any open mesh.
 TEST(FlowConfig, NormalizeAreaIsRefusedOnAnOpenSurface) {
-  FlowConfig c = flow_config_from_json(json{{"mesh", "open_cylinder"}, {"normalize_area", true}, {"steps", 1}}, "cfg.json");
+  FlowConfig c = flow_config_from_json(
+      json{{"mesh", "open_cylinder"}, {"normalize_area", true}, {"steps", 1}}, "cfg.json");
   const MeshSource open = load_mesh_spec("open_cylinder:n_around=16,n_along=8");
   ASSERT_EQ(open.report.boundary_loops, 2);
   try {
     run_flow(c, open);
     ADD_FAILURE() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("normalize_area: the mesh has 2 boundary loop(s)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("normalize_area: the mesh has 2 boundary loop(s)"),
+              std::string::npos)
+        << e.what();
   }
   c.mesh = "icosphere:level=2";
-  EXPECT_EQ(run_flow(c, load_mesh_spec(c.mesh)).result["status"], "ok");  // closed: normalised as before
+  EXPECT_EQ(run_flow(c, load_mesh_spec(c.mesh)).result["status"],
+            "ok");  // closed: normalised as before
   c.normalize_area = false;
   EXPECT_EQ(run_flow(c, open).result["status"], "ok");
 }
@@ -74,14 +89,16 @@ TEST(FlowConfig, NormalizeAreaIsRefusedOnAnOpenSurface) {
 // The dense reference's size limit is a configuration error before the first step, not a flow
 // that "turned singular" at step 1 (its old result.json said so, with exit status 0).
 TEST(FlowConfig, DenseSolverOnALargeSystemIsAConfigError) {
-  FlowConfig c = flow_config_from_json(json{{"mesh", "icosphere:level=5"}, {"solver", {{"name", "dense"}}}, {"steps", 1}},
-                                       "cfg.json");
+  FlowConfig c = flow_config_from_json(
+      json{{"mesh", "icosphere:level=5"}, {"solver", {{"name", "dense"}}}, {"steps", 1}},
+      "cfg.json");
   try {
     run_flow(c, load_mesh_spec(c.mesh));
     ADD_FAILURE() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("icosphere:level=5: solver: \"dense\" factorizes at most 5000 functions "
-                                         "and this basis has 10242 free ones"),
+    EXPECT_NE(std::string(e.what()).find(
+                  "icosphere:level=5: solver: \"dense\" factorizes at most 5000 functions "
+                  "and this basis has 10242 free ones"),
               std::string::npos)
         << e.what();
   }
@@ -95,7 +112,8 @@ TEST(FlowConfig, ThreadsCapTheBlasUnderCholmodForTheFlow) {
   const ScopedBlasThreads two(2);  // so that a cap of 1 is told apart from OpenBLAS's own count
   if (blas_threads() < 2) GTEST_SKIP() << "OpenBLAS runs one thread on this machine";
   const int before = blas_threads();
-  FlowConfig c = flow_config_from_json(json{{"mesh", "icosphere:level=2"}, {"steps", 2}, {"threads", 1}}, "cfg.json");
+  FlowConfig c = flow_config_from_json(
+      json{{"mesh", "icosphere:level=2"}, {"steps", 2}, {"threads", 1}}, "cfg.json");
   std::vector<int> seen;
   FlowObserver observer;
   observer.on_step = [&](int, double, const Positions&) { seen.push_back(blas_threads()); };

@@ -22,7 +22,8 @@ class ScalarContext final : public StepContext {
   void evaluate_operators(const Coefficients& X) override { m_ = 1.0 + mu_ * X.squaredNorm(); }
   Coefficients apply_mass(const Coefficients& X) const override { return m_ * X; }
   Coefficients apply_stiffness(const Coefficients& X) const override { return lambda_ * X; }
-  Coefficients solve(double a, double b, const Coefficients& R, const Coefficients&, const Coefficients&) override {
+  Coefficients solve(double a, double b, const Coefficients& R, const Coefficients&,
+                     const Coefficients&) override {
     return R / (a * m_ + b * lambda_);
   }
   void advance(const Coefficients& next) {
@@ -38,7 +39,8 @@ class ScalarContext final : public StepContext {
   bool has_prev_ = false;
 };
 
-double final_value(const std::string& name, double dt, double T, double mu = 0.0, bool extrapolate = true) {
+double final_value(const std::string& name, double dt, double T, double mu = 0.0,
+                   bool extrapolate = true) {
   auto integrator = make_integrator(name, extrapolate);
   ScalarContext ctx(1.0, dt, mu);
   const int steps = int(std::lround(T / dt));
@@ -46,7 +48,8 @@ double final_value(const std::string& name, double dt, double T, double mu = 0.0
   return ctx.x_(0, 0);
 }
 
-double observed_order(const std::string& name, double mu = 0.0, bool extrapolate = true, double reference = -1) {
+double observed_order(const std::string& name, double mu = 0.0, bool extrapolate = true,
+                      double reference = -1) {
   const double T = 1.0;
   const double exact = reference >= 0 ? reference : std::exp(-T);
   const double e1 = std::abs(final_value(name, 0.02, T, mu, extrapolate) - exact);
@@ -80,7 +83,9 @@ TEST(Integrators, ExplicitEulerIsUnstableBeyondItsLimit) {
   EXPECT_LT(std::abs(final_value("semi-implicit", 2.5, 100.0)), 1.0);
 }
 
-TEST(Integrators, UnknownNameThrows) { EXPECT_THROW(make_integrator("rk4", true), std::invalid_argument); }
+TEST(Integrators, UnknownNameThrows) {
+  EXPECT_THROW(make_integrator("rk4", true), std::invalid_argument);
+}
 
 }  // namespace
 }  // namespace mcf

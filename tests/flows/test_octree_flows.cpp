@@ -23,14 +23,20 @@ using testing::last;
 using testing::run;
 
 json octree(const std::string& mesh, const std::string& tracking, int depth, const json& solver) {
-  return json{{"mesh", mesh}, {"basis", "octree"}, {"octree", {{"tracking", tracking}, {"depth", depth}}}, {"solver", solver}};
+  return json{{"mesh", mesh},
+              {"basis", "octree"},
+              {"octree", {{"tracking", tracking}, {"depth", depth}}},
+              {"solver", solver}};
 }
 
 TEST(OctreeFlows, MultigridConvergesToCholmod) {
   // Multigrid-preconditioned CG to 1e-12 reproduces the direct solution of the same system.
   for (const char* tracking : {"rebuilt", "tracked"}) {
     json mg = octree("icosphere:level=4", tracking, 6,
-                     {{"name", "pcg"}, {"preconditioner", "multigrid"}, {"tolerance", 1e-12}, {"max_iterations", 500}});
+                     {{"name", "pcg"},
+                      {"preconditioner", "multigrid"},
+                      {"tolerance", 1e-12},
+                      {"max_iterations", 500}});
     json ch = octree("icosphere:level=4", tracking, 6, {{"name", "cholmod"}});
     mg["steps"] = ch["steps"] = 3;
     const Positions a = run(mg).final_mesh.vertices, b = run(ch).final_mesh.vertices;
@@ -45,8 +51,9 @@ TEST(OctreeFlows, PlainCyclesConvergeToCholmod) {
   ch["steps"] = 1;
   const Positions b = run(ch).final_mesh.vertices;
   for (const char* cycle : {"V", "W"}) {
-    json mg = octree("icosphere:level=4", "tracked", 5,
-                     {{"name", "multigrid"}, {"cycle", cycle}, {"cycles", 800}, {"tolerance", 1e-11}});
+    json mg =
+        octree("icosphere:level=4", "tracked", 5,
+               {{"name", "multigrid"}, {"cycle", cycle}, {"cycles", 800}, {"tolerance", 1e-11}});
     mg["steps"] = 1;
     const auto o = run(mg);
     const auto& r = o.result["steps"][0]["solver"]["residuals"];
@@ -122,7 +129,8 @@ TEST(OctreeFlows, TrackedFollowsTheSemiImplicitRadius) {
   // close to r³/(r²+2δ) and is no worse than the rebuilt basis at the same depth — with an exact
   // solve and with three W-cycles per step. (With a single W-cycle the solver's error per step
   // dominates both; the sphere_error study shows it.)
-  for (const json& solver : {json{{"name", "cholmod"}}, json{{"name", "multigrid"}, {"cycles", 3}}}) {
+  for (const json& solver :
+       {json{{"name", "cholmod"}}, json{{"name", "multigrid"}, {"cycles", 3}}}) {
     json tracked = octree("icosphere:level=4", "tracked", 5, solver);
     json rebuilt = octree("icosphere:level=4", "rebuilt", 5, solver);
     tracked["steps"] = rebuilt["steps"] = 100;
@@ -130,7 +138,8 @@ TEST(OctreeFlows, TrackedFollowsTheSemiImplicitRadius) {
     ASSERT_EQ(t.result["status"], "ok");
     ASSERT_EQ(r.result["status"], "ok");
     const double et = last(t, "radial_error", "rms"), er = last(r, "radial_error", "rms");
-    EXPECT_LT(et, 1.5e-3) << solver.dump();  // the level-4 mesh alone is ~7e-4 off the sphere (sagitta)
+    EXPECT_LT(et, 1.5e-3)
+        << solver.dump();  // the level-4 mesh alone is ~7e-4 off the sphere (sagitta)
     // Not merely no worse: an order of magnitude better (measured 8.6e-4 vs 4.6e-2 with CHOLMOD,
     // 6.7e-4 vs 1.6e-2 with three W-cycles; the README's "2.2e-4 vs 1.2e-2" is level 5, depth 6).
     // The rebuilt basis re-integrates the flat-faced mesh every step and drifts inward.
@@ -139,7 +148,8 @@ TEST(OctreeFlows, TrackedFollowsTheSemiImplicitRadius) {
     double radius = 1;
     for (int n = 0; n < 100; ++n) radius = radius * radius * radius / (radius * radius + 2e-3);
     EXPECT_NEAR(radius, 0.7755782260, 1e-9);  // sqrt(1 - 4t) = 0.7746 at t = 0.1
-    EXPECT_NEAR(t.result["steps"].back()["radial_error"]["radius_semi_implicit"].get<double>(), radius, 1e-12);
+    EXPECT_NEAR(t.result["steps"].back()["radial_error"]["radius_semi_implicit"].get<double>(),
+                radius, 1e-12);
   }
 }
 
@@ -150,14 +160,16 @@ double mean_depth_of_faces(const TriangleMesh& mesh) {
   constexpr int n = 16;
   double weighted = 0, area = 0;
   for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
-    const Eigen::RowVector3d a = mesh.vertices.row(mesh.faces(f, 0)), b = mesh.vertices.row(mesh.faces(f, 1)),
+    const Eigen::RowVector3d a = mesh.vertices.row(mesh.faces(f, 0)),
+                             b = mesh.vertices.row(mesh.faces(f, 1)),
                              c = mesh.vertices.row(mesh.faces(f, 2));
     const double face_area = 0.5 * (b - a).cross(c - a).norm();
     double sum = 0;
     int count = 0;
     for (int i = 0; i < n; ++i)
       for (int j = 0; i + j < n; ++j)
-        for (int flip = 0; flip < (i + j + 1 < n ? 2 : 1); ++flip) {  // upright and inverted sub-triangles
+        for (int flip = 0; flip < (i + j + 1 < n ? 2 : 1);
+             ++flip) {  // upright and inverted sub-triangles
           const double u = (i + (flip ? 2.0 : 1.0) / 3) / n, v = (j + (flip ? 2.0 : 1.0) / 3) / n;
           sum += 1 - (a + u * (b - a) + v * (c - a)).norm();
           ++count;
@@ -191,7 +203,8 @@ TEST(OctreeFlows, EachRebuildDropsTheVerticesTowardTheFlatFaces) {
     EXPECT_EQ(o.result["status"], "ok");
     std::vector<double> d;
     for (const auto& s : o.result["steps"])
-      d.push_back(s["radial_error"]["radius_semi_implicit"].get<double>() - s["radial_error"]["mean_radius"].get<double>());
+      d.push_back(s["radial_error"]["radius_semi_implicit"].get<double>() -
+                  s["radial_error"]["mean_radius"].get<double>());
     return d;
   };
   const json exact = {{"name", "cholmod"}}, one_cycle = {{"name", "multigrid"}, {"cycles", 1}};
@@ -222,7 +235,8 @@ TEST(OctreeFlows, TrackedAndRebuiltAgreeOnARealModel) {
   tracked["dt"] = rebuilt["dt"] = 1e-5;
   const auto t = run(tracked), r = run(rebuilt);
   const Positions moved = t.final_mesh.vertices - load_mesh_spec("cgal:bunny00").mesh.vertices;
-  const double difference = (t.final_mesh.vertices - r.final_mesh.vertices).rowwise().norm().maxCoeff();
+  const double difference =
+      (t.final_mesh.vertices - r.final_mesh.vertices).rowwise().norm().maxCoeff();
   EXPECT_LT(difference, 0.1 / 64);
   EXPECT_LT(difference, 0.5 * moved.rowwise().norm().maxCoeff());
 }
@@ -248,7 +262,8 @@ TEST(OctreeFlows, TrackedFlowThroughAPinchFinishes) {
   EXPECT_EQ(o.result["status"], "ok") << o.result["stop"].dump();
   // It really went through the pinch: the surface collapsed to under 1% of its area, where the
   // cotangent flow with the same step already failed (CHOLMOD: not positive definite).
-  EXPECT_LT(o.result["steps"].back()["area"].get<double>(), 0.01 * o.result["mesh"]["area"].get<double>());
+  EXPECT_LT(o.result["steps"].back()["area"].get<double>(),
+            0.01 * o.result["mesh"]["area"].get<double>());
   const auto hat = run(json{{"mesh", "dumbbell:resolution=32"}, {"dt", 0.05}, {"steps", 20}});
   EXPECT_EQ(hat.result["status"], "singular");
 }
@@ -262,7 +277,9 @@ TEST(OctreeFlows, EveryRebuiltStepRecordsItsRebuild) {
   ASSERT_EQ(o.result["status"], "ok");
   // Not a timing goal: a step that only re-used the set-up's system took microseconds, a
   // rebuild takes milliseconds, so a tenth of the later steps' rebuilds tells them apart.
-  const auto update = [&](int i) { return o.result["steps"][i]["seconds"]["update"].get<double>(); };
+  const auto update = [&](int i) {
+    return o.result["steps"][i]["seconds"]["update"].get<double>();
+  };
   EXPECT_GT(update(0), 0.1 * std::min(update(1), update(2)));
   EXPECT_TRUE(o.result["steps"][0].contains("setup_seconds"));
 }
@@ -288,9 +305,12 @@ TEST(OctreeFlows, ResultRecordsTheGridCube) {
     const double side = 1.01 * (hi - lo).maxCoeff() / (1.0 - 1.0 / 16.0);  // 1% margin and one cell
     EXPECT_DOUBLE_EQ(sphere.result["system"]["cube"]["side"].get<double>(), side);
     for (int c = 0; c < 3; ++c)
-      EXPECT_DOUBLE_EQ(sphere.result["system"]["cube"]["origin"][c].get<double>(), 0.5 * (lo(c) + hi(c)) - 0.5 * side);
+      EXPECT_DOUBLE_EQ(sphere.result["system"]["cube"]["origin"][c].get<double>(),
+                       0.5 * (lo(c) + hi(c)) - 0.5 * side);
   }
-  EXPECT_FALSE(run(json{{"mesh", "icosphere:level=2"}, {"steps", 1}}).result["system"].contains("cube"));  // hat
+  EXPECT_FALSE(run(json{{"mesh", "icosphere:level=2"}, {"steps", 1}})
+                   .result["system"]
+                   .contains("cube"));  // hat
 }
 
 TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
@@ -309,9 +329,13 @@ TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
   const auto cholmod = with({{"name", "cholmod"}});
   EXPECT_EQ(cholmod.result["status"], "singular");
   const auto mg = with({{"name", "multigrid"}, {"cycles", 200}, {"tolerance", 1e-12}});
-  const auto cg = with({{"name", "pcg"}, {"preconditioner", "jacobi"}, {"tolerance", 1e-13}, {"max_iterations", 20000}});
+  const auto cg = with({{"name", "pcg"},
+                        {"preconditioner", "jacobi"},
+                        {"tolerance", 1e-13},
+                        {"max_iterations", 20000}});
   const auto one = with({{"name", "multigrid"}});
-  for (const auto* o : {&mg, &cg, &one}) ASSERT_EQ(o->result["status"], "ok") << o->result["stop"].dump();
+  for (const auto* o : {&mg, &cg, &one})
+    ASSERT_EQ(o->result["status"], "ok") << o->result["stop"].dump();
   const Positions& a = mg.final_mesh.vertices;
   const Positions& b = cg.final_mesh.vertices;
   EXPECT_LT((a - b).norm() / b.norm(), 1e-9);
@@ -320,7 +344,8 @@ TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
   // used to replace it); CG with Jacobi has no hierarchy and nothing to note.
   for (const auto* o : {&mg, &one})
     for (const json& step : o->result["steps"])
-      EXPECT_NE(step["solver"].value("message", "").find("coarsest level semi-definite"), std::string::npos)
+      EXPECT_NE(step["solver"].value("message", "").find("coarsest level semi-definite"),
+                std::string::npos)
           << step["solver"].dump();
   for (const json& step : cg.result["steps"]) EXPECT_FALSE(step["solver"].contains("message"));
 }
@@ -334,7 +359,7 @@ TEST(OctreeFlows, UnusedVerticesKeepTheirPositions) {
   MeshSource extra = plain;
   const Eigen::Index n = plain.mesh.num_vertices();
   extra.mesh.vertices.conservativeResize(n + 2, 3);
-  extra.mesh.vertices.row(n) = Eigen::RowVector3d(0, 0, 0);          // inside, in no active cell
+  extra.mesh.vertices.row(n) = Eigen::RowVector3d(0, 0, 0);             // inside, in no active cell
   extra.mesh.vertices.row(n + 1) = 0.999 * plain.mesh.vertices.row(0);  // beside the surface
   extra.report.unreferenced_vertices = 2;
   for (const char* tracking : {"tracked", "rebuilt"}) {
@@ -372,7 +397,8 @@ TEST(OctreeFlows, RefinedInputFlowsItsMidpointsUnderNormalisation) {
 }
 
 TEST(OctreeFlows, OpenSurfaceKeepsItsBoundary) {
-  json j = octree("open_cylinder:n_around=32,n_along=16", "tracked", 6, {{"name", "multigrid"}, {"cycles", 3}});
+  json j = octree("open_cylinder:n_around=32,n_along=16", "tracked", 6,
+                  {{"name", "multigrid"}, {"cycles", 3}});
   j["dt"] = 1e-2;
   j["steps"] = 5;
   const auto o = run(j);
@@ -423,7 +449,8 @@ TEST(OctreeFlows, CmcfAndHeatRunOnTheTrackedBasis) {
     // Measured at depth 6: all three rings ~8e-4 inside their recursions (the same at depth 7).
     EXPECT_NEAR(got[flow], r, 1.5e-3) << flow;
   }
-  // The flows really differ here (by ~5e-3 at t = 0.1), so a flow ignored on the tracked basis fails.
+  // The flows really differ here (by ~5e-3 at t = 0.1), so a flow ignored on the tracked basis
+  // fails.
   EXPECT_GT(got["cmcf"] - got["mcf"], 3e-3);
   EXPECT_GT(got["heat"] - got["cmcf"], 3e-3);
 }

@@ -24,8 +24,7 @@ struct SphereSystem {
   RebuiltOctreeBasis basis;
   SparseMatrix A;
   Eigen::MatrixXd B;
-  explicit SphereSystem(int depth)
-      : basis(make_icosphere(5, 1.0), OctreeOptions{.depth = depth}) {
+  explicit SphereSystem(int depth) : basis(make_icosphere(5, 1.0), OctreeOptions{.depth = depth}) {
     A = basis.mass() + 1e-3 * basis.stiffness();
     A.makeCompressed();
     B = basis.mass() * basis.initial_coefficients();
@@ -33,7 +32,8 @@ struct SphereSystem {
   HierarchyView view() const { return {basis.prolongations(), basis.colours()}; }
 };
 
-std::vector<double> w_cycles(const SparseMatrix& A, const Eigen::MatrixXd& B, HierarchyView v, int n) {
+std::vector<double> w_cycles(const SparseMatrix& A, const Eigen::MatrixXd& B, HierarchyView v,
+                             int n) {
   MultigridOptions o;
   o.cycles = n;
   MultigridSolver mg(o);

@@ -63,7 +63,8 @@ TEST(ReducedSystem, HandsTheSumToTheSolverBitwiseAsItsOwnSum) {
     ReducedSystem system(basis, handed);
     const Coefficients y = system.solve(1.0, b, R, x, x);
     ASSERT_TRUE(system.report().ok()) << system.report().message;
-    ASSERT_EQ(system.num_fixed(), 0u) << "a closed sphere holds no function: the sum is handed over";
+    ASSERT_EQ(system.num_fixed(), 0u)
+        << "a closed sphere holds no function: the sum is handed over";
 
     SparseMatrix S = basis.mass();
     sum_on_pattern(1.0, basis.mass(), b, basis.stiffness(), S);
@@ -75,8 +76,10 @@ TEST(ReducedSystem, HandsTheSumToTheSolverBitwiseAsItsOwnSum) {
     // its residual, amplified by M's conditioning (measured 3.8e-8 relative). With b = 1e-3 the
     // coefficients move by O(‖x‖) (0.69 ‖x‖ for a direct solve, measured: at this coarse depth the
     // functions that barely touch the surface are smoothed hard, while the vertices move ~2δ).
-    if (b != 0) EXPECT_GT((y - x).norm(), 0.1 * x.norm());
-    else EXPECT_LT((y - x).norm(), 1e-6 * x.norm());
+    if (b != 0)
+      EXPECT_GT((y - x).norm(), 0.1 * x.norm());
+    else
+      EXPECT_LT((y - x).norm(), 1e-6 * x.norm());
   }
 }
 
@@ -122,7 +125,8 @@ class ChainBasis : public Basis {
   Eigen::Index dimension() const override { return full_mass_.rows(); }
   Coefficients initial_coefficients() const override {
     Coefficients x(dimension(), 3);
-    for (Eigen::Index i = 0; i < x.rows(); ++i) x.row(i) << double(i), std::sin(double(i)), 1.0 + 0.1 * double(i * i);
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      x.row(i) << double(i), std::sin(double(i)), 1.0 + 0.1 * double(i * i);
     return x;
   }
   void update(const Coefficients&, bool, bool) override {}
@@ -143,7 +147,8 @@ class ChainBasis : public Basis {
 /// (a M + b K) Y = R with the `held` rows fixed at `v` and eliminated: dense, from the definition.
 Coefficients eliminated_solution(const ChainBasis& basis, double a, double b, const Coefficients& R,
                                  const Coefficients& v, const std::set<int>& held) {
-  const Eigen::MatrixXd S = a * Eigen::MatrixXd(basis.mass()) + b * Eigen::MatrixXd(basis.stiffness());
+  const Eigen::MatrixXd S =
+      a * Eigen::MatrixXd(basis.mass()) + b * Eigen::MatrixXd(basis.stiffness());
   std::vector<int> free;
   for (int i = 0; i < int(S.rows()); ++i)
     if (!held.count(i)) free.push_back(i);

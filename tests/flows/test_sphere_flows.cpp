@@ -25,7 +25,8 @@ TEST(SphereFlows, SemiImplicitRadiusConvergesUnderRefinement) {
   // mesh the error is spatial, O(h²): about 4x smaller each time the edge length halves.
   std::vector<double> errors;
   for (int level = 2; level <= 5; ++level) {
-    const auto o = run(json{{"mesh", "icosphere:level=" + std::to_string(level)}, {"dt", 1e-3}, {"steps", 10}});
+    const auto o = run(
+        json{{"mesh", "icosphere:level=" + std::to_string(level)}, {"dt", 1e-3}, {"steps", 10}});
     ASSERT_EQ(o.result["status"], "ok");
     errors.push_back(last(o, "radial_error", "rms"));
   }
@@ -43,12 +44,14 @@ TEST(SphereFlows, SphereOfRadiusTwoFollowsTheContinuousRadii) {
   const int steps = int(std::lround(T / dt));
   for (const char* flow : {"mcf", "heat"}) {
     const bool heat = std::string(flow) == "heat";
-    const auto o = run(json{{"mesh", "icosphere:level=4,radius=2"}, {"flow", flow}, {"dt", dt}, {"steps", steps}});
+    const auto o = run(
+        json{{"mesh", "icosphere:level=4,radius=2"}, {"flow", flow}, {"dt", dt}, {"steps", steps}});
     ASSERT_EQ(o.result["status"], "ok") << flow;
     const json& e = o.result["steps"].back()["radial_error"];
     double discrete = r0;
     for (int n = 0; n < steps; ++n)
-      discrete = heat ? discrete / (1 + 2 * dt / (r0 * r0)) : std::pow(discrete, 3) / (discrete * discrete + 2 * dt);
+      discrete = heat ? discrete / (1 + 2 * dt / (r0 * r0))
+                      : std::pow(discrete, 3) / (discrete * discrete + 2 * dt);
     const double continuous = heat ? r0 * std::exp(-2 * T / (r0 * r0)) : std::sqrt(r0 * r0 - 4 * T);
     EXPECT_NEAR(e["radius_semi_implicit"].get<double>(), discrete, 1e-12) << flow;
     EXPECT_NEAR(e["radius_continuous"].get<double>(), continuous, 1e-12) << flow;
@@ -97,20 +100,26 @@ TEST(SphereFlows, HeatFlowMatchesItsClosedForm) {
   // Heat flow keeps M_0, K_0: r_n = r0 (1 + 2δ/r0²)^-n, and r0 exp(-2t/r0²) as δ → 0.
   std::vector<double> errors;
   for (int level = 3; level <= 5; ++level) {
-    const auto o = run(json{{"mesh", "icosphere:level=" + std::to_string(level)}, {"flow", "heat"}, {"dt", 1e-2}, {"steps", 20}});
+    const auto o = run(json{{"mesh", "icosphere:level=" + std::to_string(level)},
+                            {"flow", "heat"},
+                            {"dt", 1e-2},
+                            {"steps", 20}});
     errors.push_back(last(o, "radial_error", "rms"));
-    EXPECT_NEAR(o.result["steps"].back()["radial_error"]["radius_semi_implicit"].get<double>(), std::pow(1.02, -20), 1e-14);
+    EXPECT_NEAR(o.result["steps"].back()["radial_error"]["radius_semi_implicit"].get<double>(),
+                std::pow(1.02, -20), 1e-14);
   }
   EXPECT_GT(errors[0] / errors[1], 3.0);
   EXPECT_GT(errors[1] / errors[2], 3.0);
   EXPECT_LT(errors[2], 2e-4);
   // Heat flow keeps the shape a sphere for any step: the mean radius follows the recursion.
-  const auto big = run(json{{"mesh", "icosphere:level=4"}, {"flow", "heat"}, {"dt", 0.1}, {"steps", 5}});
+  const auto big =
+      run(json{{"mesh", "icosphere:level=4"}, {"flow", "heat"}, {"dt", 0.1}, {"steps", 5}});
   EXPECT_LT(last(big, "radial_error", "rms"), 1e-2 * std::pow(1.2, -5));
 }
 
 TEST(SphereFlows, LockedBoundaryStaysPut) {
-  const auto o = run(json{{"mesh", "open_cylinder:n_around=32,n_along=16"}, {"dt", 1e-2}, {"steps", 5}});
+  const auto o =
+      run(json{{"mesh", "open_cylinder:n_around=32,n_along=16"}, {"dt", 1e-2}, {"steps", 5}});
   ASSERT_EQ(o.result["status"], "ok");
   const MeshSource src = load_mesh_spec("open_cylinder:n_around=32,n_along=16");
   const auto boundary = boundary_vertices(src.mesh);
@@ -132,19 +141,30 @@ TEST(SphereFlows, PinchStopsCleanly) {
 TEST(SphereFlows, UnstableExplicitStepStopsAsDiverged) {
   // Beyond its stability limit (~h²) explicit Euler amplifies the highest frequencies and the
   // area grows: the flow stops and says why, instead of producing a plausible-looking radius.
-  const auto o = run(json{{"mesh", "icosphere:level=3"}, {"integrator", "explicit-euler"}, {"dt", 0.01}, {"steps", 50}});
+  const auto o = run(json{{"mesh", "icosphere:level=3"},
+                          {"integrator", "explicit-euler"},
+                          {"dt", 0.01},
+                          {"steps", 50}});
   EXPECT_EQ(o.result["status"], "singular");
   EXPECT_NE(o.result["stop"]["reason"].get<std::string>().find("diverged"), std::string::npos);
   // The stopping step keeps its seconds and the area that stopped it, as every step does.
   const auto& last_step = o.result["steps"].back();
-  EXPECT_TRUE(last_step.contains("seconds") && last_step["seconds"].contains("total")) << last_step.dump();
-  EXPECT_GT(last_step["area"].get<double>(), 1.05 * o.result["steps"][o.result["steps"].size() - 2]["area"].get<double>());
-  const auto stable = run(json{{"mesh", "icosphere:level=3"}, {"integrator", "explicit-euler"}, {"dt", 5e-4}, {"steps", 50}});
+  EXPECT_TRUE(last_step.contains("seconds") && last_step["seconds"].contains("total"))
+      << last_step.dump();
+  EXPECT_GT(last_step["area"].get<double>(),
+            1.05 * o.result["steps"][o.result["steps"].size() - 2]["area"].get<double>());
+  const auto stable = run(json{{"mesh", "icosphere:level=3"},
+                               {"integrator", "explicit-euler"},
+                               {"dt", 5e-4},
+                               {"steps", 50}});
   EXPECT_EQ(stable.result["status"], "ok");
 }
 
 TEST(SphereFlows, NormalizationKeepsUnitArea) {
-  const auto o = run(json{{"mesh", "icosphere:level=3,radius=2"}, {"normalize_area", true}, {"dt", 1e-2}, {"steps", 5}});
+  const auto o = run(json{{"mesh", "icosphere:level=3,radius=2"},
+                          {"normalize_area", true},
+                          {"dt", 1e-2},
+                          {"steps", 5}});
   const Positions& V = o.final_mesh.vertices;
   EXPECT_NEAR(surface_area(o.final_mesh), 1.0, 1e-12);
   EXPECT_LT(V.colwise().mean().norm(), 1e-12);
@@ -152,21 +172,28 @@ TEST(SphereFlows, NormalizationKeepsUnitArea) {
 
 // Temporal order on MCF, measured as DESIGN.md says: against a run with a much smaller δ on
 // the same mesh, so the spatial error cancels (against sqrt(1-4t) it puts a floor under it).
-double temporal_error(const std::string& integrator, double dt, double T, bool extrapolate, const Positions& reference,
-                      const std::string& mesh) {
-  const auto o = run(json{{"mesh", mesh}, {"integrator", integrator}, {"extrapolate", extrapolate},
-                          {"dt", dt}, {"steps", int(std::lround(T / dt))}});
+double temporal_error(const std::string& integrator, double dt, double T, bool extrapolate,
+                      const Positions& reference, const std::string& mesh) {
+  const auto o = run(json{{"mesh", mesh},
+                          {"integrator", integrator},
+                          {"extrapolate", extrapolate},
+                          {"dt", dt},
+                          {"steps", int(std::lround(T / dt))}});
   EXPECT_EQ(o.result["status"], "ok") << integrator;
   return std::abs(mean_radius(o.final_mesh.vertices) - mean_radius(reference));
 }
 
-double order(const std::string& integrator, double dt, double T, bool extrapolate, const std::string& mesh) {
+double order(const std::string& integrator, double dt, double T, bool extrapolate,
+             const std::string& mesh) {
   // Reference: Crank-Nicolson (second order) at δ/32, shared by the schemes tested at δ.
   static std::map<std::tuple<std::string, double, double>, Positions> references;
   auto& ref = references[{mesh, dt, T}];
   if (ref.rows() == 0)
-    ref = run(json{{"mesh", mesh}, {"integrator", "crank-nicolson"}, {"dt", dt / 32},
-                   {"steps", int(std::lround(T / (dt / 32)))}}).final_mesh.vertices;
+    ref = run(json{{"mesh", mesh},
+                   {"integrator", "crank-nicolson"},
+                   {"dt", dt / 32},
+                   {"steps", int(std::lround(T / (dt / 32)))}})
+              .final_mesh.vertices;
   const double e1 = temporal_error(integrator, dt, T, extrapolate, ref, mesh);
   const double e2 = temporal_error(integrator, dt / 2, T, extrapolate, ref, mesh);
   return std::log2(e1 / e2);
@@ -211,7 +238,8 @@ namespace {
 // away) follows them; the three differ by a few 1e-3 at t = 0.1.
 double middle_radius(const std::string& flow) {
   const std::string mesh = "open_cylinder:radius=1,length=12,n_around=64,n_along=96";
-  const auto o = testing::run(nlohmann::json{{"mesh", mesh}, {"flow", flow}, {"dt", 1e-3}, {"steps", 100}});
+  const auto o =
+      testing::run(nlohmann::json{{"mesh", mesh}, {"flow", flow}, {"dt", 1e-3}, {"steps", 100}});
   EXPECT_EQ(o.result["status"], "ok");
   const Positions& V = o.final_mesh.vertices;
   double sum = 0;
@@ -231,9 +259,13 @@ double middle_radius(const std::string& flow) {
   EXPECT_NEAR(c["ring_radius"].get<double>(), sum / count, 1e-12) << flow;
   double r = 1;
   for (int n = 0; n < 100; ++n)
-    r = flow == "mcf" ? r * r * r / (r * r + 1e-3) : flow == "cmcf" ? r * r / (r + 1e-3) : r / (1 + 1e-3);
+    r = flow == "mcf"    ? r * r * r / (r * r + 1e-3)
+        : flow == "cmcf" ? r * r / (r + 1e-3)
+                         : r / (1 + 1e-3);
   EXPECT_NEAR(c["radius_semi_implicit"].get<double>(), r, 1e-14) << flow;
-  const double t = 0.1, continuous = flow == "mcf" ? std::sqrt(1 - 2 * t) : flow == "cmcf" ? 1 - t : std::exp(-t);
+  const double t = 0.1, continuous = flow == "mcf"    ? std::sqrt(1 - 2 * t)
+                                     : flow == "cmcf" ? 1 - t
+                                                      : std::exp(-t);
   EXPECT_NEAR(c["radius_continuous"].get<double>(), continuous, 1e-14) << flow;
   return sum / count;
 }
@@ -241,16 +273,22 @@ double middle_radius(const std::string& flow) {
 TEST(CylinderFlows, RecordedOnlyForOpenCylinders) {
   // An open cylinder is never normalised (its boundary is held: FlowConfig's
   // NormalizeAreaIsRefusedOnAnOpenSurface), so its analytic radius always applies.
-  EXPECT_THROW(testing::run(nlohmann::json{{"mesh", "open_cylinder:n_around=16,n_along=8"}, {"steps", 1},
-                                           {"normalize_area", true}}),
-               ConfigError);
+  EXPECT_THROW(
+      testing::run(nlohmann::json{
+          {"mesh", "open_cylinder:n_around=16,n_along=8"}, {"steps", 1}, {"normalize_area", true}}),
+      ConfigError);
   const auto sphere = testing::run(nlohmann::json{{"mesh", "icosphere:level=1"}, {"steps", 1}});
   EXPECT_FALSE(sphere.result["steps"][0].contains("cylinder"));
   // Radius 0.5: the recursion uses r0 (cMCF: r_n² / (r_n + δ/r0)).
-  const auto half = testing::run(nlohmann::json{{"mesh", "open_cylinder:radius=0.5,n_around=16,n_along=8"}, {"flow", "cmcf"},
-                                                {"steps", 1}, {"dt", 1e-2}});
-  EXPECT_NEAR(half.result["steps"][0]["cylinder"]["radius_semi_implicit"].get<double>(), 0.25 / (0.5 + 1e-2 / 0.5), 1e-15);
-  EXPECT_NEAR(half.result["steps"][0]["cylinder"]["radius_continuous"].get<double>(), 0.5 - 1e-2 / 0.5, 1e-15);
+  const auto half =
+      testing::run(nlohmann::json{{"mesh", "open_cylinder:radius=0.5,n_around=16,n_along=8"},
+                                  {"flow", "cmcf"},
+                                  {"steps", 1},
+                                  {"dt", 1e-2}});
+  EXPECT_NEAR(half.result["steps"][0]["cylinder"]["radius_semi_implicit"].get<double>(),
+              0.25 / (0.5 + 1e-2 / 0.5), 1e-15);
+  EXPECT_NEAR(half.result["steps"][0]["cylinder"]["radius_continuous"].get<double>(),
+              0.5 - 1e-2 / 0.5, 1e-15);
 }
 
 TEST(CylinderFlows, RadiiFollowTheCmcfPapersTable) {

@@ -10,11 +10,11 @@
 namespace mcf {
 namespace {
 
-using test::laplacian3d;
-using test::symmetric_permutation;
 using test::graph_laplacian;
+using test::laplacian3d;
 using test::random_rhs;
 using test::relative_difference;
+using test::symmetric_permutation;
 
 TEST(CholmodSolver, MatchesDenseOnLaplacian3d) {
   const SparseMatrix A = laplacian3d(10, 9, 8);
@@ -297,7 +297,8 @@ TEST(CholmodSolver, VersionString) {
 TEST(DenseReference, ReportsIndefiniteAndTooLarge) {
   SparseMatrix A = laplacian3d(4, 4, 4);
   Eigen::MatrixXd X;
-  EXPECT_EQ(dense_llt_solve(SparseMatrix(-A), random_rhs(64), X).status, SolveStatus::not_positive_definite);
+  EXPECT_EQ(dense_llt_solve(SparseMatrix(-A), random_rhs(64), X).status,
+            SolveStatus::not_positive_definite);
   EXPECT_EQ(dense_llt_solve(A, random_rhs(64), X, 10).status, SolveStatus::failed);
   const SolveReport r = dense_llt_solve(A, random_rhs(64), X);
   EXPECT_EQ(r.status, SolveStatus::converged);

@@ -24,16 +24,20 @@ SparseMatrix from_triplets(int n, const std::vector<Eigen::Triplet<double, int>>
 }
 
 TEST(SamePattern, ComparesIndicesNotValues) {
-  const SparseMatrix A = from_triplets(3, {{0, 0, 1.0}, {1, 0, 2.0}, {0, 1, 2.0}, {1, 1, 3.0}, {2, 2, 4.0}});
-  const SparseMatrix B = from_triplets(3, {{0, 0, -7.0}, {1, 0, 0.5}, {0, 1, 0.5}, {1, 1, 9.0}, {2, 2, 1.0}});
+  const SparseMatrix A =
+      from_triplets(3, {{0, 0, 1.0}, {1, 0, 2.0}, {0, 1, 2.0}, {1, 1, 3.0}, {2, 2, 4.0}});
+  const SparseMatrix B =
+      from_triplets(3, {{0, 0, -7.0}, {1, 0, 0.5}, {0, 1, 0.5}, {1, 1, 9.0}, {2, 2, 1.0}});
   EXPECT_TRUE(mcf::same_pattern(A, B));
   EXPECT_TRUE(mcf::same_pattern(A, A));
   // Same count of entries, one row index moved: (1, 0) -> (2, 0) and (0, 1) -> (0, 2).
-  const SparseMatrix C = from_triplets(3, {{0, 0, 1.0}, {2, 0, 2.0}, {0, 2, 2.0}, {1, 1, 3.0}, {2, 2, 4.0}});
+  const SparseMatrix C =
+      from_triplets(3, {{0, 0, 1.0}, {2, 0, 2.0}, {0, 2, 2.0}, {1, 1, 3.0}, {2, 2, 4.0}});
   EXPECT_FALSE(mcf::same_pattern(A, C));
   // One entry fewer; a different size.
   EXPECT_FALSE(mcf::same_pattern(A, from_triplets(3, {{0, 0, 1.0}, {1, 1, 3.0}, {2, 2, 4.0}})));
-  EXPECT_FALSE(mcf::same_pattern(A, from_triplets(4, {{0, 0, 1.0}, {1, 0, 2.0}, {0, 1, 2.0}, {1, 1, 3.0}, {2, 2, 4.0}})));
+  EXPECT_FALSE(mcf::same_pattern(
+      A, from_triplets(4, {{0, 0, 1.0}, {1, 0, 2.0}, {0, 1, 2.0}, {1, 1, 3.0}, {2, 2, 4.0}})));
   // Not compressed: never the same (its stored arrays are not a plain CSC pattern).
   SparseMatrix U = A;
   U.insert(2, 1) = 1.0;  // leaves U uncompressed
@@ -42,12 +46,14 @@ TEST(SamePattern, ComparesIndicesNotValues) {
   EXPECT_FALSE(mcf::same_pattern(U, U));
   // Maps of one pattern's arrays (a basis's mass and stiffness views) with their own values.
   const std::vector<double> values(std::size_t(A.nonZeros()), 5.0);
-  const Eigen::Map<const SparseMatrix> V(3, 3, A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(), values.data());
+  const Eigen::Map<const SparseMatrix> V(3, 3, A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(),
+                                         values.data());
   EXPECT_TRUE(mcf::same_pattern(V, A));
   EXPECT_TRUE(mcf::same_pattern(V, B));
   EXPECT_FALSE(mcf::same_pattern(V, C));
   // The same arrays seen with fewer entries or columns are another pattern.
-  const Eigen::Map<const SparseMatrix> W(2, 2, 4, A.outerIndexPtr(), A.innerIndexPtr(), values.data());
+  const Eigen::Map<const SparseMatrix> W(2, 2, 4, A.outerIndexPtr(), A.innerIndexPtr(),
+                                         values.data());
   EXPECT_FALSE(mcf::same_pattern(V, W));
 }
 
@@ -96,14 +102,17 @@ class RecordingSolver : public mcf::LinearSolver {
     ++calls;
     return {};
   }
-  mcf::SolveReport solve_in_place(const mcf::ConstMatrixRef&, mcf::MatrixRef) override { return {}; }
+  mcf::SolveReport solve_in_place(const mcf::ConstMatrixRef&, mcf::MatrixRef) override {
+    return {};
+  }
   SparseMatrix given;
   std::uint64_t key = 0;
   int calls = 0;
 };
 
 bool bitwise_equal(const SparseMatrix& A, const SparseMatrix& B) {
-  return mcf::same_pattern(A, B) && std::equal(A.valuePtr(), A.valuePtr() + A.nonZeros(), B.valuePtr());
+  return mcf::same_pattern(A, B) &&
+         std::equal(A.valuePtr(), A.valuePtr() + A.nonZeros(), B.valuePtr());
 }
 
 // The default hands set_matrix exactly sum_on_pattern's matrix; it follows a change of pattern
@@ -111,10 +120,14 @@ bool bitwise_equal(const SparseMatrix& A, const SparseMatrix& B) {
 // operands off one pattern get Eigen's general sum (the union of the patterns), without a key.
 TEST(SetMatrixSum, DefaultHandsOverSumOnPattern) {
   using T = Eigen::Triplet<double, int>;
-  const SparseMatrix M1 = from_triplets(3, {T{0, 0, 2.0}, T{1, 0, 0.5}, T{0, 1, 0.5}, T{1, 1, 3.0}, T{2, 2, 4.0}});
-  const SparseMatrix K1 = from_triplets(3, {T{0, 0, 1.0}, T{1, 0, -1.0}, T{0, 1, -1.0}, T{1, 1, 1.0}, T{2, 2, 0.0}});
-  const SparseMatrix M2 = from_triplets(3, {T{0, 0, 2.0}, T{2, 0, 0.25}, T{0, 2, 0.25}, T{1, 1, 3.0}, T{2, 2, 4.0}});
-  const SparseMatrix K2 = from_triplets(3, {T{0, 0, 1.0}, T{2, 0, -1.0}, T{0, 2, -1.0}, T{1, 1, 7.0}, T{2, 2, 1.0}});
+  const SparseMatrix M1 =
+      from_triplets(3, {T{0, 0, 2.0}, T{1, 0, 0.5}, T{0, 1, 0.5}, T{1, 1, 3.0}, T{2, 2, 4.0}});
+  const SparseMatrix K1 =
+      from_triplets(3, {T{0, 0, 1.0}, T{1, 0, -1.0}, T{0, 1, -1.0}, T{1, 1, 1.0}, T{2, 2, 0.0}});
+  const SparseMatrix M2 =
+      from_triplets(3, {T{0, 0, 2.0}, T{2, 0, 0.25}, T{0, 2, 0.25}, T{1, 1, 3.0}, T{2, 2, 4.0}});
+  const SparseMatrix K2 =
+      from_triplets(3, {T{0, 0, 1.0}, T{2, 0, -1.0}, T{0, 2, -1.0}, T{1, 1, 7.0}, T{2, 2, 1.0}});
   ASSERT_FALSE(mcf::same_pattern(M1, M2));
   auto sum = [](double a, const SparseMatrix& M, double b, const SparseMatrix& K) {
     SparseMatrix S = M;
@@ -126,7 +139,8 @@ TEST(SetMatrixSum, DefaultHandsOverSumOnPattern) {
   ASSERT_TRUE(s.set_matrix_sum(1.0, M1, 0.1, K1, {nullptr, nullptr, key}).ok());
   EXPECT_TRUE(bitwise_equal(s.given, sum(1.0, M1, 0.1, K1)));
   EXPECT_EQ(s.key, key);
-  ASSERT_TRUE(s.set_matrix_sum(2.0, M1, 0.3, K1, {nullptr, nullptr, key}).ok());  // vouched: values only
+  ASSERT_TRUE(
+      s.set_matrix_sum(2.0, M1, 0.3, K1, {nullptr, nullptr, key}).ok());  // vouched: values only
   EXPECT_TRUE(bitwise_equal(s.given, sum(2.0, M1, 0.3, K1)));
   ASSERT_TRUE(s.set_matrix_sum(1.0, M2, 0.1, K2).ok());  // no key: compared, new pattern taken
   EXPECT_TRUE(bitwise_equal(s.given, sum(1.0, M2, 0.1, K2)));

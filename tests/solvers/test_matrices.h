@@ -96,7 +96,8 @@ inline double relative_residual(const SparseMatrix& A, const Eigen::MatrixXd& B,
                                 const Eigen::MatrixXd& X) {
   const Eigen::MatrixXd R = B - A * X;
   double worst = 0.0;
-  for (Eigen::Index c = 0; c < B.cols(); ++c) worst = std::max(worst, R.col(c).norm() / B.col(c).norm());
+  for (Eigen::Index c = 0; c < B.cols(); ++c)
+    worst = std::max(worst, R.col(c).norm() / B.col(c).norm());
   return worst;
 }
 

@@ -3,15 +3,15 @@
 // 1-D refinement (1/2, 1, 1/2) tensor prolongations, parity colours. Variants drop functions
 // (a spherical shell, as an octree around a surface would; or random), so P loses rows/columns.
 
-#include "solvers/multigrid.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/dense_reference.h"
+#include "solvers/multigrid.h"
 #include "solvers/multigrid_pcg.h"
 #include "solvers/pcg_solver.h"
 
-#include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <chrono>
@@ -33,13 +33,15 @@ using mcf::SparseMatrix;
 using Triplets = std::vector<Eigen::Triplet<double, int>>;
 
 struct Problem {
-  SparseMatrix A;                                      // finest level
-  std::vector<SparseMatrix> P;                         // coarsest first
-  std::vector<std::vector<std::uint8_t>> colours;      // per level, coarsest first
+  SparseMatrix A;                                  // finest level
+  std::vector<SparseMatrix> P;                     // coarsest first
+  std::vector<std::vector<std::uint8_t>> colours;  // per level, coarsest first
   HierarchyView view() const { return {&P, &colours}; }
 };
 
-int vid(int N, int i, int j, int k) { return i + (N + 1) * (j + (N + 1) * k); }
+int vid(int N, int i, int j, int k) {
+  return i + (N + 1) * (j + (N + 1) * k);
+}
 
 double m1(int N, int a, int b) {
   const double h = 1.0 / N;
@@ -100,7 +102,8 @@ std::vector<std::uint8_t> grid_colours(int N) {
   std::vector<std::uint8_t> c(std::size_t((N + 1) * (N + 1) * (N + 1)));
   for (int k = 0; k <= N; ++k)
     for (int j = 0; j <= N; ++j)
-      for (int i = 0; i <= N; ++i) c[std::size_t(vid(N, i, j, k))] = std::uint8_t((i & 1) | (j & 1) << 1 | (k & 1) << 2);
+      for (int i = 0; i <= N; ++i)
+        c[std::size_t(vid(N, i, j, k))] = std::uint8_t((i & 1) | (j & 1) << 1 | (k & 1) << 2);
   return c;
 }
 
@@ -136,7 +139,8 @@ Problem make_problem(int depth, int coarsest, double dt, Drop drop = Drop::none)
     keep[std::size_t(l)].assign(std::size_t(P.cols()), 0);
     for (int J = 0; J < P.outerSize(); ++J)
       for (SparseMatrix::InnerIterator it(P, J); it; ++it)
-        if (keep[std::size_t(l) + 1][std::size_t(it.row())]) keep[std::size_t(l)][std::size_t(J)] = 1;
+        if (keep[std::size_t(l) + 1][std::size_t(it.row())])
+          keep[std::size_t(l)][std::size_t(J)] = 1;
   }
   std::vector<std::vector<int>> map(static_cast<std::size_t>(nl));
   std::vector<int> count(static_cast<std::size_t>(nl), 0);
@@ -145,7 +149,8 @@ Problem make_problem(int depth, int coarsest, double dt, Drop drop = Drop::none)
     for (std::size_t i = 0; i < keep[std::size_t(l)].size(); ++i)
       if (keep[std::size_t(l)][i]) map[std::size_t(l)][i] = count[std::size_t(l)]++;
   }
-  auto select = [](const SparseMatrix& M, const std::vector<int>& rmap, const std::vector<int>& cmap, int nr, int nc) {
+  auto select = [](const SparseMatrix& M, const std::vector<int>& rmap,
+                   const std::vector<int>& cmap, int nr, int nc) {
     Triplets t;
     for (int J = 0; J < M.outerSize(); ++J)
       for (SparseMatrix::InnerIterator it(M, J); it; ++it)
@@ -164,7 +169,8 @@ Problem make_problem(int depth, int coarsest, double dt, Drop drop = Drop::none)
   for (int l = 0; l < nl; ++l) {
     std::vector<std::uint8_t> c(std::size_t(count[std::size_t(l)]));
     for (std::size_t i = 0; i < map[std::size_t(l)].size(); ++i)
-      if (map[std::size_t(l)][i] >= 0) c[std::size_t(map[std::size_t(l)][i])] = col[std::size_t(l)][i];
+      if (map[std::size_t(l)][i] >= 0)
+        c[std::size_t(map[std::size_t(l)][i])] = col[std::size_t(l)][i];
     pr.colours.push_back(std::move(c));
   }
   return pr;
@@ -179,7 +185,9 @@ Eigen::MatrixXd random_matrix(Eigen::Index n, Eigen::Index k, unsigned seed) {
   return M;
 }
 
-double rel_diff(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return (a - b).norm() / b.norm(); }
+double rel_diff(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).norm() / b.norm();
+}
 
 void expect_galerkin(const MultigridSolver& mg, const Problem& pr) {
   ASSERT_EQ(mg.levels(), int(pr.P.size()) + 1);
@@ -209,7 +217,8 @@ TEST(Multigrid, GalerkinMatchesBruteForceAndUpdatesNumerically) {
 
     // New values, same pattern: no new symbolic build, coarse operators follow.
     Problem pr2 = make_problem(4, 1, 0.7, drop);
-    for (Eigen::Index e = 0; e < pr2.A.nonZeros(); ++e) pr2.A.valuePtr()[e] *= 1.0 + 0.01 * double(e % 7);
+    for (Eigen::Index e = 0; e < pr2.A.nonZeros(); ++e)
+      pr2.A.valuePtr()[e] *= 1.0 + 0.01 * double(e % 7);
     pr2.A = SparseMatrix(0.5 * (pr2.A + SparseMatrix(pr2.A.transpose())));
     ASSERT_EQ(pr2.A.nonZeros(), pr.A.nonZeros());
     rep = mg.set_matrix(pr2.A, pr2.view());
@@ -287,8 +296,12 @@ TEST(Multigrid, SetMatrixSumEqualsSetMatrixOfTheSum) {
     const Eigen::MatrixXd B = random_matrix(M.rows(), 3, 7);
     const std::uint64_t key = mcf::new_pattern_key();
     MultigridSolver fused, reference;
-    struct Call { double a, b; std::uint64_t key; };
-    for (const Call c : {Call{1.0, 0.05, key}, Call{0.5, 0.2, key}, Call{2.0, 0.0, 0}, Call{1.0, 1e-3, 0}}) {
+    struct Call {
+      double a, b;
+      std::uint64_t key;
+    };
+    for (const Call c :
+         {Call{1.0, 0.05, key}, Call{0.5, 0.2, key}, Call{2.0, 0.0, 0}, Call{1.0, 1e-3, 0}}) {
       SCOPED_TRACE(c.a);
       HierarchyView v = pm.view();
       v.pattern_key = c.key;
@@ -300,7 +313,8 @@ TEST(Multigrid, SetMatrixSumEqualsSetMatrixOfTheSum) {
       for (int l = 0; l < fused.levels(); ++l) {
         const SparseMatrix Lf = fused.level_matrix(l), Lr = reference.level_matrix(l);
         ASSERT_TRUE(mcf::same_pattern(Lf, Lr)) << "level " << l;
-        EXPECT_TRUE(std::equal(Lf.valuePtr(), Lf.valuePtr() + Lf.nonZeros(), Lr.valuePtr())) << "level " << l;
+        EXPECT_TRUE(std::equal(Lf.valuePtr(), Lf.valuePtr() + Lf.nonZeros(), Lr.valuePtr()))
+            << "level " << l;
       }
       Eigen::MatrixXd X1, X2;
       ASSERT_TRUE(fused.solve(B, X1).ok());
@@ -328,7 +342,8 @@ SparseMatrix rotate_columns(const SparseMatrix& A) {
 }
 
 bool same_values(const SparseMatrix& X, const SparseMatrix& Y) {
-  return mcf::same_pattern(X, Y) && std::equal(X.valuePtr(), X.valuePtr() + X.nonZeros(), Y.valuePtr());
+  return mcf::same_pattern(X, Y) &&
+         std::equal(X.valuePtr(), X.valuePtr() + X.nonZeros(), Y.valuePtr());
 }
 
 /// The finest level stores each column's diagonal last and remembers where the caller had it
@@ -342,7 +357,8 @@ TEST(Multigrid, FinestDiagonalStoredLastWhereverTheCallerHasIt) {
   int ranks_seen = 0;  // teeth: the rotation really moves the diagonal around
   for (int j = 0; j < M.cols(); ++j) {
     const int p0 = M.outerIndexPtr()[j];
-    if (M.innerIndexPtr()[p0] != j && M.innerIndexPtr()[M.outerIndexPtr()[j + 1] - 1] != j) ++ranks_seen;
+    if (M.innerIndexPtr()[p0] != j && M.innerIndexPtr()[M.outerIndexPtr()[j + 1] - 1] != j)
+      ++ranks_seen;
   }
   ASSERT_GT(ranks_seen, M.cols() / 2);
   const Eigen::MatrixXd B = random_matrix(M.rows(), 3, 31);
@@ -383,7 +399,8 @@ TEST(Multigrid, FinestDiagonalStoredLastWhereverTheCallerHasIt) {
 
 // PCG preconditioned by the cycle hands M and K to both halves: bitwise as set_matrix on the sum.
 TEST(Multigrid, PcgSetMatrixSumEqualsSetMatrixOfTheSum) {
-  const Problem pm = make_problem(4, 1, 0.0, Drop::shell), pk = make_problem(4, 1, 1.0, Drop::shell);
+  const Problem pm = make_problem(4, 1, 0.0, Drop::shell),
+                pk = make_problem(4, 1, 1.0, Drop::shell);
   ASSERT_TRUE(mcf::same_pattern(pm.A, pk.A));
   mcf::PcgOptions pcg;
   pcg.max_iterations = 3;
@@ -449,13 +466,22 @@ void expect_converges_to_direct(MultigridCycle cycle, Drop drop) {
   EXPECT_EQ(rep.status, SolveStatus::converged);
   EXPECT_LT(rel_diff(X, Xd), 1e-8);
   EXPECT_EQ(int(rep.residuals.size()), rep.iterations);
-  for (std::size_t i = 1; i < rep.residuals.size(); ++i) EXPECT_LT(rep.residuals[i], rep.residuals[i - 1]);
+  for (std::size_t i = 1; i < rep.residuals.size(); ++i)
+    EXPECT_LT(rep.residuals[i], rep.residuals[i - 1]);
 }
 
-TEST(Multigrid, VCycleConvergesToDirectSolution) { expect_converges_to_direct(MultigridCycle::V, Drop::none); }
-TEST(Multigrid, WCycleConvergesToDirectSolution) { expect_converges_to_direct(MultigridCycle::W, Drop::none); }
-TEST(Multigrid, VCycleConvergesOnShell) { expect_converges_to_direct(MultigridCycle::V, Drop::shell); }
-TEST(Multigrid, WCycleConvergesOnShell) { expect_converges_to_direct(MultigridCycle::W, Drop::shell); }
+TEST(Multigrid, VCycleConvergesToDirectSolution) {
+  expect_converges_to_direct(MultigridCycle::V, Drop::none);
+}
+TEST(Multigrid, WCycleConvergesToDirectSolution) {
+  expect_converges_to_direct(MultigridCycle::W, Drop::none);
+}
+TEST(Multigrid, VCycleConvergesOnShell) {
+  expect_converges_to_direct(MultigridCycle::V, Drop::shell);
+}
+TEST(Multigrid, WCycleConvergesOnShell) {
+  expect_converges_to_direct(MultigridCycle::W, Drop::shell);
+}
 
 // A semi-definite coarsest level (the octree functions on a face parallel to a grid plane are
 // dependent, and a coarse function whose finer functions are all held has a zero row): the
@@ -487,14 +513,17 @@ TEST(Multigrid, SemiDefiniteCoarsestLevelIsSolvedByItsPseudoInverse) {
   ASSERT_EQ(A.coeff(dropped, dropped), 0.0);
   const Eigen::MatrixXd B = W.transpose() * random_matrix(n, 3, 5);  // consistent: in A's range
   Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
-  ASSERT_TRUE(ldlt.info() != Eigen::Success || ldlt.vectorD().cwiseAbs().minCoeff() < 1e-12 * ldlt.vectorD().maxCoeff())
+  ASSERT_TRUE(ldlt.info() != Eigen::Success ||
+              ldlt.vectorD().cwiseAbs().minCoeff() < 1e-12 * ldlt.vectorD().maxCoeff())
       << "the test matrix must be singular";
 
   MultigridSolver mg;
   const std::vector<SparseMatrix> none;
   const mcf::SolveReport set = mg.set_matrix(A, HierarchyView{&none, nullptr});
   ASSERT_TRUE(set.ok()) << set.message;
-  EXPECT_NE(set.message.find("null space of dimension " + std::to_string(pairs + 1)), std::string::npos) << set.message;
+  EXPECT_NE(set.message.find("null space of dimension " + std::to_string(pairs + 1)),
+            std::string::npos)
+      << set.message;
   Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n, 3);
   ASSERT_TRUE(mg.solve(B, X).ok());
   EXPECT_LT(((A * X - B).colwise().norm().array() / B.colwise().norm().array()).maxCoeff(), 1e-11);
@@ -510,7 +539,8 @@ TEST(Multigrid, SemiDefiniteCoarsestLevelIsSolvedByItsPseudoInverse) {
   // Positive diagonal, a 2 x 2 principal minor < 0.
   SparseMatrix indefinite = A;
   const int a = vid(N, 2, 0, 0), b = vid(N, 3, 0, 0);
-  indefinite.coeffRef(a, b) = indefinite.coeffRef(b, a) = 3 * std::sqrt(A.coeff(a, a) * A.coeff(b, b));
+  indefinite.coeffRef(a, b) = indefinite.coeffRef(b, a) =
+      3 * std::sqrt(A.coeff(a, a) * A.coeff(b, b));
   const mcf::SolveReport refused = mg.set_matrix(indefinite, HierarchyView{&none, nullptr});
   EXPECT_EQ(refused.status, SolveStatus::not_positive_definite);
   EXPECT_NE(refused.message.find("eigenvalue"), std::string::npos) << refused.message;
@@ -529,7 +559,8 @@ TEST(Multigrid, OneWCycleReducesResidualTenfold) {
       EXPECT_EQ(rep.status, SolveStatus::converged);
       EXPECT_LT(rep.relative_residual, 0.1) << "dt " << dt << " drop " << int(drop);
       // The reported residual is the true one.
-      const double r = ((B - pr.A * X).colwise().norm().array() / B.colwise().norm().array()).maxCoeff();
+      const double r =
+          ((B - pr.A * X).colwise().norm().array() / B.colwise().norm().array()).maxCoeff();
       EXPECT_NEAR(rep.relative_residual, r, 1e-12);
     }
   }
@@ -580,7 +611,8 @@ TEST(Multigrid, WCycleNeedsNoMoreCyclesThanV) {
       its[c == MultigridCycle::W] = rep.iterations;
     }
     EXPECT_LE(its[1], its[0]) << "V " << its[0] << " W " << its[1];
-    std::cout << "[ cycles   ] to 1e-10, drop " << int(drop) << ": V " << its[0] << ", W " << its[1] << "\n";
+    std::cout << "[ cycles   ] to 1e-10, drop " << int(drop) << ": V " << its[0] << ", W " << its[1]
+              << "\n";
   }
 }
 
@@ -603,14 +635,15 @@ TEST(Multigrid, BitwiseIdenticalForOneAndTwoThreads) {
   EXPECT_EQ((X[0] - X[1]).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(res[0], res[1]);
   ASSERT_EQ(coarse[0].nonZeros(), coarse[1].nonZeros());
-  EXPECT_TRUE(std::equal(coarse[0].valuePtr(), coarse[0].valuePtr() + coarse[0].nonZeros(), coarse[1].valuePtr()));
+  EXPECT_TRUE(std::equal(coarse[0].valuePtr(), coarse[0].valuePtr() + coarse[0].nonZeros(),
+                         coarse[1].valuePtr()));
 }
 
 /// Serial Gauss-Seidel over `order`: row i's off-diagonal terms in index order, its diagonal
 /// exact; with `single`, the off-diagonal values rounded to single precision as the solver's
 /// compact smoother rows hold them.
-void reference_gs(const SparseMatrix& A, const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const std::vector<int>& order,
-                  bool single = false) {
+void reference_gs(const SparseMatrix& A, const Eigen::MatrixXd& B, Eigen::MatrixXd& X,
+                  const std::vector<int>& order, bool single = false) {
   for (int i : order) {
     double d = 0;
     Eigen::RowVectorXd acc = B.row(i);
@@ -645,7 +678,8 @@ TEST(Multigrid, SweepEqualsSerialGaussSeidelInItsRelaxationOrder) {
     ASSERT_EQ(fwd.size(), std::size_t(A.rows()));
     std::vector<int> sorted = fwd;
     std::sort(sorted.begin(), sorted.end());
-    for (int i = 0; i < A.rows(); ++i) ASSERT_EQ(sorted[std::size_t(i)], i) << "not a permutation, level " << l;
+    for (int i = 0; i < A.rows(); ++i)
+      ASSERT_EQ(sorted[std::size_t(i)], i) << "not a permutation, level " << l;
     // The reverse sweep equals the serial sweep in the exact reverse of the forward order (what
     // makes the cycle symmetric); relaxation_order(l, true) may list the independent functions of
     // one colour in another order, which gives the same result.
@@ -659,8 +693,10 @@ TEST(Multigrid, SweepEqualsSerialGaussSeidelInItsRelaxationOrder) {
         reference_gs(A, B, Xo, reverse ? rev : fwd, single);
       }
       const double scale = Xr.cwiseAbs().maxCoeff();
-      EXPECT_LE((X - Xr).cwiseAbs().maxCoeff(), 1e-13 * scale) << "level " << l << " reverse " << reverse;
-      EXPECT_LE((X - Xo).cwiseAbs().maxCoeff(), 1e-13 * scale) << "level " << l << " reverse " << reverse;
+      EXPECT_LE((X - Xr).cwiseAbs().maxCoeff(), 1e-13 * scale)
+          << "level " << l << " reverse " << reverse;
+      EXPECT_LE((X - Xo).cwiseAbs().maxCoeff(), 1e-13 * scale)
+          << "level " << l << " reverse " << reverse;
     }
   }
   // Teeth: on a finest level of several relaxation blocks (a depth-6 shell: ~27 tiles) the sweep
@@ -689,7 +725,8 @@ TEST(Multigrid, SweepEqualsSerialGaussSeidelInItsRelaxationOrder) {
 /// The parallel sweep relaxes blocks of one parity at the same time, so it is a serial
 /// Gauss-Seidel sweep only if no function couples with one two or more blocks away. Checked on
 /// every level's matrix, with levels of several blocks (a depth-7 shell, whose finest level couples
-/// functions more than a tile apart) so that the check is not vacuous: with one-tile blocks it fails.
+/// functions more than a tile apart) so that the check is not vacuous: with one-tile blocks it
+/// fails.
 TEST(Multigrid, RelaxationBlocksOfOneParityNeverCouple) {
   Problem pr = make_problem(7, 4, 0.05, Drop::shell);
   MultigridSolver mg;
@@ -788,7 +825,8 @@ void expect_symmetric_preconditioner(MultigridCycle cycle) {
   MultigridSolver mg(opt);
   ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
   for (unsigned s = 0; s < 3; ++s) {
-    const Eigen::MatrixXd u = random_matrix(pr.A.rows(), 3, 100 + s), v = random_matrix(pr.A.rows(), 3, 200 + s);
+    const Eigen::MatrixXd u = random_matrix(pr.A.rows(), 3, 100 + s),
+                          v = random_matrix(pr.A.rows(), 3, 200 + s);
     Eigen::MatrixXd Bu, Bv;
     mg.precondition(u, Bu);
     mg.precondition(v, Bv);
@@ -806,8 +844,12 @@ void expect_symmetric_preconditioner(MultigridCycle cycle) {
   EXPECT_EQ((X - z).cwiseAbs().maxCoeff(), 0.0);
 }
 
-TEST(Multigrid, PreconditionerIsSymmetricW) { expect_symmetric_preconditioner(MultigridCycle::W); }
-TEST(Multigrid, PreconditionerIsSymmetricV) { expect_symmetric_preconditioner(MultigridCycle::V); }
+TEST(Multigrid, PreconditionerIsSymmetricW) {
+  expect_symmetric_preconditioner(MultigridCycle::W);
+}
+TEST(Multigrid, PreconditionerIsSymmetricV) {
+  expect_symmetric_preconditioner(MultigridCycle::V);
+}
 
 // level_work(): the visits are those of the cycle's definition (V: once per level per cycle; W:
 // level l < finest 2^(finest - l) times, the coarsest as often as the next, since its exact solve
@@ -831,7 +873,8 @@ TEST(Multigrid, LevelWorkCountsTheCyclesVisits) {
     ASSERT_TRUE(mg.solve(B, X).ok());
     Eigen::MatrixXd Z;
     mg.precondition(B, Z);  // one more cycle
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     const auto work = mg.level_work();
     ASSERT_EQ(int(work.size()), top + 1);
@@ -938,7 +981,8 @@ TEST(LinearSolverInterface, AnyColumnMajorBlockSolvesInPlaceBitwise) {
     EXPECT_EQ(fixed.relative_residual, plain.relative_residual);
 
     // Rows 2..n+1 and columns 1..3 of (n + 5) x 5 matrices: the column stride is n + 5.
-    Eigen::MatrixXd Bw = Eigen::MatrixXd::Constant(n + 5, 5, 7.0), Xw = Eigen::MatrixXd::Constant(n + 5, 5, -3.0);
+    Eigen::MatrixXd Bw = Eigen::MatrixXd::Constant(n + 5, 5, 7.0),
+                    Xw = Eigen::MatrixXd::Constant(n + 5, 5, -3.0);
     Bw.block(2, 1, n, 3) = B;
     Xw.block(2, 1, n, 3) = warm;
     const mcf::SolveReport strided = solver->solve(Bw.block(2, 1, n, 3), Xw.block(2, 1, n, 3));
@@ -950,7 +994,8 @@ TEST(LinearSolverInterface, AnyColumnMajorBlockSolvesInPlaceBitwise) {
     EXPECT_TRUE((around.array() == -3.0).all());
 
     // Another shape: a block fails untouched; a resizable matrix is zeroed, then solved.
-    Eigen::Matrix<double, Eigen::Dynamic, 3> short_block = Eigen::Matrix<double, Eigen::Dynamic, 3>::Constant(n - 1, 3, 5.0);
+    Eigen::Matrix<double, Eigen::Dynamic, 3> short_block =
+        Eigen::Matrix<double, Eigen::Dynamic, 3>::Constant(n - 1, 3, 5.0);
     const mcf::SolveReport refused = solver->solve(B, short_block);
     EXPECT_EQ(refused.status, SolveStatus::failed);
     EXPECT_NE(refused.message.find("warm start"), std::string::npos) << refused.message;

@@ -50,8 +50,12 @@ void expect_all_agree(const SparseMatrix& A) {
   }
 }
 
-TEST(PcgSolver, AgreesWithCholmodAndDenseOnLaplacian3d) { expect_all_agree(laplacian3d(10, 9, 8)); }
-TEST(PcgSolver, AgreesWithCholmodAndDenseOnGraphLaplacian) { expect_all_agree(graph_laplacian(700)); }
+TEST(PcgSolver, AgreesWithCholmodAndDenseOnLaplacian3d) {
+  expect_all_agree(laplacian3d(10, 9, 8));
+}
+TEST(PcgSolver, AgreesWithCholmodAndDenseOnGraphLaplacian) {
+  expect_all_agree(graph_laplacian(700));
+}
 
 TEST(PcgSolver, PreconditionersReduceIterations) {
   // Badly scaled diagonal: Jacobi and IC must beat plain CG clearly.
@@ -247,11 +251,15 @@ TEST(PcgSolver, SetMatrixSumEqualsSetMatrixOfTheSum) {
   const SparseMatrix M2 = graph_laplacian(700, 4, 0.05), K2 = graph_laplacian(700, 4, 0.3);
   ASSERT_TRUE(same_pattern(M1, K1));
   ASSERT_TRUE(same_pattern(M2, K2));
-  struct Call { const SparseMatrix *M, *K; double a, b; };
+  struct Call {
+    const SparseMatrix *M, *K;
+    double a, b;
+  };
   PcgOptions o = tight(PcgPreconditioner::incomplete_cholesky);
   o.max_iterations = 7;  // stop early: an iterate depends on every rounding of A and of the factor
   PcgSolver fused(o), reference(o);
-  for (const Call c : {Call{&M1, &K1, 1.0, 0.01}, Call{&M1, &K1, 0.5, 0.2}, Call{&M2, &K2, 1.0, 1e-3}}) {
+  for (const Call c :
+       {Call{&M1, &K1, 1.0, 0.01}, Call{&M1, &K1, 0.5, 0.2}, Call{&M2, &K2, 1.0, 1e-3}}) {
     SparseMatrix S = *c.M;
     sum_on_pattern(c.a, *c.M, c.b, *c.K, S);
     ASSERT_TRUE(fused.set_matrix_sum(c.a, *c.M, c.b, *c.K).ok());
@@ -285,7 +293,7 @@ TEST(PcgSolver, SetMatrixSumEqualsSetMatrixOfTheSum) {
 TEST(PcgSolver, PatternKeyVouchesWithoutComparing) {
   const SparseMatrix A1 = laplacian3d(7, 6, 5, 0.1, 51);
   const SparseMatrix A2 = laplacian3d(7, 6, 5, 0.6, 52, 2.0);  // same pattern, new values
-  const SparseMatrix A3 = symmetric_permutation(A2, 11);  // 210 and 11 coprime
+  const SparseMatrix A3 = symmetric_permutation(A2, 11);       // 210 and 11 coprime
   ASSERT_EQ(A3.nonZeros(), A1.nonZeros());
   ASSERT_FALSE(same_pattern(A1, A3));
   const SparseMatrix small = laplacian3d(4, 4, 4);

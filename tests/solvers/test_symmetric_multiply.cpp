@@ -52,7 +52,8 @@ TEST(SymmetricMultiply, MatchesEigenProductForAnyColumnCount) {
 
 TEST(SymmetricMultiply, CoefficientsInMatrixOut) {
   const SparseMatrix A = random_symmetric(500, 5);
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> X = Eigen::Matrix<double, Eigen::Dynamic, 3>::Random(500, 3);
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> X =
+      Eigen::Matrix<double, Eigen::Dynamic, 3>::Random(500, 3);
   const Eigen::Matrix<double, Eigen::Dynamic, 3> Y = symmetric_multiply(A, X);
   EXPECT_LE((Y - A * X).cwiseAbs().maxCoeff(), 1e-13);
 }

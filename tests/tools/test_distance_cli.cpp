@@ -1,8 +1,8 @@
 // `mcfbench distance` end to end: files are read as is (no unit-cube rescaling), the JSON has
 // every key, and a missing file fails naming it.
 
-#include <nlohmann/json.hpp>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -29,26 +29,29 @@ std::pair<int, std::string> capture(const std::string& cmd) {
 fs::path square(const fs::path& dir, const std::string& name, double s, double z) {
   const fs::path p = dir / name;
   std::ofstream f(p);
-  f << "OFF\n4 2 0\n0 0 " << z << "\n" << s << " 0 " << z << "\n" << s << " " << s << " " << z << "\n0 " << s
-    << " " << z << "\n3 0 1 2\n3 0 2 3\n";
+  f << "OFF\n4 2 0\n0 0 " << z << "\n"
+    << s << " 0 " << z << "\n"
+    << s << " " << s << " " << z << "\n0 " << s << " " << z << "\n3 0 1 2\n3 0 2 3\n";
   return p;
 }
 
 TEST(DistanceCli, FilesAreComparedUnscaled) {
-  const fs::path dir = fs::temp_directory_path() / ("mcfbench_distance_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("mcfbench_distance_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   // A 3×3 square and a copy 0.25 above it: unit-cube scaling would make the gap 1/12.
   const fs::path a = square(dir, "a.off", 3.0, 0.0), b = square(dir, "b.off", 3.0, 0.25);
-  const auto [status, out] =
-      capture(std::string(MCFBENCH_BINARY) + " distance " + a.string() + " " + b.string() + " --samples 2000 --seed 3");
+  const auto [status, out] = capture(std::string(MCFBENCH_BINARY) + " distance " + a.string() +
+                                     " " + b.string() + " --samples 2000 --seed 3");
   ASSERT_EQ(status, 0) << out;
   const nlohmann::json j = nlohmann::json::parse(out);
-  for (const char* key : {"rms_forward", "max_forward", "rms_backward", "max_backward", "rms", "max"})
+  for (const char* key :
+       {"rms_forward", "max_forward", "rms_backward", "max_backward", "rms", "max"})
     EXPECT_NEAR(j.at(key).get<double>(), 0.25, 1e-6) << key;  // OFF stores 17 digits
   EXPECT_EQ(j.at("samples").get<long long>(), 2000);
 
-  const auto [bad, msg] = capture(std::string(MCFBENCH_BINARY) + " distance " + (dir / "missing.off").string() + " " +
-                                  b.string());
+  const auto [bad, msg] = capture(std::string(MCFBENCH_BINARY) + " distance " +
+                                  (dir / "missing.off").string() + " " + b.string());
   EXPECT_NE(bad, 0);
   EXPECT_NE(msg.find("missing.off"), std::string::npos) << msg;
   fs::remove_all(dir);
@@ -56,7 +59,8 @@ TEST(DistanceCli, FilesAreComparedUnscaled) {
 
 TEST(DistanceCli, MeshSpecsWork) {
   const auto [status, out] =
-      capture(std::string(MCFBENCH_BINARY) + " distance icosphere:level=3 icosphere:level=3 --samples 1000");
+      capture(std::string(MCFBENCH_BINARY) +
+              " distance icosphere:level=3 icosphere:level=3 --samples 1000");
   ASSERT_EQ(status, 0) << out;
   EXPECT_LT(nlohmann::json::parse(out).at("max").get<double>(), 1e-12);
 }

@@ -42,7 +42,8 @@ TEST(Progress, LinesModePrintsAHeartbeatOnlyEveryLineSecondsAndNotAtTheEnd) {
     p.update_at(300.0, 100);  // the caller reports completion itself
     p.finish();
   }
-  EXPECT_EQ(out.text(), "step 20/100  60.0 s  left 240.0 s\nstep 40/100  120.5 s  left 180.8 s  cycle 2\n");
+  EXPECT_EQ(out.text(),
+            "step 20/100  60.0 s  left 240.0 s\nstep 40/100  120.5 s  left 180.8 s  cycle 2\n");
 }
 
 TEST(Progress, LinesModeWithZeroSecondsPrintsEveryUpdateButTheLast) {
@@ -89,7 +90,8 @@ TEST(Progress, LineSecondsComeFromTheEnvironmentAndABadValueNamesTheVariable) {
       progress_line_seconds();
       ADD_FAILURE() << bad << " accepted";
     } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("MCFBENCH_PROGRESS_SECONDS"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("MCFBENCH_PROGRESS_SECONDS"), std::string::npos)
+          << e.what();
       EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
     }
   }
