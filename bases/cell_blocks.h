@@ -1,6 +1,6 @@
 #pragma once
-// The per-cell kernel of SetSystemMatrices (Chuang & Kazhdan 2011, Sec. 4; DESIGN.md "Octree
-// trilinear B-spline basis"): the 8x8 mass and stiffness blocks of one cell's corner functions,
+// The per-cell kernel of SetSystemMatrices (Chuang & Kazhdan 2011, Sec. 4; docs/design.md "The
+// octree basis"): the 8x8 mass and stiffness blocks of one cell's corner functions,
 // summed over the cell's cubature points,
 //   M_ab += w_m β_a β_b,      K_ab += (η_a, μ_a) S (η_b, μ_b)ᵀ,
 // where β are the trilinear values and (η, μ) the gradients in an orthonormal frame (e1, e2) of

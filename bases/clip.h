@@ -1,7 +1,7 @@
 #pragma once
-// Clipping of a triangle mesh to the finest grid cells (DESIGN.md "Clipping"): every triangle is
-// split by the planes x = o_x + i h, y = o_y + j h, z = o_z + k h into convex pieces, one per
-// cell, which are fan-triangulated.
+// Clipping of a triangle mesh to the finest grid cells (docs/design.md "The octree basis"): every
+// triangle is split by the planes x = o_x + i h, y = o_y + j h, z = o_z + k h into convex pieces,
+// one per cell, which are fan-triangulated.
 //
 // Robustness: the split of a convex polygon by a plane uses exact sign tests on the coordinate
 // (points exactly on the plane go to both sides, a polygon lying in the plane goes to one side

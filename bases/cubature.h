@@ -1,6 +1,6 @@
 #pragma once
-// Triangle cubature rules in barycentric coordinates (DESIGN.md "Octree trilinear B-spline
-// basis"). Weights sum to 1, so  ∫_T f dA ≈ |T| Σ_q ω_q f(Σ_i b_qi v_i).
+// Triangle cubature rules in barycentric coordinates (docs/design.md "The octree basis").
+// Weights sum to 1, so  ∫_T f dA ≈ |T| Σ_q ω_q f(Σ_i b_qi v_i).
 
 #include <array>
 #include <vector>

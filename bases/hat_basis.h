@@ -1,6 +1,6 @@
 #pragma once
 // The hat (piecewise-linear, P1) basis: one function per vertex, cotangent stiffness and a
-// consistent (or lumped) mass matrix (DESIGN.md "Conventions").
+// consistent (or lumped) mass matrix (docs/design.md "Conventions").
 
 #include "bases/basis.h"
 #include "bases/fixed_pattern.h"

@@ -1,5 +1,5 @@
 #pragma once
-// The octree that indexes trilinear B-splines (DESIGN.md "Octree trilinear B-spline basis").
+// The octree that indexes trilinear B-splines (docs/design.md "The octree basis").
 // A grid of depth d over a cube (origin, side); cell (i,j,k) at depth l is the box
 // origin + h_l [i,i+1]x[j,j+1]x[k,k+1], h_l = side / 2^l; function (i,j,k) at depth l is centred
 // at the grid vertex origin + h_l (i,j,k). Cells and functions of a level are stored sorted by

@@ -1,5 +1,5 @@
 #pragma once
-// The rebuilt octree basis (DESIGN.md "Octree trilinear B-spline basis", "Rebuilt"): the CLB*09
+// The rebuilt octree basis (docs/design.md "The octree basis", rebuilt): the CLB*09
 // baseline that builds the octree, clips the mesh and integrates with the identity metric on the
 // current vertex positions at every step.
 

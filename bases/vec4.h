@@ -2,7 +2,8 @@
 // Four doubles as one value (GCC/Clang vector extensions: one AVX register when compiled for it,
 // emulated otherwise), for the integration kernels of the octree bases: bases/cell_blocks.h holds
 // a point's 8 corner lanes in two of them, bases/tracked_octree_basis.cpp four cubature points in
-// one. (solvers/multigrid.cpp has its own copy: solvers may not include bases, DESIGN.md "Layers".)
+// one. (solvers/multigrid.cpp has its own copy: solvers may not include bases, docs/design.md
+// "Layers".)
 
 #include <algorithm>
 #include <cmath>

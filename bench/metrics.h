@@ -1,6 +1,7 @@
 #pragma once
-// Metrics of DESIGN.md "Metrics" beyond those the flow records itself (radial error, residuals,
-// step difference, timings): Metro-style mesh distance, quasi-conformal error, sphericity.
+// Metrics of docs/experiments.md "Metrics" beyond those the flow records itself (radial error,
+// residuals, step difference, timings): Metro-style mesh distance, quasi-conformal error,
+// sphericity.
 
 #include "datasets/mesh.h"
 
@@ -22,7 +23,7 @@ MeshDistance mesh_distance(const TriangleMesh& a, const TriangleMesh& b, long lo
                            std::uint64_t seed = 1);
 
 /// Area-weighted (initial areas) mean over triangles of σ_max/σ_min of the affine map from the
-/// initial triangle to the current one (1 for a conformal map; cMCF paper, DESIGN.md).
+/// initial triangle to the current one (1 for a conformal map; as the cMCF paper's authors log it).
 /// Triangles degenerate initially or now (σ_min = 0: infinite ratio) are left out of the mean
 /// and of the weights; NaN when no triangle is left. Throws if the vertex counts differ.
 double quasi_conformal_error(const TriangleMesh& initial, const Positions& current);

@@ -1,6 +1,6 @@
 #pragma once
 // The triangle mesh value type every layer exchanges: plain Eigen arrays, no topology.
-// OpenMesh is used for STL I/O and topology checks only (DESIGN.md, practical notes;
+// OpenMesh is used for STL I/O and topology checks only (docs/design.md "Libraries";
 // datasets/mesh_io.h).
 
 #include <Eigen/Core>

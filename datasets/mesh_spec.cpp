@@ -298,8 +298,8 @@ MeshSource load_mesh_spec(const std::string& spec) {
       if (name == "sphere" || name == "icosphere") src.sphere_radius = values.at("radius");
       if (name == "open_cylinder") src.cylinder_radius = values.at("radius");
       // The spiral stands in for the paper's cubical spiral *model*, and the paper scales every
-      // model but the sphere into the unit cube (DESIGN.md "Datasets"): so does this one, or
-      // table1's δ and octree would see a 2 x 2 x 3.6 shape instead.
+      // model but the sphere into the unit cube (docs/design.md "Conventions"): so does this one,
+      // or table1's δ and octree would see a 2 x 2 x 3.6 shape instead.
       if (name == "spiral") {
         src.analytic = false;
         fit_unit_cube(src.mesh);

@@ -109,7 +109,7 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
 }
 
 void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::string& source) {
-  // An open surface's boundary is held where it is (DESIGN.md "Open surfaces"; the cMCF paper
+  // An open surface's boundary is held where it is (docs/design.md "Conventions"; the cMCF paper
   // flows an open surface with its boundary fixed), while unit-area normalisation rescales and
   // recentres the whole surface every step: the held boundary would move with it (a loop grew by
   // 24% in 8 steps of cMCF on the mannequin). The two contradict each other, so refuse.

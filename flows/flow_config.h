@@ -13,7 +13,7 @@ namespace mcf {
 struct OctreeConfig {
   std::string tracking = "tracked";  ///< tracked | rebuilt
   int depth = 8;                     ///< finest level, 4..10
-  int cubature = 3;                  ///< 1 | 3 | 6 (rule's name, DESIGN.md "Octree")
+  int cubature = 3;                  ///< 1 | 3 | 6 (rule's name, docs/design.md)
   std::string cube = "auto";         ///< auto | unit | tight
   bool refine_input = false;         ///< 1-to-4 split of the initial mesh first (Fig. 6, blue)
 };

@@ -30,7 +30,7 @@ class SemiImplicitEuler final : public Integrator {
   }
 };
 
-// Two-step schemes start with one semi-implicit Euler step (DESIGN.md).
+// Two-step schemes start with one semi-implicit Euler step (docs/design.md "Time integrators").
 class TwoStep : public Integrator {
  public:
   explicit TwoStep(bool extrapolate) : extrapolate_(extrapolate) {}

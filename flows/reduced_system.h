@@ -1,9 +1,10 @@
 #pragma once
 // Solving (a M + b K) Y = R with some functions held fixed. The basis's locked functions (open
-// boundaries, DESIGN.md) are eliminated, so the system the solver sees stays symmetric positive
-// definite. Functions whose row is empty this step (no cubature point contributes: the paper's
-// "anchoring" through a pinch) are held too instead of making the matrix singular: in place,
-// by a diagonal entry and a matching right-hand side, so the pattern does not change with them.
+// boundaries, docs/design.md "Conventions") are eliminated, so the system the solver sees stays
+// symmetric positive definite. Functions whose row is empty this step (no cubature point
+// contributes: the paper's "anchoring" through a pinch) are held too instead of making the matrix
+// singular: in place, by a diagonal entry and a matching right-hand side, so the pattern does not
+// change with them.
 // With no function held (a closed surface) M and K go to the solver as they are
 // (LinearSolver::set_matrix_sum), so the sum is not stored here as well.
 // The reduced pattern and the restricted hierarchy are rebuilt only when the eliminated set

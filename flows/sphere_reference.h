@@ -1,5 +1,5 @@
 #pragma once
-// Analytic radii of a sphere of radius r0 under each flow (DESIGN.md "Conventions"):
+// Analytic radii of a sphere of radius r0 under each flow (docs/design.md "Conventions"):
 //   MCF and cMCF, semi-implicit:  r_{n+1} = r_n³ / (r_n² + 2δ)    continuous: r(t) = sqrt(r0² - 4t)
 //   heat flow (operators of t=0): r_{n+1} = r_n / (1 + 2δ/r0²)     continuous: r0 exp(-2t/r0²)
 // (On a sphere K x = (2/r²) M x; cMCF keeps K_0 but M scales with the area, so its radius

@@ -86,7 +86,7 @@ def summary(cells, out_dir, reference, written):
         ["model", "flow", "dt", "status", "stop step", "reason", "last ‖ΔX‖", "last QC error", "last sphericity"], rows)
     analytic = analytic_rows(cells)
     if analytic:
-        text += ("\n\n## Analytic radii: sphere (DESIGN.md) and the middle ring of a long open cylinder "
+        text += ("\n\n## Analytic radii: sphere and the middle ring of a long open cylinder "
                  "(SGP 2012 Table 1)\n\nThe measured radius (the sphere's mean vertex radius, the "
                  "cylinder's middle ring) against the semi-implicit recursion of the same δ and the "
                  "continuous solution, at the last step; on the cylinder MCF, cMCF and heat differ "

@@ -2,7 +2,7 @@
 """Shared helpers for the report scripts: loading result files, labelling variants,
 reference values, figure style and provenance sidecars.
 
-Reports read result JSON only (DESIGN.md "Layers"); nothing here runs a flow.
+Reports read result JSON only (docs/design.md "Layers"); nothing here runs a flow.
 """
 
 import contextlib

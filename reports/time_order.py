@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""SGI note / DESIGN.md time_order study: error vs time step (log-log) per integrator with
+"""SGI note / time_order study (docs/studies.md): error vs time step (log-log) per integrator with
 fitted convergence slopes, and a Markdown table of fitted orders and the largest stable dt."""
 
 import math
@@ -31,7 +31,7 @@ def setting(result):
 def reference_runs(cells):
     """Per setting() (flow, mesh, quick flag), the run with the smallest dt among second-order
     extrapolated schemes (Crank-Nicolson, else BDF2): the temporal reference. Measuring against it
-    on the same mesh cancels the spatial error (DESIGN.md 'Time integrators'); against sqrt(1-4t)
+    on the same mesh cancels the spatial error (docs/design.md 'Conventions'); against sqrt(1-4t)
     the mesh puts a floor under every scheme."""
     refs = {}
     for name in ("crank-nicolson", "bdf2"):
@@ -133,8 +133,8 @@ def fitted_points(pts, unstable):
     return [p for p in pts if p is not edge]
 
 
-# Integrators in the order DESIGN.md lists them: each keeps its colour and marker in every
-# flow's panel, so one integrator reads the same in the mcf and the heat panel.
+# Integrators in the order docs/design.md "Time integrators" lists them: each keeps its colour and
+# marker in every flow's panel, so one integrator reads the same in the mcf and the heat panel.
 INTEGRATORS = ("explicit-euler", "semi-implicit", "crank-nicolson", "bdf2", "taylor2", "neumann2")
 MARKERS = "osD^vP*Xhp<>"
 

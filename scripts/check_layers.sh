@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fails if a layer includes a header of a layer above it (DESIGN.md "Layers").
+# Fails if a layer includes a header of a layer above it (docs/design.md "Layers").
 root=${1:-$(dirname "$0")/..}
 order=(datasets bases solvers flows bench tools)
 # solvers sits beside bases (neither may include the other).

@@ -33,7 +33,7 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # Real meshes: libcgal-demo's data.tar.gz. Installing the package pulls in Qt, so download the
-# .deb and unpack it into a cache instead (DESIGN.md, practical notes).
+# .deb and unpack it into a cache instead (docs/flow.md "Mesh specs").
 cache="${MCFBENCH_CACHE:-$HOME/.cache/mcfbench}"
 archive=/usr/share/doc/libcgal-dev/data.tar.gz
 if [ ! -f "$archive" ] && [ ! -f "$cache/cgal-demo/usr/share/doc/libcgal-dev/data.tar.gz" ]; then

@@ -1,5 +1,5 @@
 #pragma once
-// Preconditioned conjugate gradients on a block of right-hand sides (DESIGN.md "Layers",
+// Preconditioned conjugate gradients on a block of right-hand sides (docs/design.md "Layers",
 // solvers/): k independent CG recurrences that share one pass over A per iteration (the
 // flows always solve x, y, z together, so the matrix is streamed once instead of three times).
 //

@@ -1,7 +1,7 @@
 // The octree mass and stiffness against a brute-force assembly written straight from the
-// definitions (DESIGN.md "Octree trilinear B-spline basis"), sharing no code with the bases'
-// per-cell kernel (bases/cell_blocks.h), its tiles or its slot table: every function is evaluated
-// from B_ijk(p) = Π_a max(0, 1 - |p_a/h - idx_a|), gradients are projected onto the piece's plane
+// definitions (docs/design.md "The octree basis"), sharing no code with the bases' per-cell kernel
+// (bases/cell_blocks.h), its tiles or its slot table: every function is evaluated from B_ijk(p) =
+// Π_a max(0, 1 - |p_a/h - idx_a|), gradients are projected onto the piece's plane
 // in 3-D (no tangent frame), and entries are summed into a dense map keyed by (I, J).
 //   rebuilt:  M_IJ = Σ w B_I B_J,            K_IJ = Σ w ∇_T B_I · ∇_T B_J
 //   tracked:  dX = Σ_I x_I ⊗ ∇_T B_I (3x3, rank 2 on the tangent plane), g = dXᵀdX on the plane,

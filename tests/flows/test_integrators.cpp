@@ -68,7 +68,8 @@ TEST(Integrators, LinearOrders) {
 
 TEST(Integrators, NonlinearNeedsExtrapolation) {
   // With an embedding-dependent mass, CN and BDF2 are second order only when the operators are
-  // evaluated at the extrapolated X*; frozen at X_n they drop to first order (DESIGN.md).
+  // evaluated at the extrapolated X*; frozen at X_n they drop to first order (docs/design.md
+  // "Time integrators").
   const double mu = 0.5, T = 1.0;
   const double reference = final_value("crank-nicolson", 1e-4, T, mu, true);
   EXPECT_NEAR(observed_order("crank-nicolson", mu, true, reference), 2.0, 0.2);

@@ -1,4 +1,5 @@
-// Flows on the sphere against analytic radii (DESIGN.md "Conventions"), and against each other.
+// Flows on the sphere against analytic radii (docs/design.md "Conventions"), and against each
+// other.
 
 #include "flow_test_util.h"
 
@@ -39,7 +40,7 @@ TEST(SphereFlows, SemiImplicitRadiusConvergesUnderRefinement) {
 
 TEST(SphereFlows, SphereOfRadiusTwoFollowsTheContinuousRadii) {
   // r0 = 2 (so a formula that drops r0 fails): MCF r(t) = sqrt(r0² - 4t), heat flow
-  // r0 exp(-2t/r0²) (DESIGN.md "Conventions"). At t = 0.5 they are 1.414 and 1.558.
+  // r0 exp(-2t/r0²) (docs/design.md "Conventions"). At t = 0.5 they are 1.414 and 1.558.
   const double r0 = 2, dt = 2e-3, T = 0.5;
   const int steps = int(std::lround(T / dt));
   for (const char* flow : {"mcf", "heat"}) {
@@ -170,8 +171,9 @@ TEST(SphereFlows, NormalizationKeepsUnitArea) {
   EXPECT_LT(V.colwise().mean().norm(), 1e-12);
 }
 
-// Temporal order on MCF, measured as DESIGN.md says: against a run with a much smaller δ on
-// the same mesh, so the spatial error cancels (against sqrt(1-4t) it puts a floor under it).
+// Temporal order on MCF, measured as docs/design.md "Conventions" says: against a run with a much
+// smaller δ on the same mesh, so the spatial error cancels (against sqrt(1-4t) it puts a floor
+// under it).
 double temporal_error(const std::string& integrator, double dt, double T, bool extrapolate,
                       const Positions& reference, const std::string& mesh) {
   const auto o = run(json{{"mesh", mesh},
