@@ -1,6 +1,6 @@
 #pragma once
 // A finite-element basis turns a mesh (and the current coefficients) into a mass matrix, a
-// stiffness matrix and optionally a multigrid hierarchy (DESIGN.md "Layers", "Conventions").
+// stiffness matrix and optionally a multigrid hierarchy (docs/design.md "Layers", "Conventions").
 //   mass      M_IJ = ∫ B_I B_J dA          stiffness K_IJ = ∫ ∇B_I · ∇B_J dA  (K is PSD)
 // Coefficients x (dimension x 3) describe the embedding X = Σ_I x^I B_I; vertices are recovered
 // with evaluate_vertices.
@@ -20,7 +20,7 @@ namespace mcf {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 /// A read-only view of a compressed matrix stored elsewhere. Bases hand out mass() and stiffness()
 /// as views so that the two can share one pattern's index arrays (every basis here assembles both
-/// on the pattern of its function pairs): at depth 9 a second copy of the row indices is 94 MB.
+/// on the pattern of its function pairs), which are as large as the values themselves.
 using SparseView = Eigen::Map<const SparseMatrix>;
 using Coefficients = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 
@@ -70,7 +70,7 @@ class Basis {
   /// Vertex positions of the original mesh's vertices under coefficients x.
   virtual Positions evaluate_vertices(const Coefficients& x) const = 0;
 
-  /// Functions held at their current value (open boundaries, DESIGN.md "Octree", "Open surfaces").
+  /// Functions held at their current value (open boundaries: docs/design.md "Conventions").
   virtual std::vector<int> locked_functions() const = 0;
 
   /// Multigrid hierarchy (coarsest level first); empty for bases without one.

@@ -1,10 +1,10 @@
 #pragma once
-// Integration of trilinear B-splines over clipped pieces (DESIGN.md "Octree trilinear B-spline
-// basis"): per piece and cubature point the weight w = area·ω, the 8 values of the cell's corner
-// functions and their gradients in an orthonormal frame of the piece's plane (cell_blocks.h);
-// mass and stiffness are accumulated into a sparsity pattern built once per octree level. Also the
-// multigrid hierarchy (prolongations, parity colours) and vertex evaluation. The pieces are exposed
-// so the tracked basis can reuse them.
+// Integration of trilinear B-splines over clipped pieces (docs/design.md "The octree basis"): per
+// piece and cubature point the weight w = area·ω, the 8 values of the cell's corner functions and
+// their gradients in an orthonormal frame of the piece's plane (cell_blocks.h); mass and stiffness
+// are accumulated into a sparsity pattern built once per octree level. Also the multigrid hierarchy
+// (prolongations, parity colours) and vertex evaluation. The pieces are exposed so the tracked
+// basis can reuse them.
 
 #include "bases/basis.h"
 #include "bases/clip.h"
@@ -80,8 +80,8 @@ class OctreeSystem {
   /// A matrix with this pattern and zero values (compressed, full symmetric storage).
   SparseMatrix pattern() const;
   /// Values on this pattern (non_zeros() of them, in CSC order) seen as a matrix: mass and
-  /// stiffness share the system's index arrays instead of each carrying a copy (~100 MB each
-  /// at depth 9). The view is valid while the system and `values` are alive and unresized.
+  /// stiffness share the system's index arrays instead of each carrying a copy. The view is valid
+  /// while the system and `values` are alive and unresized.
   SparseView view(const std::vector<double>& values) const {
     return view_of(outer_, inner_, values);
   }
@@ -165,7 +165,7 @@ class OctreeSystem {
   }
 
   /// For the tracked basis, once it holds its own compact copy of the pieces: frees what only
-  /// assemble() reads — the pieces' cells and order (~52 MB at depth 9). The pattern, the masks,
+  /// assemble() reads — the pieces' cells and order. The pattern, the masks,
   /// the tiles and cell_start() stay, so add_cell_blocks() and view() still work; assemble()
   /// then throws.
   void release_pieces();

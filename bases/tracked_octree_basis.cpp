@@ -88,7 +88,7 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   stencils_ = vertex_stencils(octree, mesh.vertices, mesh.faces);
   // From here on only the compact corners are read: the rebuilt basis's pieces are freed and its
   // assembled matrices become ours, so the first update only resets their values (a fresh copy of
-  // the pattern, ~0.28 GB per matrix at depth 9, cost more than the update itself in page faults).
+  // the pattern cost more than the update itself in page faults).
   initial_->release_assembly(mass_, stiffness_);
   const double preprocess = seconds_since(t0);
 

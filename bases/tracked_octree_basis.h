@@ -1,9 +1,9 @@
 #pragma once
-// The tracked octree basis (Chuang & Kazhdan 2011, Section 4; DESIGN.md "Tracked"): the octree,
-// the clipping, the cubature and the multigrid hierarchy are built once on X_0; the test
-// functions are pulled back to the initial surface, so each step only re-integrates the metric
-// g = dXᵀdX of the current coefficients (the paper's SetSystemMatrices / ComputeDifferential /
-// EvaluateVertex).
+// The tracked octree basis (Chuang & Kazhdan 2011, Section 4; docs/design.md "The octree basis",
+// tracked): the octree, the clipping, the cubature and the multigrid hierarchy are built once on
+// X_0; the test functions are pulled back to the initial surface, so each step only re-integrates
+// the metric g = dXᵀdX of the current coefficients (the paper's SetSystemMatrices /
+// ComputeDifferential / EvaluateVertex).
 //
 // Layout (Section 5.5 stores 25 floats per cubature point): we store per split triangle only its
 // corners in its cell's local coordinates. Cubature points, the 8 trilinear values and
@@ -14,8 +14,7 @@
 // that order, so the corners are stored as fans: a piece that continues the previous one's fan
 // (the same p0, its p1 the previous p2, bitwise) stores only its new corner (3 doubles instead of
 // 9) and a flag. The corners read are the very same doubles, so M and K are bitwise those of
-// storing 9 per piece; at depth 9 the armadillo needs 28% fewer bytes (17.4 per cubature point
-// instead of 24.1: 45% of its pieces continue a fan).
+// storing 9 per piece (bytes per cubature point: docs/octree-multigrid.md "Assembly").
 
 #include "bases/octree_basis.h"
 
@@ -30,8 +29,8 @@ class TrackedOctreeBasis final : public Basis {
 
   std::string name() const override { return "octree-tracked"; }
   Eigen::Index dimension() const override { return initial_->dimension(); }
-  /// The identity embedding: the finest functions' node positions (computed on each call, not
-  /// kept: 31 MB at depth 9, and the flow asks once).
+  /// The identity embedding: the finest functions' node positions (computed on each call rather
+  /// than kept beside the coefficients: the flow asks once).
   Coefficients initial_coefficients() const override { return initial_->initial_coefficients(); }
 
   /// Re-integrates M and/or K at coefficients x: for each cubature point, dX = Σ_I x^I (η^I, μ^I),

@@ -1,5 +1,5 @@
 // Micro-benchmarks of the hat basis and the direct/iterative solvers on a paper-sized mesh
-// (issue 2): hat assembly, CHOLMOD refactorization + solve, PCG solve.
+// (docs/benchmarks.md): hat assembly, CHOLMOD refactorization + solve, PCG solve.
 // Mesh: $MCFBENCH_BENCH_MESH (default cgal:armadillo@faces=832000).
 
 #include "bases/hat_basis.h"

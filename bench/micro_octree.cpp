@@ -1,20 +1,20 @@
-// Micro-benchmarks of the octree bases and the multigrid solver (issues 3 and 4).
+// Micro-benchmarks of the octree bases and the multigrid solver (docs/benchmarks.md).
 //
-// Rebuilt phases (issue 3) on two paper-sized meshes:
+// Rebuilt phases on two paper-sized meshes:
 //   arm  = cgal:armadillo@faces=832000 at depth 9 (unit cube), δ = 1e-5
 //   sph  = sphere:vertices=370000 at depth 8 (tight cube),     δ = 1e-3
 // octree build, clipping, integration, hierarchy (prolongations + colours), one V-cycle, one
 // W-cycle (5 GS sweeps, 3 right-hand sides, warm start x = c on (M + δK) x = M c), one fine SpMV
 // with 3 columns, and the counter wcycle_over_spmv = (one W-cycle) / (one fine SpMV).
 //
-// Per-step comparisons (issue 4) on the armadillo at depth 9, one W-cycle, 5 GS sweeps:
+// Per-step comparisons on the armadillo at depth 9, one W-cycle, 5 GS sweeps:
 //   BM_Step_Tracked/threads:T  update(x,true,true) + set_matrix_sum(M, δ, K) (pattern key:
 //                              values only) + W-cycle + evaluate
 //   BM_Step_Rebuilt/threads:2  rebuild(vertices) + set_matrix_sum(M, δ, K) (fresh solver: new
 //                              pattern) + W-cycle + evaluate
 //   BM_Step_HatCholmod/threads:2  hat update + M+δK + CHOLMOD refactorize + solve
 //                              (symbolic analysis outside the loop)
-// Ratios: bench/summarize_micro.py turns the JSON into the README table.
+// Ratios: summarize_micro.py turns the JSON into the tables of docs/benchmarks.md.
 //
 // Fixtures are large (several GB at depth 9 on 832k faces), so only one lives at a time: taking
 // one frees the previous. Keep benchmarks that share a fixture next to each other.
@@ -52,10 +52,9 @@ using Clock = std::chrono::steady_clock;
 
 // Warm-up: every step and cycle benchmark runs its body once untimed before the timed
 // iterations. The first solve allocates the multigrid's per-level buffers (and the first CHOLMOD
-// factorization its factor); on the KVM guests we measure on, first use of memory the process
-// has not had before costs ~5 ms per MB (the host backs the pages then), so the first iteration
-// of the tracked step took ~0.8 s longer than the others and, averaged over 5 iterations,
-// inflated its solve by ~40%. The steady state is what a flow of many steps sees.
+// factorization its factor); on virtual machines the first use of memory the process has not had
+// before is slow (the host backs the pages then), enough to distort an average of a few steps
+// (docs/benchmarks.md). The steady state is what a flow of many steps sees.
 
 struct Case {
   std::string spec;

@@ -1,7 +1,7 @@
 // Mesh file I/O. OFF, OBJ and PLY are walked here (and in ply_format.cpp) once, in exact doubles,
 // with errors that name the line; OpenMesh's half-edge insertion then checks the topology, which
 // its own readers would instead repair silently by dropping faces or duplicating vertices
-// (DESIGN.md, practical notes). Binary OFF is walked here too, in the layout OpenMesh reads. STL
+// (docs/flow.md "Formats"). Binary OFF is walked here too, in the layout OpenMesh reads. STL
 // is read by OpenMesh, in the layout (ASCII or binary) decided here rather than by its guess from
 // the file's length, and checked by counts, after a streaming pass that checks its lines.
 
@@ -613,13 +613,12 @@ struct StlLayout {
   long long triangles = 0;  // ASCII: the facets OpenMesh opens ('outer' lines, AsciiStlLines)
 };
 
-// A file is ASCII if it starts with "solid", in any case (until 2026-11-25 a file in capitals was
-// taken for binary), and its first 84 + 1 MiB bytes are text: some binary exporters start their
-// header with "solid" too, and words like "facet" after it (until 2026-11-25 the word "facet"
-// anywhere in the file made it ASCII). An ASCII file is streamed in an 84-byte head and then
-// 1 MiB chunks, never held whole, and the same pass checks its lines (AsciiStlLines) and counts
-// its facets. Any other file is binary, and is not read here beyond
-// its header and its length (OpenMesh reads it next). Vertices are merged by OpenMesh (STL has no
+// A file is ASCII if it starts with "solid", in any case (a file in capitals is ASCII too), and its
+// first 84 + 1 MiB bytes are text: some binary exporters start their header with "solid" too, and
+// words like "facet" after it, so no word in the file decides it. An ASCII file is streamed in an
+// 84-byte head and then 1 MiB chunks, never held whole, and the same pass checks its lines
+// (AsciiStlLines) and counts its facets. Any other file is binary, and is not read here beyond its
+// header and its length (OpenMesh reads it next). Vertices are merged by OpenMesh (STL has no
 // shared vertices), so their count is unknown in advance.
 StlLayout scan_stl(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

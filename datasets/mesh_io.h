@@ -34,9 +34,8 @@ enum class FaceCheck {
   half_edge,
   /// The caller vouches that the faces passed that check already: a flow writing its frames and
   /// final mesh with the faces of a MeshSource (checked by load_mesh_spec), which no flow
-  /// changes. Building the half-edge mesh again was four fifths of writing a frame (binary PLY of
-  /// the 832k-face armadillo: 0.25 s with it, 0.053 s without). STL, which OpenMesh writes from
-  /// a half-edge mesh, is checked anyway.
+  /// changes. Building the half-edge mesh again would be most of the cost of writing a frame.
+  /// STL, which OpenMesh writes from a half-edge mesh, is checked anyway.
   trusted,
 };
 

@@ -1,6 +1,6 @@
 #pragma once
 // Mesh validation: fatal problems throw MeshError naming the mesh and the problem; the rest is
-// reported (DESIGN.md "datasets", issue 2).
+// reported (docs/flow.md "Validation").
 
 #include "datasets/mesh.h"
 #include "datasets/mesh_error.h"

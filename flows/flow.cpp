@@ -112,8 +112,7 @@ class FlowStepContext final : public StepContext {
   std::unique_ptr<ReducedSystem> system_;
   std::string flow_;
   double dt_;
-  // The caller's iterates, which outlive the step: read in place, not copied (31 MB each at
-  // depth 9).
+  // The caller's iterates, which outlive the step: read in place, not copied.
   const Coefficients* x_ = nullptr;
   const Coefficients* x_prev_ = nullptr;
   bool assembled_ = false;

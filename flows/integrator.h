@@ -1,5 +1,5 @@
 #pragma once
-// Time integrators (DESIGN.md "Time integrators"; A = -M⁻¹K).
+// Time integrators (docs/design.md "Time integrators"; A = -M⁻¹K).
 
 #include "flows/step_context.h"
 
@@ -15,7 +15,7 @@ class Integrator {
   virtual std::string name() const = 0;
   /// Returns X_{n+1}. Leaves the operators as evaluated for this step.
   virtual Coefficients step(StepContext& ctx) = 0;
-  /// Whether step() reads X_{n-1} (ctx.previous()): the flow keeps it only then (31 MB at depth 9).
+  /// Whether step() reads X_{n-1} (ctx.previous()): the flow keeps that copy only then.
   virtual bool uses_previous() const { return false; }
 };
 

@@ -34,7 +34,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
   const Eigen::Index n = M.rows();
   // S = a M + b K. Bases assemble M and K on one pattern: then S is a value-wise sum, and it is
   // formed here only when functions are held (below); otherwise the solver forms it itself
-  // (set_matrix_sum), so no copy of it is kept here (0.28 GB at depth 9).
+  // (set_matrix_sum), so no copy of it, as large as M, is kept here.
   const bool shared = shares_pattern(M, K);
   if (!shared) sum_ = general_sum(a, M, b, K);
 
@@ -69,7 +69,7 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
     } else {
       report_ = solver_.set_matrix(sum_, view);
     }
-    Coefficients X = warm;  // solved in place: no n x 3 copies in and out (31 MB each at depth 9)
+    Coefficients X = warm;  // solved in place: no n x 3 copies in and out
     solve_after_set(R, X);
     return X;
   }
@@ -214,7 +214,8 @@ void ReducedSystem::rebuild_reduction(const SparseMatrix& S) {
   reduced_.makeCompressed();
 
   // Restrict the finest prolongation's rows (and the finest colours) to the free functions; on
-  // coarser levels the correction at a fixed function is then zero (DESIGN.md "Open surfaces").
+  // coarser levels the correction at a fixed function is then zero (docs/octree-multigrid.md "Held
+  // functions").
   prolongations_.clear();
   colours_.clear();
   if (basis_.prolongations() && !basis_.prolongations()->empty()) {

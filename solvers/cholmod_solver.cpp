@@ -13,7 +13,7 @@ using Long = SuiteSparse_long;
 
 // CHOLMOD's default reaction to errors is to print (Common->print > 0) and call a user handler;
 // it never aborts, but the flows must stay silent and decide from the status themselves
-// (a non-SPD matrix means the flow turned singular, DESIGN.md "Studies" cmcf).
+// (a non-SPD matrix means the flow turned singular: docs/flow.md "Singular flows").
 void silent_error_handler(int /*status*/, const char* /*file*/, int /*line*/,
                           const char* /*message*/) {}
 
@@ -195,10 +195,10 @@ SolveReport CholmodSolver::set_matrix_sum(double a, const SparseRef& M, double b
   if (!summable(M, K)) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
   factor_ok_ = false;
   if (M.rows() != M.cols()) return fail(SolveStatus::failed, "matrix is not square");
-  // a M + b K straight into the lower triangle the factorization reads, no full sum kept (at
-  // depth 9 that matrix is 0.28 GB); each entry is sum_entry's, so the factor is bitwise that of
-  // set_matrix on sum_on_pattern's result. Only the lower triangle is formed, so only it is
-  // checked for NaN/inf (M and K are symmetric).
+  // a M + b K straight into the lower triangle the factorization reads, no full sum kept (it would
+  // be as large as M); each entry is sum_entry's, so the factor is bitwise that of set_matrix on
+  // sum_on_pattern's result. Only the lower triangle is formed, so only it is checked for NaN/inf
+  // (M and K are symmetric).
   const double *m = M.valuePtr(), *k = K.valuePtr();
   return factorize(M, hierarchy.pattern_key, [=](double* x, const int* gather, std::size_t count) {
     bool finite = true;

@@ -1,5 +1,5 @@
 #pragma once
-// Sparse direct solver: CHOLMOD supernodal LL^T (DESIGN.md "Layers", solvers/).
+// Sparse direct solver: CHOLMOD supernodal LL^T (docs/design.md "Layers", solvers/).
 // The symbolic analysis (fill-reducing ordering + supernodal structure) is the expensive part
 // that only depends on the sparsity pattern; the flows keep one pattern for a whole run (tracked
 // octree basis, hat basis on a fixed mesh), so it is computed once and only the numeric
@@ -81,7 +81,7 @@ class CholmodSolver final : public LinearSolver {
   KeptPattern kept_;           // the key of the cached pattern, the comparisons made
   // lower_->x[e] = A.valuePtr()[gather_[e]]: refreshing values is one gather, no pattern work.
   // Together with lower_'s own pattern it is also what a new A is compared against, so no copy
-  // of A's full pattern is kept (94 MB at depth 9). Positions in an int-indexed matrix: int.
+  // of A's full pattern is kept. Positions in an int-indexed matrix: int.
   std::vector<int> gather_;
 
   int analyses_ = 0;

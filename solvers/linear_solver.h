@@ -1,5 +1,5 @@
 #pragma once
-// One interface for every linear solver (DESIGN.md "Layers": a basis and a solver only meet
+// One interface for every linear solver (docs/design.md "Layers": a basis and a solver only meet
 // through the system they exchange). A solver is given a sparse symmetric positive-definite
 // matrix, optionally with a multigrid hierarchy, and solves several right-hand sides at once.
 
@@ -44,7 +44,7 @@ struct SolveReport {
 /// Multigrid hierarchy as plain arrays (levels ordered coarsest first; the finest level is the
 /// system's own). prolongations[l] maps level l to level l+1, so there are levels-1 of them.
 /// colours[l][i] in 0..7 is the Gauss-Seidel colour of function i on level l: functions of the
-/// same colour never couple (octree parity colouring, DESIGN.md "Multigrid").
+/// same colour never couple (octree parity colouring, docs/octree-multigrid.md).
 ///
 /// pattern_key: 0, or a key from new_pattern_key() by which the caller vouches that A's sparsity
 /// pattern, the prolongations (pattern and values) and the colours are exactly those of the
@@ -135,18 +135,17 @@ class LinearSolver {
 
   /// set_matrix(a M + b K) for M and K on one pattern (same_pattern: the caller checks; when
   /// summable() does not hold, the default below forms Eigen's general sum, whose pattern is the
-  /// union), bitwise the same, without the caller storing the sum:
-  /// at depth 9 that matrix is 0.28 GB. The default forms the sum in a matrix this object keeps
-  /// (the dense reference uses it); the multigrid, PCG and CHOLMOD solvers override it and write
-  /// a M + b K straight into the copy they keep anyway (the multigrid's permuted finest level,
-  /// PCG's matrix, CHOLMOD's lower triangle).
+  /// union), bitwise the same, without the caller storing the sum (as large as M itself). The
+  /// default forms the sum in a matrix this object keeps (the dense reference uses it); the
+  /// multigrid, PCG and CHOLMOD solvers override it and write a M + b K straight into the copy they
+  /// keep anyway (the multigrid's permuted finest level, PCG's matrix, CHOLMOD's lower triangle).
   virtual SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
                                      HierarchyView hierarchy = {});
 
-  /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers
-  /// use it; direct solvers ignore it) and the solution on exit. Any column-major matrix binds
-  /// to B and X without a copy (the flows' n x 3 Coefficients too: at depth 9 each copy was
-  /// 31 MB); X must have B's shape, else the report is `failed` and X is left alone.
+  /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers use
+  /// it; direct solvers ignore it) and the solution on exit. Any column-major matrix binds to B and
+  /// X without a copy (the flows' n x 3 Coefficients too); X must have B's shape, else the report
+  /// is `failed` and X is left alone.
   SolveReport solve(const ConstMatrixRef& B, MatrixRef X);
   /// The same for a resizable X: one of another shape than B's is first set to zero.
   SolveReport solve(const ConstMatrixRef& B, Eigen::MatrixXd& X);

@@ -49,7 +49,7 @@ void for_rows(int n, F&& f) {
 // The kernels below cost a few instructions per matrix entry and run at full speed only when
 // inlined into their loops: out of line, the two accumulators passed by reference go through
 // memory on every entry. GCC stopped inlining gather_sub and gather_sub_compact once they had a
-// few more call sites (a fine sweep at depth 9 went from 116 to 140-180 ms), so they are forced.
+// few more call sites (a fine sweep then took up to 1.5x as long), so they are forced.
 #define MCF_KERNEL_INLINE inline __attribute__((always_inline))
 
 /// Four doubles (GCC/Clang vector extensions: one AVX register when compiled for it, emulated
@@ -168,8 +168,8 @@ MCF_KERNEL_INLINE void transpose_rows(const Csc& M, const double* v, double* y, 
 ///   single precision (6 bytes an entry instead of CSC's 12).
 /// - Finest level (`aligned`): one offset per entry of the level's CSC matrix, whose columns store
 ///   their diagonal last (Impl::symbolic), so a row's off-diagonal entries are one run of the
-///   matrix's own values: 10 bytes an entry, and the largest matrix is stored once (a copy of its
-///   values was 0.18 GB at depth 9). Why not single precision here: a Gauss-Seidel update
+///   matrix's own values: 10 bytes an entry, and the largest matrix is stored once (no copy of its
+///   values beside it). Why not single precision here: a Gauss-Seidel update
 ///   x_i = (b_i - Σ a_ij x_j) / a_ii with rounded a_ij has the rounded system's solution as its
 ///   fixed point, so the finest level's sweeps would pull the iterate off A x = b (a test that
 ///   cycles to 1e-10 stalled at 2e-8); on a coarse level the sweeps only shape a correction of
@@ -316,7 +316,7 @@ void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatri
 // whole matrix (the interleaved rows defeated the hardware prefetchers: a sweep on the armadillo
 // at depth 9 took 2.1x as long in the solver, 3.5x in a stand-alone kernel benchmark), and the
 // rows a coarse function's support touches stay within a few tiles, which keeps the Galerkin
-// product's accumulators in cache (a global colour-major order made it 1.6x slower). DESIGN.md's
+// product's accumulators in cache (a global colour-major order made it 1.6x slower). The parity
 // 8-colour ordering and its iterates are unchanged. `perm[r]` is the caller's index of internal
 // row r, `inv` its inverse; both are empty for the identity.
 
@@ -522,10 +522,9 @@ struct MultigridSolver::Impl {
   /// Relaxation blocks of a coloured level (header, "Smoother ordering"): runs of `block_tiles`
   /// consecutive tiles, at least as many as the farthest coupling reaches (in tiles), so rows of
   /// block q couple only with blocks q-1, q, q+1 and blocks of one parity never couple.
-  /// Measured on the armadillo at depth 9 (reach 9 tiles, 2 threads): five fine sweeps
-  /// 176 -> ~100 ms with the compact smoother rows, the W-cycle 646 -> ~430 ms. A floor of
-  /// kMinBlockTiles (8) instead of 1 costs nothing measurable there and keeps small levels
-  /// from being cut into many tiny tasks.
+  /// A block's rows and iterates stay in cache through its eight colours (on the armadillo at
+  /// depth 9 the farthest coupling reaches 9 tiles). A floor of kMinBlockTiles (8) instead of 1
+  /// costs nothing measurable there and keeps small levels from being cut into many tiny tasks.
   static void find_blocks(Level& L) {
     L.block_tiles = 1;
     if (!L.coloured) return;

@@ -1,7 +1,7 @@
 #pragma once
-// Geometric multigrid on a given hierarchy (DESIGN.md "Multigrid"; Chuang & Kazhdan 2011, Sec. 5):
-// Galerkin coarse operators A_l = P_lᵀ A_{l+1} P_l, V- or W-cycles, colour-parallel Gauss-Seidel
-// smoothing, a direct (SimplicialLDLT) solve on the coarsest level.
+// Geometric multigrid on a given hierarchy (docs/octree-multigrid.md; Chuang & Kazhdan 2011,
+// Section 5): Galerkin coarse operators A_l = P_lᵀ A_{l+1} P_l, V- or W-cycles, colour-parallel
+// Gauss-Seidel smoothing, a direct (SimplicialLDLT) solve on the coarsest level.
 //
 // Determinism: every parallel kernel is a gather (each output entry is computed by exactly one
 // task, in a fixed order), and norms use a deterministic reduction, so results are bitwise
@@ -48,7 +48,7 @@
 // (symbolic_builds()); later set_matrix calls only recompute values: per coarse column J, v =
 // A_{l+1} P e_J in a thread-local dense accumulator, then the upper entries (I <= J) as dot
 // products P e_I · v, mirrored, so A_l is exactly symmetric and A P is never stored. Measured
-// numbers: README "Benchmarks" (bench/micro_octree.cpp).
+// numbers: docs/benchmarks.md (the micro-benchmarks BM_Rebuilt_Cycle, BM_Rebuilt_Sweep).
 
 #include "solvers/linear_solver.h"
 

@@ -273,10 +273,10 @@ TEST(OctreeBasis, SizesOfA40kSphereAtDepth7) {
       basis.octree().cube.side, s.split_triangles, s.dimension, s.cubature_points, s.levels,
       static_cast<long long>(basis.mass().nonZeros()), s.setup_seconds.at("octree"),
       s.setup_seconds.at("clip"), s.setup_seconds.at("integrate"), s.setup_seconds.at("hierarchy"));
-  // Pinned (measured 2026-11-24: 664,112 split triangles, dimension 148,828, 2,678,744
-  // nonzeros, 6 levels) to 0.1%, so a change in the clipping or in which functions the surface
-  // supports shows up here, not only in the README's numbers; the 3-point rule gives three
-  // cubature points per split triangle.
+  // Pinned (as measured: 664,112 split triangles, dimension 148,828, 2,678,744 nonzeros,
+  // 6 levels) to 0.1%, so a change in the clipping or in which functions the surface supports
+  // shows up here, not only in the studies' numbers; the 3-point rule gives three cubature points
+  // per split triangle.
   EXPECT_NEAR(double(s.split_triangles), 664112.0, 664.0);
   EXPECT_NEAR(double(s.dimension), 148828.0, 149.0);
   EXPECT_NEAR(double(basis.mass().nonZeros()), 2678744.0, 2679.0);

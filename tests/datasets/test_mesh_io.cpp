@@ -687,7 +687,7 @@ std::string ascii_stl_past_the_first_chunk(TempDir& dir, const TriangleMesh& m) 
 }
 
 // An ASCII STL is counted in chunks of 1 MiB read after its 84-byte head (mesh_io.cpp: the
-// facets its lines open; until 2026-11-25 the word "facet" made it ASCII). The count notices a
+// facets its lines open, not the word "facet", which a solid's name may hold). The count notices a
 // facet OpenMesh drops without an error (here a degenerate one), so a keyword missed or counted
 // twice at a chunk boundary would hide it or blame a wrong number.
 // One file per way a keyword can meet the first boundary, moved there by blanks ("fa|cet",

@@ -137,8 +137,8 @@ TEST(MeshSpec, FilesAreScaledIntoTheUnitCube) {
 }
 
 // Fitting rounds: (x - lo) s + offset can land an ulp below 0 or above 1 on the long axis
-// (cgal:bunny00's smallest x came out -2.1e-17), and the octree's "auto" cube then took the
-// tight cube instead of the unit cube the paper and README describe ("unit" refused the mesh).
+// (cgal:bunny00's smallest x came out -2.1e-17), and the octree's "auto" cube then took the tight
+// cube instead of the unit cube the paper and docs/flow.md describe ("unit" refused the mesh).
 // Seeded boxes with awkward extents: every fitted coordinate lies in [0, 1] (what choose_cube's
 // "auto" tests).
 TEST(MeshSpec, FittedMeshesLieInTheClosedUnitCube) {

@@ -1,5 +1,6 @@
-// Octree flows (issues 3 and 4): multigrid against CHOLMOD on the same system, the W-cycle's
-// residual reduction, tracked vs rebuilt vs the analytic sphere, thread independence, pinches.
+// Octree flows (docs/octree-multigrid.md): multigrid against CHOLMOD on the same system, the
+// W-cycle's residual reduction, tracked vs rebuilt vs the analytic sphere, thread independence,
+// pinches.
 
 #include "flow_test_util.h"
 
@@ -46,7 +47,8 @@ TEST(OctreeFlows, MultigridConvergesToCholmod) {
 
 TEST(OctreeFlows, PlainCyclesConvergeToCholmod) {
   // Plain V- and W-cycles (no Krylov acceleration) also reach the direct solution, only slowly
-  // on the restricted surface system (about 0.95 per cycle after the first few; README).
+  // on the restricted surface system (about 0.95 per cycle after the first few;
+  // docs/octree-multigrid.md "Convergence").
   json ch = octree("icosphere:level=4", "tracked", 5, {{"name", "cholmod"}});
   ch["steps"] = 1;
   const Positions b = run(ch).final_mesh.vertices;
@@ -67,7 +69,7 @@ TEST(OctreeFlows, PlainCyclesConvergeToCholmod) {
 TEST(OctreeFlows, MultigridCyclesReduceTheResidual) {
   // Plain W-cycles: the residual falls with every cycle. (On the restricted surface system the
   // convergence factor degrades after the first cycles — near-null modes of the restricted
-  // B-splines; see README — so this checks monotone decrease, not a rate.)
+  // B-splines; see docs/octree-multigrid.md — so this checks monotone decrease, not a rate.)
   json j = octree("icosphere:level=4", "tracked", 6, {{"name", "multigrid"}, {"cycles", 8}});
   j["steps"] = 1;
   const auto o = run(j);
@@ -141,7 +143,7 @@ TEST(OctreeFlows, TrackedFollowsTheSemiImplicitRadius) {
     EXPECT_LT(et, 1.5e-3)
         << solver.dump();  // the level-4 mesh alone is ~7e-4 off the sphere (sagitta)
     // Not merely no worse: an order of magnitude better (measured 8.6e-4 vs 4.6e-2 with CHOLMOD,
-    // 6.7e-4 vs 1.6e-2 with three W-cycles; the README's "2.2e-4 vs 1.2e-2" is level 5, depth 6).
+    // 6.7e-4 vs 1.6e-2 with three W-cycles; on a level-5 mesh at depth 6, 2.2e-4 vs 1.2e-2).
     // The rebuilt basis re-integrates the flat-faced mesh every step and drifts inward.
     EXPECT_LT(et, 0.1 * er) << solver.dump() << " tracked " << et << " rebuilt " << er;
     // The radius moved a lot (r² ≈ 1 - 4t), so this is not a trivially small error.
@@ -182,15 +184,15 @@ double mean_depth_of_faces(const TriangleMesh& mesh) {
 
 TEST(OctreeFlows, EachRebuildDropsTheVerticesTowardTheFlatFaces) {
   // Why the rebuilt basis drifts inward on the sphere, and why one W-cycle a step drifts less than
-  // an exact solve (README, "What to expect of the full sphere_error"). The octree functions see
-  // the whole flat-faced polyhedron, whose curvature sits on its edges, so an exact step moves the
-  // vertices (which lie on the sphere) toward the faces, which lie inside it by the mean depth D;
-  // the finer the octree against the edges, the more of D. The rebuilt basis starts every step
-  // from a flat-faced mesh again and pays this every step; the tracked surface X(triangle) is
-  // curved after the first step and pays it once. One W-cycle, warm-started from X_n, moves the
-  // vertices less than the exact solve does, so its error opposes the rebuilt basis's drop: the
-  // rebuilt basis with one cycle drifts less than with an exact solve (the tracked one, which has
-  // no drop to cancel, is left with the cycle's error alone).
+  // an exact solve (docs/studies.md "sphere_error"). The octree functions see the whole flat-faced
+  // polyhedron, whose curvature sits on its edges, so an exact step moves the vertices (which lie
+  // on the sphere) toward the faces, which lie inside it by the mean depth D; the finer the octree
+  // against the edges, the more of D. The rebuilt basis starts every step from a flat-faced mesh
+  // again and pays this every step; the tracked surface X(triangle) is curved after the first step
+  // and pays it once. One W-cycle, warm-started from X_n, moves the vertices less than the exact
+  // solve does, so its error opposes the rebuilt basis's drop: the rebuilt basis with one cycle
+  // drifts less than with an exact solve (the tracked one, which has no drop to cancel, is left
+  // with the cycle's error alone).
   const std::string mesh = "icosphere:level=4";
   const double D = mean_depth_of_faces(load_mesh_spec(mesh).mesh);
   EXPECT_NEAR(D, 7.04e-4, 0.2e-4);  // edge 0.0755: h²/8 = 7.1e-4

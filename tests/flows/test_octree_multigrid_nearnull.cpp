@@ -1,4 +1,5 @@
-// Why plain multigrid cycles stagnate on the octree surface system A = M + δK (mginvest branch).
+// Why plain multigrid cycles stagnate on the octree surface system A = M + δK
+// (docs/octree-multigrid.md "Convergence").
 // Evidence recorded as a test: the hierarchy is valid (all levels properly coloured), the
 // stagnation is not caused by functions with negligible support, and it comes from smooth 3-D
 // functions that nearly vanish on the surface (near-null modes of the restricted B-splines,

@@ -140,7 +140,7 @@ TEST(Cli, FlowWritesTheResultContract) {
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["steps"].size(), 4u);
   EXPECT_EQ(j["mesh"]["unreferenced_vertices"],
-            0);  // the README lists it beside genus and components
+            0);  // docs/design.md lists it beside genus and components
   EXPECT_EQ(j["mesh"]["genus"], 0);
   EXPECT_TRUE(j["steps"][0]["radial_error"].contains("rms_continuous"));
   for (const char* key : {"commit", "cpu", "cores", "threads", "libraries"})
