@@ -73,6 +73,12 @@ class Basis {
   /// Functions held at their current value (open boundaries: docs/design.md "Conventions").
   virtual std::vector<int> locked_functions() const = 0;
 
+  /// The band's normal-gradient matrix S_IJ = ∫ (n·∇B_I)(n·∇B_J) dV (bases/normal_gradient.h) on
+  /// the pattern of M and K, which the flows add, weighted, to the system of an increment
+  /// (docs/octree-multigrid.md, "Stabilization"). Empty (0 x 0) for a basis that has none (the hat
+  /// basis) or was not asked to assemble it; like mass(), valid until the next rebuild().
+  virtual SparseView normal_gradient() const;
+
   /// Multigrid hierarchy (coarsest level first); empty for bases without one.
   virtual const std::vector<SparseMatrix>* prolongations() const { return nullptr; }
   virtual const std::vector<std::vector<std::uint8_t>>* colours() const { return nullptr; }

@@ -1,5 +1,6 @@
 #include "bases/octree_basis.h"
 
+#include "bases/normal_gradient.h"
 #include "datasets/subdivide.h"
 #include "datasets/validate.h"
 
@@ -130,6 +131,15 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
   system_->assemble(cubature_rule(options_.cubature), mass_, stiffness_);
   stats_.setup_seconds["integrate"] = seconds_since(t0);
 
+  if (options_.normal_gradient) {
+    t0 = Clock::now();
+    normal_gradient_ = assemble_normal_gradient(*system_, octree_,
+                                                cell_normals(octree_, pieces_, piece_cells_));
+    stats_.setup_seconds["normal_gradient"] = seconds_since(t0);
+  } else {
+    std::vector<double>().swap(normal_gradient_);
+  }
+
   t0 = Clock::now();
   prolongations_ = build_prolongations(octree_);
   colours_ = build_colours(octree_);
@@ -145,11 +155,14 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
 }
 
 void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass,
-                                          std::vector<double>& stiffness) {
+                                          std::vector<double>& stiffness,
+                                          std::vector<double>& normal_gradient) {
   mass.swap(mass_);
   stiffness.swap(stiffness_);
+  normal_gradient.swap(normal_gradient_);
   std::vector<double>().swap(mass_);
   std::vector<double>().swap(stiffness_);
+  std::vector<double>().swap(normal_gradient_);
   // swap with empty vectors: clear() alone keeps the capacity (the pieces are the largest array).
   std::vector<ClippedTriangle>().swap(pieces_);
   std::vector<int>().swap(piece_cells_);
@@ -172,6 +185,9 @@ SparseView RebuiltOctreeBasis::mass() const {
 }
 SparseView RebuiltOctreeBasis::stiffness() const {
   return values_view(system_.get(), stiffness_);
+}
+SparseView RebuiltOctreeBasis::normal_gradient() const {
+  return values_view(system_.get(), normal_gradient_);
 }
 
 Coefficients RebuiltOctreeBasis::initial_coefficients() const {

@@ -23,6 +23,9 @@ struct OctreeOptions {
   OctreeCube cube = OctreeCube::automatic;
   bool refine_input = false;  ///< 1-to-4 split of the initial mesh first
   int coarsest_depth = 2;     ///< coarsest multigrid level (clamped to depth)
+  /// Also assemble the band's normal-gradient matrix (Basis::normal_gradient), for flows that
+  /// stabilize their increments; it costs one more value array on the pattern.
+  bool normal_gradient = false;
 };
 
 /// Finest-level functions whose support meets a boundary edge (or a boundary vertex): the corners
@@ -57,6 +60,8 @@ class RebuiltOctreeBasis : public Basis {
   /// On the system's pattern (OctreeSystem::view): one copy of the index arrays for both.
   SparseView mass() const override;
   SparseView stiffness() const override;
+  /// With options().normal_gradient: S on the current mesh's band (rebuilt with the basis).
+  SparseView normal_gradient() const override;
   /// v = Σ_I B_I(v) x^I for the input mesh's vertices (trilinear stencils in an active finest
   /// cell). Vertices used by no face keep the position they had at the last rebuild.
   Positions evaluate_vertices(const Coefficients& x) const override;
@@ -85,7 +90,10 @@ class RebuiltOctreeBasis : public Basis {
   /// pieces() are empty, system() can no longer assemble, and evaluate_vertices() throws
   /// std::logic_error; octree, pattern, hierarchy, locked functions and stats stay. rebuild()
   /// starts over from scratch as usual.
-  void release_assembly(std::vector<double>& mass, std::vector<double>& stiffness);
+  /// The normal-gradient values (with options().normal_gradient) are swapped into
+  /// `normal_gradient` the same way.
+  void release_assembly(std::vector<double>& mass, std::vector<double>& stiffness,
+                        std::vector<double>& normal_gradient);
 
  private:
   OctreeOptions options_;
@@ -96,6 +104,7 @@ class RebuiltOctreeBasis : public Basis {
   std::vector<int> piece_cells_;
   std::unique_ptr<OctreeSystem> system_;
   std::vector<double> mass_, stiffness_;  // values on system_'s pattern
+  std::vector<double> normal_gradient_;   // options_.normal_gradient: values on the pattern
   std::vector<SparseMatrix> prolongations_;
   std::vector<std::vector<std::uint8_t>> colours_;
   VertexStencils stencils_;  ///< mesh_'s vertices (with refine_input, the midpoints too)

@@ -89,7 +89,7 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   // From here on only the compact corners are read: the rebuilt basis's pieces are freed and its
   // assembled matrices become ours, so the first update only resets their values (a fresh copy of
   // the pattern cost more than the update itself in page faults).
-  initial_->release_assembly(mass_, stiffness_);
+  initial_->release_assembly(mass_, stiffness_, normal_gradient_);
   const double preprocess = seconds_since(t0);
 
   const auto t1 = Clock::now();
@@ -361,6 +361,11 @@ std::vector<double> TrackedOctreeBasis::cell_local_corners(int c) const {
     for (const double* p : {fan.p0, fan.p1, fan.p2}) out.insert(out.end(), p, p + 3);
   }
   return out;
+}
+
+SparseView TrackedOctreeBasis::normal_gradient() const {
+  if (normal_gradient_.empty()) return Basis::normal_gradient();
+  return initial_->system().view(normal_gradient_);
 }
 
 Positions TrackedOctreeBasis::evaluate_vertices(const Coefficients& x) const {

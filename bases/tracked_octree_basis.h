@@ -43,6 +43,9 @@ class TrackedOctreeBasis final : public Basis {
   /// On the initial basis's system pattern (OctreeSystem::view): one copy of the index arrays.
   SparseView mass() const override { return initial_->system().view(mass_); }
   SparseView stiffness() const override { return initial_->system().view(stiffness_); }
+  /// With options.normal_gradient: S of X_0's band, assembled once (it never changes: the
+  /// functions are pulled back to X_0, and so is the stabilization).
+  SparseView normal_gradient() const override;
   /// v = Σ_I β_v^I x^I with the 8 stencil weights of each original vertex on X_0.
   Positions evaluate_vertices(const Coefficients& x) const override;
   std::vector<int> locked_functions() const override { return initial_->locked_functions(); }
@@ -84,6 +87,7 @@ class TrackedOctreeBasis final : public Basis {
       point_start_;  // cell c's fan points: [point_start_[c], point_start_[c+1]), 3 doubles each
   VertexStencils stencils_;               // original vertices
   std::vector<double> mass_, stiffness_;  // values on initial_->system()'s pattern
+  std::vector<double> normal_gradient_;   // idem, X_0's band (options.normal_gradient)
   BasisStats stats_;
   long long degenerate_points_ = 0;
 };
