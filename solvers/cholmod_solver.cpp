@@ -189,25 +189,25 @@ SolveReport CholmodSolver::set_matrix(const SparseMatrix& A, HierarchyView hiera
   });
 }
 
-SolveReport CholmodSolver::set_matrix_sum(double a, const SparseRef& M, double b,
-                                          const SparseRef& K, HierarchyView hierarchy) {
+SolveReport CholmodSolver::set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy) {
   // Off one pattern: the default forms Eigen's general sum and calls set_matrix.
-  if (!summable(M, K)) return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
+  if (!summable(sum)) return LinearSolver::set_matrix_sum(sum, hierarchy);
+  const SparseRef& M = sum.M;
   factor_ok_ = false;
   if (M.rows() != M.cols()) return fail(SolveStatus::failed, "matrix is not square");
   // a M + b K straight into the lower triangle the factorization reads, no full sum kept (it would
   // be as large as M); each entry is sum_entry's, so the factor is bitwise that of set_matrix on
   // sum_on_pattern's result. Only the lower triangle is formed, so only it is checked for NaN/inf
   // (M and K are symmetric).
-  const double *m = M.valuePtr(), *k = K.valuePtr();
-  return factorize(M, hierarchy.pattern_key, [=](double* x, const int* gather, std::size_t count) {
-    bool finite = true;
-    for (std::size_t e = 0; e < count; ++e) {
-      x[e] = sum_entry(a, m[gather[e]], b, k[gather[e]]);
-      finite = finite && std::isfinite(x[e]);
-    }
-    return finite;
-  });
+  return factorize(M, hierarchy.pattern_key,
+                   [&sum](double* x, const int* gather, std::size_t count) {
+                     bool finite = true;
+                     for (std::size_t e = 0; e < count; ++e) {
+                       x[e] = sum.entry(gather[e]);
+                       finite = finite && std::isfinite(x[e]);
+                     }
+                     return finite;
+                   });
 }
 
 SolveReport CholmodSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {

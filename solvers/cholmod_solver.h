@@ -30,10 +30,10 @@ class CholmodSolver final : public LinearSolver {
   /// vouches for it (linear_solver.h). Status not_positive_definite when the factorization
   /// meets a non-positive pivot (no abort, no output).
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
-  /// set_matrix(a M + b K) for M and K on one pattern, formed straight into the cached lower
-  /// triangle (bitwise the same factor; no full sum kept). Off one pattern, the default.
-  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                             HierarchyView hierarchy = {}) override;
+  /// set_matrix(a M + b K [+ s S]) for terms on one pattern, formed straight into the cached
+  /// lower triangle (bitwise the same factor; no full sum kept). Off one pattern, the default.
+  SolveReport set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy = {}) override;
+  using LinearSolver::set_matrix_sum;
 
   /// Number of symbolic analyses done so far (tests check that refactorization reuses it).
   int analyses() const { return analyses_; }

@@ -43,18 +43,28 @@ bool same_pattern(const SparseRef& A, const SparseRef& B) {
            std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr())));
 }
 
-void sum_on_pattern(double a, const SparseRef& M, double b, const SparseRef& K, SparseMatrix& S) {
-  const double *m = M.valuePtr(), *k = K.valuePtr();
-  double* s = S.valuePtr();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, M.nonZeros(), 1 << 14), [&](const auto& r) {
-    for (Eigen::Index i = r.begin(); i != r.end(); ++i) s[i] = sum_entry(a, m[i], b, k[i]);
-  });
+void sum_on_pattern(const MatrixSum& sum, SparseMatrix& A) {
+  const double *m = sum.M.valuePtr(), *k = sum.K.valuePtr();
+  const double* q = sum.S ? sum.S->valuePtr() : nullptr;
+  const double a = sum.a, b = sum.b, s = sum.s;
+  double* out = A.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, sum.M.nonZeros(), 1 << 14),
+                    [&](const auto& r) {
+                      if (q)
+                        for (Eigen::Index i = r.begin(); i != r.end(); ++i)
+                          out[i] = sum_entry(a, m[i], b, k[i], s, q[i]);
+                      else
+                        for (Eigen::Index i = r.begin(); i != r.end(); ++i)
+                          out[i] = sum_entry(a, m[i], b, k[i]);
+                    });
 }
 
-SparseMatrix general_sum(double a, const SparseRef& M, double b, const SparseRef& K) {
-  SparseMatrix S = b == 0.0 ? SparseMatrix(a * M) : SparseMatrix(a * M + b * K);
-  S.makeCompressed();
-  return S;
+SparseMatrix general_sum(const MatrixSum& sum) {
+  SparseMatrix A =
+      sum.b == 0.0 ? SparseMatrix(sum.a * sum.M) : SparseMatrix(sum.a * sum.M + sum.b * sum.K);
+  if (sum.S && sum.s != 0.0) A = SparseMatrix(A + sum.s * *sum.S);
+  A.makeCompressed();
+  return A;
 }
 
 bool summable(const SparseRef& M, const SparseRef& K) {
@@ -62,21 +72,25 @@ bool summable(const SparseRef& M, const SparseRef& K) {
          M.nonZeros() == K.nonZeros();
 }
 
-SolveReport LinearSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                                         HierarchyView hierarchy) {
-  if (!summable(M, K)) {
+bool summable(const MatrixSum& sum) {
+  return summable(sum.M, sum.K) && (!sum.S || summable(sum.M, *sum.S));
+}
+
+SolveReport LinearSolver::set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy) {
+  if (!summable(sum)) {
     // Off one pattern: Eigen merges the patterns; no key, as the union is not what it vouched for.
-    sum_ = general_sum(a, M, b, K);
+    sum_ = general_sum(sum);
     sum_key_ = 0;
     return set_matrix(sum_, HierarchyView{hierarchy.prolongations, hierarchy.colours, 0});
   }
   // The key vouches for M's pattern as it does for A's (HierarchyView); without one, compare.
+  const SparseRef& M = sum.M;
   const std::uint64_t key = hierarchy.pattern_key;
   if (key == 0 || key != sum_key_ || sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows()) {
     if (!same_pattern(sum_, M)) sum_ = M;
   }
   sum_key_ = key;
-  sum_on_pattern(a, M, b, K, sum_);
+  sum_on_pattern(sum, sum_);
   return set_matrix(sum_, hierarchy);
 }
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -96,19 +97,57 @@ inline double sum_entry(double a, double m, double b, double k) {
   return a * m + b * k;
 }
 
-/// S = a M + b K entry by entry, in parallel, for M, K and S on one pattern (same_pattern: the
-/// caller checks; S keeps its pattern and only its values are written). This is how every flow
-/// forms its system matrix when the basis assembles M and K on one pattern.
-void sum_on_pattern(double a, const SparseRef& M, double b, const SparseRef& K, SparseMatrix& S);
+/// One entry of a M + b K + s S: the third term is added last, so that without it (s S absent)
+/// an entry is bitwise sum_entry(a, m, b, k).
+inline double sum_entry(double a, double m, double b, double k, double s, double q) {
+  return sum_entry(a, m, b, k) + s * q;
+}
 
-/// a M + b K for any two patterns (Eigen's sum: the union of the patterns; a M alone when b is 0),
-/// compressed.
-SparseMatrix general_sum(double a, const SparseRef& M, double b, const SparseRef& K);
+/// The system matrix of a flow step as its terms: a M + b K, and for a stabilized increment also
+/// s S (docs/octree-multigrid.md, "Stabilization"). The matrices are views of storage the caller
+/// keeps alive while the sum is in use; solvers form the entries they need with entry().
+struct MatrixSum {
+  MatrixSum(double a, const SparseRef& M, double b, const SparseRef& K) : a(a), M(M), b(b), K(K) {}
+  MatrixSum(double a, const SparseRef& M, double b, const SparseRef& K, double s,
+            const SparseRef& S)
+      : a(a), M(M), b(b), K(K), s(s), S(S) {}
+  double a;
+  SparseRef M;
+  double b;
+  SparseRef K;
+  double s = 0.0;
+  std::optional<SparseRef> S;  ///< the third term, if any
+
+  /// Entry p of the value arrays (all terms on one pattern): sum_entry's.
+  double entry(Eigen::Index p) const {
+    const double v = sum_entry(a, M.valuePtr()[p], b, K.valuePtr()[p]);
+    return S ? v + s * S->valuePtr()[p] : v;
+  }
+};
+
+/// A = a M + b K [+ s S] entry by entry, in parallel, for all terms and A on one pattern
+/// (same_pattern: the caller checks; A keeps its pattern and only its values are written). This
+/// is how every flow forms its system matrix when the basis assembles its matrices on one
+/// pattern.
+void sum_on_pattern(const MatrixSum& sum, SparseMatrix& A);
+inline void sum_on_pattern(double a, const SparseRef& M, double b, const SparseRef& K,
+                           SparseMatrix& A) {
+  sum_on_pattern(MatrixSum(a, M, b, K), A);
+}
+
+/// The sum for any patterns (Eigen's sum: the union of the patterns; a M alone when b is 0 and
+/// there is no third term), compressed.
+SparseMatrix general_sum(const MatrixSum& sum);
+inline SparseMatrix general_sum(double a, const SparseRef& M, double b, const SparseRef& K) {
+  return general_sum(MatrixSum(a, M, b, K));
+}
 
 /// Whether M and K may be summed on one pattern as far as O(1) checks tell (compressed, same
 /// size and number of nonzeros); same_pattern() is the full comparison, which a caller that owns
 /// a fixed pattern makes once.
 bool summable(const SparseRef& M, const SparseRef& K);
+/// The same for all terms of a sum.
+bool summable(const MatrixSum& sum);
 
 /// Dense blocks of right-hand sides and solutions, n x k, column-major (Eigen::Ref: any column
 /// stride, so a block of a larger matrix binds as well).
@@ -133,14 +172,18 @@ class LinearSolver {
   /// Returns a report whose status is not_positive_definite when a factorization fails.
   virtual SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) = 0;
 
-  /// set_matrix(a M + b K) for M and K on one pattern (same_pattern: the caller checks; when
+  /// set_matrix(a M + b K [+ s S]) for terms on one pattern (same_pattern: the caller checks; when
   /// summable() does not hold, the default below forms Eigen's general sum, whose pattern is the
   /// union), bitwise the same, without the caller storing the sum (as large as M itself). The
   /// default forms the sum in a matrix this object keeps (the dense reference uses it); the
   /// multigrid, PCG and CHOLMOD solvers override it and write a M + b K straight into the copy they
   /// keep anyway (the multigrid's permuted finest level, PCG's matrix, CHOLMOD's lower triangle).
-  virtual SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                                     HierarchyView hierarchy = {});
+  virtual SolveReport set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy = {});
+  /// set_matrix_sum of a M + b K.
+  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
+                             HierarchyView hierarchy = {}) {
+    return set_matrix_sum(MatrixSum(a, M, b, K), hierarchy);
+  }
 
   /// Solves A X = B for all columns of B. X holds the warm start on entry (iterative solvers use
   /// it; direct solvers ignore it) and the solution on exit. Any column-major matrix binds to B and

@@ -682,18 +682,23 @@ struct MultigridSolver::Impl {
   }
 
   /// New values of the finest matrix (same pattern as the stored one, in the caller's numbering):
-  /// A's, or a A + b K entry by entry when K is given (K on A's pattern; sum_entry, so bitwise
-  /// what sum_on_pattern would have handed to set_matrix).
-  void set_fine_values(const SparseRef& A, double a, double b, const SparseRef* K) {
+  /// A's, or the sum's entry by entry when one is given (its terms on A's pattern, A its M;
+  /// sum_entry, so bitwise what sum_on_pattern would have handed to set_matrix).
+  void set_fine_values(const SparseRef& A, const MatrixSum* sum) {
     Level& F = levels.back();
     const Csc G(A);
     const int* outer = F.A.outerIndexPtr();
     double* val = F.A.valuePtr();
-    const double* kv = K ? K->valuePtr() : nullptr;
-    // Caller's entries [p, q) of column j to out: copied, or summed with K's.
+    const double* kv = sum ? sum->K.valuePtr() : nullptr;
+    const double* sv = sum && sum->S ? sum->S->valuePtr() : nullptr;
+    const double a = sum ? sum->a : 1.0, b = sum ? sum->b : 0.0, s = sum ? sum->s : 0.0;
+    // Caller's entries [p, q) of column j to out: copied, or summed with the other terms'.
     const auto put = [&](int p, int q, double* out) {
       if (!kv) return std::copy(G.val + p, G.val + q, out);
-      for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p]);
+      if (sv)
+        for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p], s, sv[p]);
+      else
+        for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p]);
       return out;
     };
     for_rows(F.n(), [&](int rb, int re) {
@@ -1049,18 +1054,16 @@ void MultigridSolver::reset_level_work() {
 }
 
 SolveReport MultigridSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
-  return set_levels(A, 1.0, 0.0, nullptr, hierarchy);
+  return set_levels(A, nullptr, hierarchy);
 }
 
-SolveReport MultigridSolver::set_matrix_sum(double a, const SparseRef& M, double b,
-                                            const SparseRef& K, HierarchyView hierarchy) {
-  if (!summable(M, K))
-    return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);  // the general sum
-  return set_levels(M, a, b, &K, hierarchy);
+SolveReport MultigridSolver::set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy) {
+  if (!summable(sum)) return LinearSolver::set_matrix_sum(sum, hierarchy);  // the general sum
+  return set_levels(sum.M, &sum, hierarchy);
 }
 
-SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double b,
-                                        const SparseRef* K, HierarchyView hierarchy) {
+SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* sum,
+                                        HierarchyView hierarchy) {
   SolveReport rep;
   Impl& m = *impl_;
   m.ready = false;
@@ -1110,9 +1113,9 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, double a, double 
       need_symbolic =
           !same_permuted(m.levels[l].P, P[l], m.levels[l + 1].inv, m.levels[l].perm, true, true);
   }
-  // symbolic() copies A's values along with its pattern; a sum (K given) overwrites them.
+  // symbolic() copies A's values along with its pattern; a sum overwrites them.
   if (need_symbolic) m.symbolic(A, P, colours);
-  if (!need_symbolic || K) m.set_fine_values(A, a, b, K);
+  if (!need_symbolic || sum) m.set_fine_values(A, sum);
   m.pattern_key = key;
   const bool diag_ok = m.numeric();
 

@@ -104,12 +104,12 @@ class MultigridSolver : public LinearSolver {
   /// An empty hierarchy gives a single level: the solve is then a direct solve.
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
 
-  /// set_matrix(a M + b K), bitwise, without the sum being stored anywhere but in this solver's
-  /// finest level: when the pattern is unchanged, a M + b K is written straight into the permuted
-  /// finest matrix (one pass over M and K instead of forming the sum and copying it); a new
-  /// pattern is set up from M's, and the sum then written the same way.
-  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                             HierarchyView hierarchy = {}) override;
+  /// set_matrix(a M + b K [+ s S]), bitwise, without the sum being stored anywhere but in this
+  /// solver's finest level: when the pattern is unchanged, the sum is written straight into the
+  /// permuted finest matrix (one pass over the terms instead of forming the sum and copying it);
+  /// a new pattern is set up from M's, and the sum then written the same way.
+  SolveReport set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy = {}) override;
+  using LinearSolver::set_matrix_sum;
 
   /// z = one cycle applied to r from z = 0 (a symmetric operator when pre_smooth ==
   /// post_smooth); meant as a preconditioner for PCG. z is resized as needed.
@@ -155,9 +155,9 @@ class MultigridSolver : public LinearSolver {
 
  private:
   struct Impl;
-  /// Both set_matrix entries: the finest values are A's, or a A + b K when K is given (A = M).
-  SolveReport set_levels(const SparseRef& A, double a, double b, const SparseRef* K,
-                         HierarchyView hierarchy);
+  /// Both set_matrix entries: the finest values are A's, or the sum's when one is given (A = its
+  /// M).
+  SolveReport set_levels(const SparseRef& A, const MatrixSum* sum, HierarchyView hierarchy);
   MultigridOptions options_;
   std::unique_ptr<Impl> impl_;
 };

@@ -34,11 +34,10 @@ SolveReport MultigridPcgSolver::set_matrix(const SparseMatrix& A, HierarchyView 
   return with_note(std::move(r), pcg_.set_matrix(A, hierarchy));
 }
 
-SolveReport MultigridPcgSolver::set_matrix_sum(double a, const SparseRef& M, double b,
-                                               const SparseRef& K, HierarchyView hierarchy) {
-  SolveReport r = multigrid_.set_matrix_sum(a, M, b, K, hierarchy);
+SolveReport MultigridPcgSolver::set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy) {
+  SolveReport r = multigrid_.set_matrix_sum(sum, hierarchy);
   if (!r.ok()) return r;
-  return with_note(std::move(r), pcg_.set_matrix_sum(a, M, b, K, hierarchy));
+  return with_note(std::move(r), pcg_.set_matrix_sum(sum, hierarchy));
 }
 
 }  // namespace mcf

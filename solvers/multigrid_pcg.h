@@ -13,8 +13,8 @@ class MultigridPcgSolver final : public LinearSolver {
   std::string name() const override { return "pcg-" + multigrid_.name(); }
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
   /// Both halves take M and K (each keeps its one copy of the sum).
-  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                             HierarchyView hierarchy = {}) override;
+  SolveReport set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy = {}) override;
+  using LinearSolver::set_matrix_sum;
 
  protected:
   SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override {

@@ -199,18 +199,17 @@ SolveReport PcgSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy
   return matrix_in_place();
 }
 
-SolveReport PcgSolver::set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                                      HierarchyView hierarchy) {
+SolveReport PcgSolver::set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy) {
+  const SparseRef& M = sum.M;
   // Off one pattern (the general sum) or not square (set_matrix says so): the default.
-  if (!summable(M, K) || M.rows() != M.cols())
-    return LinearSolver::set_matrix_sum(a, M, b, K, hierarchy);
+  if (!summable(sum) || M.rows() != M.cols()) return LinearSolver::set_matrix_sum(sum, hierarchy);
   have_matrix_ = false;
   // The sum straight into A_ (the copy set_matrix would make), compared as set_matrix compares.
   if (!keeps_pattern(M, hierarchy.pattern_key)) {
     A_ = M;
     ic_.reset();
   }
-  sum_on_pattern(a, M, b, K, A_);
+  sum_on_pattern(sum, A_);
   return matrix_in_place();
 }
 

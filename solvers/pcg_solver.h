@@ -56,8 +56,8 @@ class PcgSolver final : public LinearSolver {
   /// (linear_solver.h): then only the size and nonzero count are checked, not every index.
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
   /// The same for a M + b K, written straight into the copy set_matrix keeps (no other copy).
-  SolveReport set_matrix_sum(double a, const SparseRef& M, double b, const SparseRef& K,
-                             HierarchyView hierarchy = {}) override;
+  SolveReport set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy = {}) override;
+  using LinearSolver::set_matrix_sum;
 
   /// Y = A X with the deterministic parallel row SpMV (exposed for tests and other solvers).
   void multiply(const ConstMatrixRef& X, Eigen::MatrixXd& Y) const;

@@ -238,6 +238,25 @@ TEST(CholmodSolver, AcceptsUncompressedInput) {
   EXPECT_LT(relative_difference(X, Xd), 1e-8);
 }
 
+// With a third term s S too: bitwise the factor of sum_on_pattern's a M + b K + s S.
+TEST(CholmodSolver, SetMatrixSumWithAThirdTermIsBitwiseTheFactorOfTheSum) {
+  const SparseMatrix M = laplacian3d(7, 6, 5, 0.1, 3);
+  const SparseMatrix K = laplacian3d(7, 6, 5, 0.7, 4, 2.5);
+  const SparseMatrix S = laplacian3d(7, 6, 5, 0.0, 5, 1.5);
+  ASSERT_TRUE(same_pattern(M, K) && same_pattern(M, S));
+  const Eigen::MatrixXd B = random_rhs(M.rows());
+  CholmodSolver fused, plain;
+  SparseMatrix sum = M;
+  sum_on_pattern(MatrixSum(1.0, M, 0.05, K, 0.2, S), sum);
+  ASSERT_TRUE(plain.set_matrix(sum).ok());
+  ASSERT_TRUE(fused.set_matrix_sum(MatrixSum(1.0, M, 0.05, K, 0.2, S)).ok());
+  Eigen::MatrixXd Xp, Xf;
+  ASSERT_TRUE(plain.solve(B, Xp).ok());
+  ASSERT_TRUE(fused.solve(B, Xf).ok());
+  EXPECT_TRUE(Xf == Xp);
+  EXPECT_LT(relative_difference(SparseMatrix(M + 0.05 * K + 0.2 * S) * Xf, B), 1e-10);
+}
+
 // set_matrix_sum forms a M + b K in the lower triangle CHOLMOD reads: the factor, and so every
 // solution, is bitwise that of set_matrix on the sum formed by sum_on_pattern; the analysis is
 // reused; NaN/inf in the sum is refused, on a new pattern too, and the next finite sum works.

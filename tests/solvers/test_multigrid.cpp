@@ -283,6 +283,44 @@ TEST(Multigrid, PatternKeySkipsTheComparisonOnly) {
   expect_galerkin(vouched, b);
 }
 
+// A third term (s S, the stabilization of an increment) is added last, entry by entry: the levels
+// and the iterate are bitwise those of set_matrix on sum_on_pattern's matrix, which equals
+// Eigen's a M + b K + s S; s = 0 gives bitwise the two-term sum.
+TEST(Multigrid, SetMatrixSumWithAThirdTermEqualsSetMatrixOfTheSum) {
+  const Problem pm = make_problem(4, 1, 0.0, Drop::shell);
+  const Problem pk = make_problem(4, 1, 1.0, Drop::shell);
+  const Problem ps = make_problem(4, 1, 0.3, Drop::shell);
+  ASSERT_TRUE(mcf::same_pattern(pm.A, ps.A));
+  const SparseMatrix &M = pm.A, &K = pk.A, &S = ps.A;
+  const Eigen::MatrixXd B = random_matrix(M.rows(), 3, 11);
+  MultigridSolver fused, reference, two_terms;
+  for (const double s : {0.7, 0.0}) {
+    SCOPED_TRACE(s);
+    SparseMatrix sum = M;
+    mcf::sum_on_pattern(mcf::MatrixSum(1.0, M, 0.05, K, s, S), sum);
+    const SparseMatrix eigen = 1.0 * M + 0.05 * K + s * S;
+    EXPECT_LE(SparseMatrix(sum - eigen).coeffs().cwiseAbs().maxCoeff(),
+              1e-15 * eigen.coeffs().cwiseAbs().maxCoeff());
+    ASSERT_TRUE(fused.set_matrix_sum(mcf::MatrixSum(1.0, M, 0.05, K, s, S), pm.view()).ok());
+    ASSERT_TRUE(reference.set_matrix(sum, pm.view()).ok());
+    for (int l = 0; l < fused.levels(); ++l) {
+      const SparseMatrix Lf = fused.level_matrix(l), Lr = reference.level_matrix(l);
+      EXPECT_TRUE(std::equal(Lf.valuePtr(), Lf.valuePtr() + Lf.nonZeros(), Lr.valuePtr()))
+          << "level " << l;
+    }
+    Eigen::MatrixXd X1, X2;
+    ASSERT_TRUE(fused.solve(B, X1).ok());
+    ASSERT_TRUE(reference.solve(B, X2).ok());
+    EXPECT_EQ((X1 - X2).cwiseAbs().maxCoeff(), 0.0);
+    if (s == 0.0) {
+      ASSERT_TRUE(two_terms.set_matrix_sum(1.0, M, 0.05, K, pm.view()).ok());
+      Eigen::MatrixXd X3;
+      ASSERT_TRUE(two_terms.solve(B, X3).ok());
+      EXPECT_EQ((X1 - X3).cwiseAbs().maxCoeff(), 0.0);
+    }
+  }
+}
+
 // set_matrix_sum writes a M + b K straight into the finest level; it must give bitwise the levels
 // and the iterate that set_matrix gives for the sum formed by sum_on_pattern: on a new pattern
 // (symbolic set-up), on a refresh compared or vouched for by a key, and with b = 0.

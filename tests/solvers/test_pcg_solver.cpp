@@ -243,6 +243,25 @@ TEST(PcgSolver, SameAnswerAfterValueUpdateAndOptionChange) {
   EXPECT_EQ(pcg.name(), "pcg-jacobi");
 }
 
+// With a third term s S too: bitwise the iterate of set_matrix on sum_on_pattern's matrix.
+TEST(PcgSolver, SetMatrixSumWithAThirdTermEqualsSetMatrixOfTheSum) {
+  const SparseMatrix M = laplacian3d(7, 7, 7, 0.1, 1), K = laplacian3d(7, 7, 7, 0.5, 2, 3.0);
+  const SparseMatrix S = laplacian3d(7, 7, 7, 0.0, 3, 2.0);
+  ASSERT_TRUE(same_pattern(M, S));
+  PcgOptions o = tight(PcgPreconditioner::incomplete_cholesky);
+  o.max_iterations = 7;
+  PcgSolver fused(o), reference(o);
+  SparseMatrix sum = M;
+  sum_on_pattern(MatrixSum(1.0, M, 0.01, K, 0.3, S), sum);
+  ASSERT_TRUE(fused.set_matrix_sum(MatrixSum(1.0, M, 0.01, K, 0.3, S)).ok());
+  ASSERT_TRUE(reference.set_matrix(sum).ok());
+  const Eigen::MatrixXd B = random_rhs(sum.rows());
+  Eigen::MatrixXd X1, X2;
+  ASSERT_TRUE(fused.solve(B, X1).ok() && reference.solve(B, X2).ok());
+  EXPECT_EQ((X1 - X2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(X1.norm(), 0.0);
+}
+
 // set_matrix_sum writes a M + b K straight into the solver's copy: bitwise the iterate of
 // set_matrix on sum_on_pattern's matrix, through a value refresh and a change of pattern (which
 // must rebuild the incomplete Cholesky's ordering); operands off one pattern get the general sum.
