@@ -3,7 +3,7 @@
 #include "bench/cell_hash.h"
 #include "bench/environment.h"
 #include "bench/metric_hooks.h"
-#include "datasets/atomic_file.h"
+#include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "flows/config_reader.h"
 #include "flows/flow.h"

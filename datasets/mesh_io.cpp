@@ -7,7 +7,7 @@
 
 #include "datasets/mesh_io.h"
 
-#include "datasets/atomic_file.h"
+#include "core/atomic_file.h"
 #include "datasets/ply_format.h"
 #include "datasets/walked_mesh.h"
 

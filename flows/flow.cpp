@@ -1,8 +1,7 @@
 #include "flows/flow.h"
 
+#include "core/parallel.h"
 #include "datasets/validate.h"
-
-#include <Eigen/Geometry>
 #include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
 #include "flows/integrator.h"
@@ -14,6 +13,7 @@
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
+#include <Eigen/Geometry>
 
 #include <chrono>
 #include <cmath>
@@ -159,7 +159,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
                                   std::size_t(threads));
   // CHOLMOD's BLAS has its own pool: capped alike, at what TBB can run (environment.blas_threads).
-  const ScopedBlasThreads blas(std::min(threads, tbb::info::default_concurrency()));
+  const ScopedBlasThreads blas(runnable_threads(config.threads));
 
   validate_flow_mesh(config, source.report, source.spec);
   FlowOutcome out;

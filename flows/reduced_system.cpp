@@ -1,8 +1,7 @@
 #include "flows/reduced_system.h"
 
+#include "core/parallel.h"
 #include "solvers/symmetric_multiply.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -159,10 +158,8 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
     double* rv = reduced_.valuePtr();
     const double* sv = sum_.valuePtr();
     const int* src = source_nz_.data();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_nz_.size(), 1 << 14),
-                      [&](const auto& r) {
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) rv[i] = sv[src[i]];
-                      });
+    parallel_for_indices<std::size_t>(source_nz_.size(), 1 << 14,
+                                      [&](std::size_t i) { rv[i] = sv[src[i]]; });
   }
   // Right-hand side: R_f - S_fl Y_l.
   Coefficients Yfixed = Coefficients::Zero(n, 3);

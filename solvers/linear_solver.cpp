@@ -1,7 +1,6 @@
 #include "solvers/linear_solver.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "core/parallel.h"
 
 #include <algorithm>
 #include <atomic>
@@ -46,9 +45,8 @@ bool same_pattern(const SparseRef& A, const SparseRef& B) {
 void sum_on_pattern(double a, const SparseRef& M, double b, const SparseRef& K, SparseMatrix& S) {
   const double *m = M.valuePtr(), *k = K.valuePtr();
   double* s = S.valuePtr();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, M.nonZeros(), 1 << 14), [&](const auto& r) {
-    for (Eigen::Index i = r.begin(); i != r.end(); ++i) s[i] = sum_entry(a, m[i], b, k[i]);
-  });
+  parallel_for_indices<Eigen::Index>(M.nonZeros(), 1 << 14,
+                                     [&](Eigen::Index i) { s[i] = sum_entry(a, m[i], b, k[i]); });
 }
 
 SparseMatrix general_sum(double a, const SparseRef& M, double b, const SparseRef& K) {

@@ -1,9 +1,7 @@
 #include "solvers/pcg_solver.h"
 
+#include "core/parallel.h"
 #include "solvers/symmetric_multiply.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,12 +21,7 @@ constexpr Index kChunk = 4096;
 
 template <class F>
 void for_chunks(Index n, F&& f) {
-  const Index chunks = (n + kChunk - 1) / kChunk;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, chunks, 1),
-                    [&](const tbb::blocked_range<Index>& r) {
-                      for (Index ch = r.begin(); ch < r.end(); ++ch)
-                        f(ch, ch * kChunk, std::min(n, (ch + 1) * kChunk));
-                    });
+  parallel_for_chunks(n, kChunk, f);
 }
 
 // Eight independent accumulators in a fixed pattern: the lanes map onto SIMD registers without

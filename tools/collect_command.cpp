@@ -5,7 +5,7 @@
 
 #include "bench/experiment_config.h"
 #include "bench/runner.h"
-#include "datasets/atomic_file.h"
+#include "core/atomic_file.h"
 #include "flows/config_reader.h"
 #include "tools/commands.h"
 

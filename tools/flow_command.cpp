@@ -4,7 +4,7 @@
 // leaves the previous run's files as they were, never its result beside the new run's frames.
 
 #include "bench/environment.h"
-#include "datasets/atomic_file.h"
+#include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "datasets/mesh_spec.h"
 #include "flows/config_reader.h"
