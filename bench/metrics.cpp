@@ -1,6 +1,6 @@
 #include "bench/metrics.h"
 
-#include "bench/bvh.h"
+#include "datasets/bvh.h"
 #include "core/parallel.h"
 
 #include <algorithm>

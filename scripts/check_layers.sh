@@ -2,16 +2,18 @@
 # Fails if a layer, or its tests (tests/LAYER), includes a header of a layer above it (DESIGN.md
 # "Layers"). core is the bottom layer: it includes no other layer, and every layer may include it.
 root=${1:-$(dirname "$0")/..}
-order=(core datasets bases solvers flows bench tools)
-# solvers sits beside bases (neither may include the other), and beside datasets.
+order=(core datasets bases solvers flows bench benchmarks tools)
+# solvers sits beside bases (neither may include the other), and beside datasets; the
+# micro-benchmarks (benchmarks/) and the executable (tools/) sit beside each other on top.
 declare -A forbidden=(
-  [core]="datasets bases solvers flows bench tools"
-  [datasets]="bases solvers flows bench tools"
-  [bases]="solvers flows bench tools"
-  [solvers]="datasets bases flows bench tools"
-  [flows]="bench tools"
-  [bench]="tools"
-  [tools]=""
+  [core]="datasets bases solvers flows bench benchmarks tools"
+  [datasets]="bases solvers flows bench benchmarks tools"
+  [bases]="solvers flows bench benchmarks tools"
+  [solvers]="datasets bases flows bench benchmarks tools"
+  [flows]="bench benchmarks tools"
+  [bench]="benchmarks tools"
+  [benchmarks]="tools"
+  [tools]="benchmarks"
 )
 bad=0
 for layer in "${order[@]}"; do

@@ -14,7 +14,7 @@
 //                              pattern) + W-cycle + evaluate
 //   BM_Step_HatCholmod/threads:2  hat update + M+δK + CHOLMOD refactorize + solve
 //                              (symbolic analysis outside the loop)
-// Ratios: bench/summarize_micro.py turns the JSON into the README table.
+// Ratios: reports/summarize_micro.py turns the JSON into the README table.
 //
 // Fixtures are large (several GB at depth 9 on 832k faces), so only one lives at a time: taking
 // one frees the previous. Keep benchmarks that share a fixture next to each other.
