@@ -317,4 +317,21 @@ json history_entry(const ResultSet& set, const std::string& metric) {
           {"dir", set.dir},       {"metric", metric}, {"cells", cells}};
 }
 
+int compare_and_record(const CompareRequest& request) {
+  const CompareOptions& o = request.options;
+  const ResultSet old_set = load_result_set(request.old_dir, o.metric);
+  const ResultSet new_set = load_result_set(request.new_dir, o.metric);
+  const CompareReport r = compare_results(old_set, new_set, o);
+  std::printf("%s", compare_markdown(r, old_set, new_set, o).c_str());
+  if (request.append_history) {
+    const std::string file = request.history.empty() ? "results/history.jsonl" : request.history;
+    const fs::path p(file);
+    if (p.has_parent_path()) fs::create_directories(p.parent_path());
+    std::ofstream out(file, std::ios::app);
+    out << history_entry(new_set, o.metric).dump() << "\n";
+    if (!out) throw std::runtime_error(file + ": cannot append");
+  }
+  return r.regression ? 1 : 0;
+}
+
 }  // namespace mcf

@@ -1,7 +1,7 @@
 #include "bench/metrics.h"
 
-#include "datasets/bvh.h"
 #include "core/parallel.h"
+#include "datasets/bvh.h"
 
 #include <algorithm>
 #include <cmath>
