@@ -59,10 +59,14 @@ std::optional<fs::path> temporary_plan(const fs::path& plans) {
 
 /// "#3 {"dt":0.001} rep 1 (ab12cd34ef56.json)": a cell named as a user can find it.
 std::string describe_cell(int index, const json& c) {
-  std::string s = "#" + std::to_string(index);
-  if (c.contains("assignment") && !c["assignment"].empty()) s += " " + c["assignment"].dump();
-  if (c.value("repetition", 0) != 0) s += " rep " + std::to_string(c.value("repetition", 0));
-  if (c.contains("hash")) s += " (" + c["hash"].get<std::string>() + ".json)";
+  // Appended piece by piece: GCC 12 warns (-Wrestrict, falsely) on "literal" + std::string here.
+  std::string s = "#";
+  s += std::to_string(index);
+  if (c.contains("assignment") && !c["assignment"].empty())
+    s.append(" ").append(c["assignment"].dump());
+  if (c.value("repetition", 0) != 0)
+    s.append(" rep ").append(std::to_string(c.value("repetition", 0)));
+  if (c.contains("hash")) s.append(" (").append(c["hash"].get<std::string>()).append(".json)");
   return s;
 }
 

@@ -17,11 +17,12 @@ class RunProgress {
   explicit RunProgress(double line_seconds) : line_seconds_(line_seconds) {}
 
   void step(const StepReport& r) {
-    if (!steps_)
-      steps_ = std::make_unique<Progress>("[" + std::to_string(r.cell_number) + "/" +
-                                              std::to_string(r.total) + "] cell " +
-                                              std::to_string(r.plan->cell.index) + " step",
-                                          r.steps, line_seconds_);
+    if (!steps_) {
+      std::string what = "[";  // not "[" + std::string: GCC 12 warns on it (-Wrestrict, falsely)
+      what += std::to_string(r.cell_number) + "/" + std::to_string(r.total) + "] cell " +
+              std::to_string(r.plan->cell.index) + " step";
+      steps_ = std::make_unique<Progress>(what, r.steps, line_seconds_);
+    }
     steps_->update(r.step);
   }
 
