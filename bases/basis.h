@@ -5,9 +5,8 @@
 // Coefficients x (dimension x 3) describe the embedding X = Σ_I x^I B_I; vertices are recovered
 // with evaluate_vertices.
 
+#include "core/sparse.h"
 #include "datasets/mesh.h"
-
-#include <Eigen/SparseCore>
 
 #include <array>
 #include <cstdint>
@@ -17,11 +16,6 @@
 
 namespace mcf {
 
-using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-/// A read-only view of a compressed matrix stored elsewhere. Bases hand out mass() and stiffness()
-/// as views so that the two can share one pattern's index arrays (every basis here assembles both
-/// on the pattern of its function pairs), which are as large as the values themselves.
-using SparseView = Eigen::Map<const SparseMatrix>;
 using Coefficients = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 
 /// What a basis reports about its construction (result.json "system").
@@ -85,13 +79,5 @@ class Basis {
 
   virtual const BasisStats& stats() const = 0;
 };
-
-/// The view of a compressed matrix (throws std::invalid_argument for an uncompressed one, whose
-/// index arrays a view cannot describe).
-SparseView view_of(const SparseMatrix& A);
-/// The view of values on a pattern given by its column starts (columns + 1) and row indices; an
-/// empty pattern (no column starts) gives an empty matrix.
-SparseView view_of(const std::vector<int>& outer, const std::vector<int>& inner,
-                   const std::vector<double>& values);
 
 }  // namespace mcf

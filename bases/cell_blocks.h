@@ -14,7 +14,7 @@
 // upper triangles are summed (b ≥ a) and read. The order of the sums depends only on the order
 // of the points, so results do not depend on threads.
 
-#include "bases/vec4.h"
+#include "core/vec4.h"
 
 #include <cmath>
 

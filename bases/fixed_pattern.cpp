@@ -1,6 +1,7 @@
 #include "bases/fixed_pattern.h"
 
-#include <tbb/parallel_for.h>
+#include "core/parallel.h"
+
 #include <tbb/parallel_sort.h>
 
 #include <numeric>
@@ -47,12 +48,10 @@ FixedPattern::FixedPattern(Eigen::Index n, const std::vector<int>& rows,
 void FixedPattern::gather(const std::vector<double>& local, std::vector<double>& values) const {
   values.resize(inner_.size());
   double* out = values.data();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, non_zeros(), 4096), [&](const auto& r) {
-    for (Eigen::Index nz = r.begin(); nz != r.end(); ++nz) {
-      double sum = 0.0;
-      for (std::int64_t i = first_[nz]; i < first_[nz + 1]; ++i) sum += local[slot_of_[i]];
-      out[nz] = sum;
-    }
+  parallel_for_indices<Eigen::Index>(non_zeros(), 4096, [&](Eigen::Index nz) {
+    double sum = 0.0;
+    for (std::int64_t i = first_[nz]; i < first_[nz + 1]; ++i) sum += local[slot_of_[i]];
+    out[nz] = sum;
   });
 }
 

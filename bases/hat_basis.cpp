@@ -1,10 +1,9 @@
 #include "bases/hat_basis.h"
 
+#include "core/parallel.h"
 #include "datasets/validate.h"
 
 #include <Eigen/Geometry>
-
-#include <tbb/parallel_for.h>
 
 #include <chrono>
 
@@ -55,31 +54,28 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
   if (update_mass) local_m.resize(9 * m);
   if (update_stiffness) local_k.resize(9 * m);
   const bool lumped = mass_kind_ == MassKind::lumped;
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, m, 2048), [&](const auto& r) {
-    for (Eigen::Index f = r.begin(); f != r.end(); ++f) {
-      const Eigen::Vector3d p[3] = {x.row(faces_(f, 0)).transpose(),
-                                    x.row(faces_(f, 1)).transpose(),
-                                    x.row(faces_(f, 2)).transpose()};
-      if (update_mass) {
-        const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-        // Consistent P1 mass: A/6 on the diagonal, A/12 off it; lumped: A/3 on the diagonal.
-        const double diag = lumped ? area / 3.0 : area / 6.0, off = lumped ? 0.0 : area / 12.0;
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) local_m[9 * f + 3 * a + b] = a == b ? diag : off;
+  parallel_for_indices<Eigen::Index>(m, 2048, [&](Eigen::Index f) {
+    const Eigen::Vector3d p[3] = {x.row(faces_(f, 0)).transpose(), x.row(faces_(f, 1)).transpose(),
+                                  x.row(faces_(f, 2)).transpose()};
+    if (update_mass) {
+      const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+      // Consistent P1 mass: A/6 on the diagonal, A/12 off it; lumped: A/3 on the diagonal.
+      const double diag = lumped ? area / 3.0 : area / 6.0, off = lumped ? 0.0 : area / 12.0;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) local_m[9 * f + 3 * a + b] = a == b ? diag : off;
+    }
+    if (update_stiffness) {
+      // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite
+      // edge.
+      const Eigen::Vector3d cot = corner_cotangents(p[0], p[1], p[2]);
+      double* k = &local_k[9 * f];
+      for (int c = 0; c < 3; ++c) {
+        const int i = (c + 1) % 3, j = (c + 2) % 3;
+        const double w = 0.5 * cot[c];
+        k[3 * i + j] = -w;
+        k[3 * j + i] = -w;
       }
-      if (update_stiffness) {
-        // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite
-        // edge.
-        const Eigen::Vector3d cot = corner_cotangents(p[0], p[1], p[2]);
-        double* k = &local_k[9 * f];
-        for (int c = 0; c < 3; ++c) {
-          const int i = (c + 1) % 3, j = (c + 2) % 3;
-          const double w = 0.5 * cot[c];
-          k[3 * i + j] = -w;
-          k[3 * j + i] = -w;
-        }
-        for (int a = 0; a < 3; ++a) k[4 * a] = -(k[3 * a + (a + 1) % 3] + k[3 * a + (a + 2) % 3]);
-      }
+      for (int a = 0; a < 3; ++a) k[4 * a] = -(k[3 * a + (a + 1) % 3] + k[3 * a + (a + 2) % 3]);
     }
   });
   if (update_mass) pattern_.gather(local_m, mass_);

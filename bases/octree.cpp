@@ -1,5 +1,6 @@
 #include "bases/octree.h"
 
+#include "core/parallel.h"
 #include "datasets/referenced_vertices.h"
 
 #include <tbb/parallel_for.h>
@@ -77,30 +78,24 @@ void sort_unique(std::vector<GridKey>& keys) {
 void fill_functions(OctreeLevel& L) {
   const std::size_t nc = L.cells.size();
   std::vector<GridKey> corners(8 * nc);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c) {
-          const auto ijk = grid_index(L.cells[c]);
-          for (int q = 0; q < 8; ++q) {
-            const auto o = corner_offset(q);
-            corners[8 * c + q] = grid_key(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
-          }
-        }
-      });
+  parallel_for_indices<std::size_t>(nc, 4096, [&](std::size_t c) {
+    const auto ijk = grid_index(L.cells[c]);
+    for (int q = 0; q < 8; ++q) {
+      const auto o = corner_offset(q);
+      corners[8 * c + q] = grid_key(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
+    }
+  });
   sort_unique(corners);
   L.functions = std::move(corners);
   fill_rows(L.functions, (1 << L.depth) + 1, L.function_row_start);
   L.cell_functions.resize(nc);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, nc, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c) {
-          const auto ijk = grid_index(L.cells[c]);
-          for (int q = 0; q < 8; ++q) {
-            const auto o = corner_offset(q);
-            L.cell_functions[c][q] = L.find_function(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
-          }
-        }
-      });
+  parallel_for_indices<std::size_t>(nc, 4096, [&](std::size_t c) {
+    const auto ijk = grid_index(L.cells[c]);
+    for (int q = 0; q < 8; ++q) {
+      const auto o = corner_offset(q);
+      L.cell_functions[c][q] = L.find_function(ijk[0] + o[0], ijk[1] + o[1], ijk[2] + o[2]);
+    }
+  });
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 #include "bases/octree_system.h"
 
 #include "bases/cell_blocks.h"
+#include "core/parallel.h"
 #include "datasets/referenced_vertices.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
@@ -17,13 +17,10 @@ namespace mcf {
 std::vector<int> locate_pieces(const Octree& octree, const std::vector<ClippedTriangle>& pieces) {
   const OctreeLevel& L = octree.finest();
   std::vector<int> cell(pieces.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 8192),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t p = r.begin(); p != r.end(); ++p) {
-                        const auto ijk = grid_index(pieces[p].cell);
-                        cell[p] = L.find_cell(ijk[0], ijk[1], ijk[2]);
-                      }
-                    });
+  parallel_for_indices<std::size_t>(pieces.size(), 8192, [&](std::size_t p) {
+    const auto ijk = grid_index(pieces[p].cell);
+    cell[p] = L.find_cell(ijk[0], ijk[1], ijk[2]);
+  });
   for (int c : cell)
     if (c < 0) throw std::runtime_error("locate_pieces: a piece lies in an inactive cell");
   return cell;
@@ -49,15 +46,12 @@ OctreeSystem::CellTiles build_cell_tiles(const OctreeLevel& L) {
   const std::size_t nc = L.cells.size();
   // Sort key: colour in the top bits, then the tile's grid key, then the cell index (stable).
   std::vector<std::pair<std::uint64_t, int>> order(nc);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, nc, 8192), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c) {
-          const auto ijk = grid_index(L.cells[c]);
-          const int ti = ijk[0] >> kShift, tj = ijk[1] >> kShift, tk = ijk[2] >> kShift;
-          const std::uint64_t colour = std::uint64_t((ti & 1) + 2 * (tj & 1) + 4 * (tk & 1));
-          order[c] = {(colour << 60) | grid_key(ti, tj, tk), static_cast<int>(c)};
-        }
-      });
+  parallel_for_indices<std::size_t>(nc, 8192, [&](std::size_t c) {
+    const auto ijk = grid_index(L.cells[c]);
+    const int ti = ijk[0] >> kShift, tj = ijk[1] >> kShift, tk = ijk[2] >> kShift;
+    const std::uint64_t colour = std::uint64_t((ti & 1) + 2 * (tj & 1) + 4 * (tk & 1));
+    order[c] = {(colour << 60) | grid_key(ti, tj, tk), static_cast<int>(c)};
+  });
   tbb::parallel_sort(order.begin(), order.end());  // keys are unique: same order as std::sort
   OctreeSystem::CellTiles t;
   t.cells.resize(nc);
@@ -109,53 +103,44 @@ OctreeSystem::OctreeSystem(const Octree& octree, int level,
 
   // Incident cells: function J is corner b of at most one cell, incident[8J+b] (-1 if none).
   std::vector<int> incident(8 * nf, -1);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t c = r.begin(); c != r.end(); ++c)
-                        for (int b = 0; b < 8; ++b)
-                          incident[8 * static_cast<std::size_t>(
-                                           L.cell_functions[c][static_cast<std::size_t>(b)]) +
-                                   static_cast<std::size_t>(b)] = static_cast<int>(c);
-                    });
+  parallel_for_indices<std::size_t>(nc, 4096, [&](std::size_t c) {
+    for (int b = 0; b < 8; ++b)
+      incident[8 * static_cast<std::size_t>(L.cell_functions[c][static_cast<std::size_t>(b)]) +
+               static_cast<std::size_t>(b)] = static_cast<int>(c);
+  });
   // Pattern: per column J the 27-bit mask of neighbours that share an active cell with J; rows in
   // bit order are in increasing index order (keys are (k,j,i)-lexicographic).
   mask_.assign(nf, 0u);
   outer_.assign(nf + 1, 0);
   std::vector<int>& outer = outer_;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t J = r.begin(); J != r.end(); ++J) {
-                        std::uint32_t m = 0;
-                        for (int b = 0; b < 8; ++b) {
-                          if (incident[8 * J + static_cast<std::size_t>(b)] < 0) continue;
-                          for (int a = 0; a < 8; ++a) m |= 1u << neighbour_bit(a, b);
-                        }
-                        mask_[J] = m;
-                        outer[J + 1] = std::popcount(m);
-                      }
-                    });
+  parallel_for_indices<std::size_t>(nf, 4096, [&](std::size_t J) {
+    std::uint32_t m = 0;
+    for (int b = 0; b < 8; ++b) {
+      if (incident[8 * J + static_cast<std::size_t>(b)] < 0) continue;
+      for (int a = 0; a < 8; ++a) m |= 1u << neighbour_bit(a, b);
+    }
+    mask_[J] = m;
+    outer[J + 1] = std::popcount(m);
+  });
   for (std::size_t J = 0; J < nf; ++J) outer[J + 1] += outer[J];
   inner_.resize(static_cast<std::size_t>(outer[nf]));
   int* inner = inner_.data();
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t J = r.begin(); J != r.end(); ++J) {
-          int row[27];
-          for (int b = 0; b < 8; ++b) {
-            const int c = incident[8 * J + static_cast<std::size_t>(b)];
-            if (c < 0) continue;
-            for (int a = 0; a < 8; ++a)
-              row[neighbour_bit(a, b)] =
-                  L.cell_functions[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
-          }
-          int s = outer[J];
-          for (int o = 0; o < 27; ++o) {
-            if (!(mask_[J] & (1u << o))) continue;
-            inner[s] = row[o];
-            ++s;
-          }
-        }
-      });
+  parallel_for_indices<std::size_t>(nf, 4096, [&](std::size_t J) {
+    int row[27];
+    for (int b = 0; b < 8; ++b) {
+      const int c = incident[8 * J + static_cast<std::size_t>(b)];
+      if (c < 0) continue;
+      for (int a = 0; a < 8; ++a)
+        row[neighbour_bit(a, b)] =
+            L.cell_functions[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
+    }
+    int s = outer[J];
+    for (int o = 0; o < 27; ++o) {
+      if (!(mask_[J] & (1u << o))) continue;
+      inner[s] = row[o];
+      ++s;
+    }
+  });
 }
 
 void OctreeSystem::release_pieces() {
@@ -240,25 +225,21 @@ std::vector<SparseMatrix> build_prolongations(const Octree& octree) {
     std::vector<int> rows(27 * nc);
     std::vector<double> vals(27 * nc);
     std::vector<int> count(nc + 1, 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 2048),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t c = r.begin(); c != r.end(); ++c) {
-                          const auto ijk = grid_index(C.functions[c]);
-                          int n = 0;
-                          for (int dz = -1; dz <= 1; ++dz)
-                            for (int dy = -1; dy <= 1; ++dy)
-                              for (int dx = -1; dx <= 1; ++dx) {
-                                const int f = F.find_function(2 * ijk[0] + dx, 2 * ijk[1] + dy,
-                                                              2 * ijk[2] + dz);
-                                if (f < 0) continue;
-                                rows[27 * c + static_cast<std::size_t>(n)] = f;
-                                vals[27 * c + static_cast<std::size_t>(n)] =
-                                    (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
-                                ++n;
-                              }
-                          count[c + 1] = n;
-                        }
-                      });
+    parallel_for_indices<std::size_t>(nc, 2048, [&](std::size_t c) {
+      const auto ijk = grid_index(C.functions[c]);
+      int n = 0;
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int f = F.find_function(2 * ijk[0] + dx, 2 * ijk[1] + dy, 2 * ijk[2] + dz);
+            if (f < 0) continue;
+            rows[27 * c + static_cast<std::size_t>(n)] = f;
+            vals[27 * c + static_cast<std::size_t>(n)] =
+                (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
+            ++n;
+          }
+      count[c + 1] = n;
+    });
     for (std::size_t c = 0; c < nc; ++c) count[c + 1] += count[c];
     SparseMatrix M(F.num_functions(), C.num_functions());
     M.resizeNonZeros(count[nc]);

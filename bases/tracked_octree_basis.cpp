@@ -1,10 +1,9 @@
 #include "bases/tracked_octree_basis.h"
 
 #include "bases/cell_blocks.h"
-#include "bases/vec4.h"
+#include "core/parallel.h"
+#include "core/vec4.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -55,33 +54,29 @@ TrackedOctreeBasis::TrackedOctreeBasis(const TriangleMesh& mesh, OctreeOptions o
   };
   continues_.assign(order.size(), 0);
   point_start_.assign(nc + 1, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 256), [&](const auto& r) {
-    for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      double prev[9], q[9];
-      int points = 0;
-      for (int s = cell_start()[c]; s < cell_start()[c + 1]; ++s) {
-        local_corners(c, s, q);
-        const bool fan = s > cell_start()[c] && std::memcmp(q, prev, 3 * sizeof(double)) == 0 &&
-                         std::memcmp(q + 3, prev + 6, 3 * sizeof(double)) == 0;
-        continues_[std::size_t(s)] = fan;
-        points += fan ? 1 : 3;
-        std::memcpy(prev, q, sizeof(q));
-      }
-      point_start_[c + 1] = points;
+  parallel_for_indices<std::size_t>(nc, 256, [&](std::size_t c) {
+    double prev[9], q[9];
+    int points = 0;
+    for (int s = cell_start()[c]; s < cell_start()[c + 1]; ++s) {
+      local_corners(c, s, q);
+      const bool fan = s > cell_start()[c] && std::memcmp(q, prev, 3 * sizeof(double)) == 0 &&
+                       std::memcmp(q + 3, prev + 6, 3 * sizeof(double)) == 0;
+      continues_[std::size_t(s)] = fan;
+      points += fan ? 1 : 3;
+      std::memcpy(prev, q, sizeof(q));
     }
+    point_start_[c + 1] = points;
   });
   for (std::size_t c = 0; c < nc; ++c) point_start_[c + 1] += point_start_[c];
   // One double of padding: the last corner is read as four doubles.
   fan_points_.assign(3 * std::size_t(point_start_[nc]) + 1, 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nc, 256), [&](const auto& r) {
-    for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      double* out = &fan_points_[3 * std::size_t(point_start_[c])];
-      double q[9];
-      for (int s = cell_start()[c]; s < cell_start()[c + 1]; ++s) {
-        local_corners(c, s, q);
-        const int skip = continues_[std::size_t(s)] ? 6 : 0;
-        out = std::copy(q + skip, q + 9, out);
-      }
+  parallel_for_indices<std::size_t>(nc, 256, [&](std::size_t c) {
+    double* out = &fan_points_[3 * std::size_t(point_start_[c])];
+    double q[9];
+    for (int s = cell_start()[c]; s < cell_start()[c + 1]; ++s) {
+      local_corners(c, s, q);
+      const int skip = continues_[std::size_t(s)] ? 6 : 0;
+      out = std::copy(q + skip, q + 9, out);
     }
   });
   // Only the original vertices are evaluated (with refine_input the midpoints are internal).

@@ -54,6 +54,70 @@ std::string fmt(double v, const char* f = "%.4g") {
   return buf;
 }
 
+/// The commit a result was computed by ("unknown" when it does not say).
+std::string commit_of(const json& r) {
+  return r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
+}
+
+/// The cell results of `dir` (sorted by file name) of the commits `commit_filter` begins
+/// (all when empty); a file that does not parse throws.
+std::vector<json> read_cell_results(const std::string& dir, const std::string& commit_filter) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.is_regular_file() && entry.path().extension() == ".json" &&
+        entry.path().filename() != "index.json")
+      files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  std::vector<json> results;
+  for (const auto& f : files) {
+    std::ifstream in(f);
+    json r;
+    try {
+      r = json::parse(in);
+    } catch (const json::parse_error& e) {
+      throw std::runtime_error(f.string() + ": JSON parse error: " + e.what());
+    }
+    if (!r.is_object() || !r.contains("cell")) continue;  // not a cell result
+    if (!commit_filter.empty() && commit_of(r).rfind(commit_filter, 0) != 0) continue;
+    results.push_back(std::move(r));
+  }
+  return results;
+}
+
+/// Adds one repetition's result to its cell's samples; returns its number of steps.
+int add_repetition(const json& r, const std::string& metric, ResultSet& set) {
+  const json& cell = r["cell"];
+  const std::string key = cell.value("config_key", cell.value("key", ""));
+  CellSamples& c = set.cells[key];
+  c.label = label_of(cell.value("assignment", json::object()), key);
+  ++c.repetitions;
+  const std::string status = r.value("status", "error");
+  if (status == "error") ++c.errored;
+  if (status != "ok") {
+    if (c.failed++ == 0) {
+      std::string reason =
+          r.contains("stop") && r["stop"].is_object() ? r["stop"].value("reason", "") : "";
+      c.failure = status + (reason.empty() ? "" : ": " + reason);
+    }
+  }
+  const int steps = r.contains("steps") && r["steps"].is_array() ? int(r["steps"].size()) : 0;
+  c.min_steps = c.min_steps < 0 ? steps : std::min(c.min_steps, steps);
+  if (r.contains("steps"))
+    for (const auto& s : r["steps"]) {
+      const json* v = json_at_path(s, metric);
+      if (v && v->is_number()) c.values.push_back(v->get<double>());
+    }
+  for (const char* kind : kAccuracyKinds)
+    if (const double e = accuracy_of(r, kind); std::isfinite(e)) c.errors[kind].push_back(e);
+  const json* run = json_at_path(r, "run_seconds");
+  const json* steal = json_at_path(r, "steal_seconds");
+  if (run && steal && run->is_number() && steal->is_number()) {
+    set.run_seconds += run->get<double>();
+    set.steal_seconds += steal->get<double>();
+  }
+  return steps;
+}
+
 }  // namespace
 
 double median(std::vector<double> v) {
@@ -105,33 +169,15 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
   }
   if (!fs::is_directory(set.dir))
     throw std::runtime_error(dir_at_commit + ": not a results folder");
-  std::set<std::string> commits, studies;
-  std::vector<json> results;
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(set.dir))
-    if (entry.is_regular_file() && entry.path().extension() == ".json" &&
-        entry.path().filename() != "index.json")
-      files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
-  for (const auto& f : files) {
-    std::ifstream in(f);
-    json r;
-    try {
-      r = json::parse(in);
-    } catch (const json::parse_error& e) {
-      throw std::runtime_error(f.string() + ": JSON parse error: " + e.what());
-    }
-    if (!r.is_object() || !r.contains("cell")) continue;  // not a cell result
-    const std::string commit =
-        r.contains("environment") ? r["environment"].value("commit", "unknown") : "unknown";
-    if (!commit_filter.empty() && commit.rfind(commit_filter, 0) != 0) continue;
-    commits.insert(commit);
-    studies.insert(r["cell"].value("study", ""));
-    results.push_back(std::move(r));
-  }
+  const std::vector<json> results = read_cell_results(set.dir, commit_filter);
   if (results.empty())
     throw std::runtime_error(dir_at_commit + ": no cell results" +
                              (commit_filter.empty() ? "" : " of commit " + commit_filter));
+  std::set<std::string> commits, studies;
+  for (const json& r : results) {
+    commits.insert(commit_of(r));
+    studies.insert(r["cell"].value("study", ""));
+  }
   if (commits.size() > 1) {
     std::string list;
     for (const auto& c : commits) list += " " + c;
@@ -142,38 +188,7 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
   set.commit = *commits.begin();
   set.study = *studies.begin();
   bool any_steps = false;
-  for (const json& r : results) {
-    const json& cell = r["cell"];
-    const std::string key = cell.value("config_key", cell.value("key", ""));
-    CellSamples& c = set.cells[key];
-    c.label = label_of(cell.value("assignment", json::object()), key);
-    ++c.repetitions;
-    const std::string status = r.value("status", "error");
-    if (status == "error") ++c.errored;
-    if (status != "ok") {
-      if (c.failed++ == 0) {
-        std::string reason =
-            r.contains("stop") && r["stop"].is_object() ? r["stop"].value("reason", "") : "";
-        c.failure = status + (reason.empty() ? "" : ": " + reason);
-      }
-    }
-    const int steps = r.contains("steps") && r["steps"].is_array() ? int(r["steps"].size()) : 0;
-    c.min_steps = c.min_steps < 0 ? steps : std::min(c.min_steps, steps);
-    any_steps = any_steps || steps > 0;
-    if (r.contains("steps"))
-      for (const auto& s : r["steps"]) {
-        const json* v = json_at_path(s, metric);
-        if (v && v->is_number()) c.values.push_back(v->get<double>());
-      }
-    for (const char* kind : kAccuracyKinds)
-      if (const double e = accuracy_of(r, kind); std::isfinite(e)) c.errors[kind].push_back(e);
-    const json* run = json_at_path(r, "run_seconds");
-    const json* steal = json_at_path(r, "steal_seconds");
-    if (run && steal && run->is_number() && steal->is_number()) {
-      set.run_seconds += run->get<double>();
-      set.steal_seconds += steal->get<double>();
-    }
-  }
+  for (const json& r : results) any_steps = add_repetition(r, metric, set) > 0 || any_steps;
   // Cells with steps but not one value: the metric's name is wrong. (Cells without any step,
   // all errored, are compared as failures instead.)
   bool any_value = false;
@@ -315,6 +330,23 @@ json history_entry(const ResultSet& set, const std::string& metric) {
     cells[key] = {{"label", c.label}, {"median", median(c.values)}};
   return {{"commit", set.commit}, {"date", date},     {"study", set.study},
           {"dir", set.dir},       {"metric", metric}, {"cells", cells}};
+}
+
+int compare_and_record(const CompareRequest& request) {
+  const CompareOptions& o = request.options;
+  const ResultSet old_set = load_result_set(request.old_dir, o.metric);
+  const ResultSet new_set = load_result_set(request.new_dir, o.metric);
+  const CompareReport r = compare_results(old_set, new_set, o);
+  std::printf("%s", compare_markdown(r, old_set, new_set, o).c_str());
+  if (request.append_history) {
+    const std::string file = request.history.empty() ? "results/history.jsonl" : request.history;
+    const fs::path p(file);
+    if (p.has_parent_path()) fs::create_directories(p.parent_path());
+    std::ofstream out(file, std::ios::app);
+    out << history_entry(new_set, o.metric).dump() << "\n";
+    if (!out) throw std::runtime_error(file + ": cannot append");
+  }
+  return r.regression ? 1 : 0;
 }
 
 }  // namespace mcf

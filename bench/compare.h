@@ -79,6 +79,18 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
 /// One line for the history file: {commit, date, study, dir, metric, cells: {key: median}}.
 nlohmann::json history_entry(const ResultSet& set, const std::string& metric);
 
+struct CompareRequest {
+  std::string old_dir, new_dir;  ///< DIR[@COMMIT] each
+  CompareOptions options;
+  bool append_history = false;  ///< append history_entry(NEW) as one line to `history`
+  std::string history;          ///< empty: results/history.jsonl
+};
+
+/// compare as a whole: loads both sets, prints the Markdown comparison on stdout, appends NEW's
+/// history line when asked (creating its folder; throws if it cannot). Returns 1 on a
+/// regression, else 0.
+int compare_and_record(const CompareRequest& request);
+
 /// Two-sided p-value of the Mann–Whitney U test (normal approximation, tie-corrected, with
 /// continuity correction). 1 when either sample is empty or all values tie.
 double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b);

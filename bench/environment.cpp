@@ -1,10 +1,10 @@
 #include "bench/environment.h"
 
 #include "build_info.h"
+#include "core/parallel.h"
 
 #include <OpenMesh/Core/System/config.h>
 #include <suitesparse/cholmod.h>
-#include <tbb/info.h>
 #include <tbb/version.h>
 #include <Eigen/Core>
 
@@ -42,8 +42,7 @@ nlohmann::json environment_json(int threads) {
   // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the config
   // asked for (that request is in "config.threads"); the flow caps OpenBLAS, under CHOLMOD, at
   // the same count (solvers/blas_threads.h).
-  const int ran = threads > 0 ? std::min(threads, tbb::info::default_concurrency())
-                              : tbb::info::default_concurrency();
+  const int ran = runnable_threads(threads);
   const auto v = [](int a, int b, int c) {
     return std::to_string(a) + "." + std::to_string(b) + "." + std::to_string(c);
   };

@@ -251,9 +251,10 @@ bool matches_assignment(const Cell& cell, const json& partial) {
   return true;
 }
 
-ExperimentConfig parse_experiment_config(const json& j, const std::string& source, bool quick,
-                                         const std::string& default_name) {
-  if (!j.is_object()) throw ConfigError(source + ": expected a JSON object at the top level");
+namespace {
+
+/// The top level's keys, name and description.
+void read_header(const json& j, const std::string& source, ExperimentConfig& e) {
   static const std::set<std::string> top = {"name",        "description", "paper", "comment",
                                             "defaults",    "axes",        "zip",   "exclude",
                                             "repetitions", "metrics",     "quick"};
@@ -262,12 +263,6 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
       fail(source, it.key(),
            "unknown key (known: name, description, paper, comment, defaults, axes, zip, exclude, "
            "repetitions, metrics, quick)");
-
-  ExperimentConfig e;
-  e.source = source;
-  e.quick = quick;
-  e.study_config = j;
-  e.name = default_name;
   if (j.contains("name")) {
     if (!j["name"].is_string() || j["name"].get<std::string>().empty())
       fail(source, "name", "expected a non-empty string, got " + j["name"].dump());
@@ -280,68 +275,84 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
       fail(source, "description", "expected a string, got " + j["description"].dump());
     e.description = j["description"].get<std::string>();
   }
+}
 
-  // Structure of both variants is checked whichever is run, so a broken quick section is
-  // found by the full run (and vice versa) rather than months later.
-  json defaults = member(j, "defaults");
-  if (defaults.is_null()) defaults = json::object();
-  check_config_object(defaults, source, "defaults.");
-  defaults = nest_dotted_keys(defaults);
+/// The matrix of the variant being expanded: defaults (dotted keys nested), axes, zip, exclude.
+struct MatrixSpec {
+  json defaults, axes, zip, exclude;
+};
+
+/// Checks the "quick" section's structure; when the quick variant is expanded, merges it into
+/// the matrix and `e`: defaults deep, axes per key (a quick axis replaces the full one); zip,
+/// exclude, repetitions and metrics (smaller frame lists and sample counts) as a whole.
+void apply_quick(const json& q, const std::string& source, bool quick, MatrixSpec& m,
+                 ExperimentConfig& e) {
+  if (!q.is_object()) fail(source, "quick", "expected an object, got " + q.dump());
+  for (auto it = q.begin(); it != q.end(); ++it)
+    if (it.key() != "defaults" && it.key() != "axes" && it.key() != "zip" &&
+        it.key() != "exclude" && it.key() != "repetitions" && it.key() != "metrics")
+      fail(source, "quick." + it.key(),
+           "unknown key (known: defaults, axes, zip, exclude, repetitions, metrics)");
+  if (q.contains("defaults")) check_config_object(q["defaults"], source, "quick.defaults.");
+  check_axes(member(q, "axes"), source, "quick.axes");
+  check_zip(member(q, "zip"), source, "quick.zip");
+  check_exclude(member(q, "exclude"), source, "quick.exclude");
+  const int quick_reps = read_repetitions(member(q, "repetitions"), source, "quick.repetitions");
+  const bool quick_metrics = q.contains("metrics");
+  const MetricsConfig quick_metric_config =
+      quick_metrics ? read_metrics(q["metrics"], source) : MetricsConfig{};
+  if (!quick) return;
+  if (quick_metrics) e.metrics = quick_metric_config;
+  if (q.contains("defaults")) m.defaults.merge_patch(nest_dotted_keys(q["defaults"]));
+  if (q.contains("axes")) {
+    if (m.axes.is_null()) m.axes = json::object();
+    for (auto it = q["axes"].begin(); it != q["axes"].end(); ++it) m.axes[it.key()] = *it;
+  }
+  if (q.contains("zip")) m.zip = q["zip"];
+  if (q.contains("exclude")) m.exclude = q["exclude"];
+  if (q.contains("repetitions")) e.repetitions = quick_reps;
+}
+
+/// The matrix, repetitions and metrics. The structure of both variants is checked whichever is
+/// run, so a broken quick section is found by the full run (and vice versa) rather than months
+/// later.
+MatrixSpec read_matrix(const json& j, const std::string& source, bool quick, ExperimentConfig& e) {
+  MatrixSpec m;
+  m.defaults = member(j, "defaults");
+  if (m.defaults.is_null()) m.defaults = json::object();
+  check_config_object(m.defaults, source, "defaults.");
+  m.defaults = nest_dotted_keys(m.defaults);
   check_axes(member(j, "axes"), source, "axes");
   check_zip(member(j, "zip"), source, "zip");
   check_exclude(member(j, "exclude"), source, "exclude");
   e.repetitions = read_repetitions(member(j, "repetitions"), source, "repetitions");
   e.metrics = read_metrics(member(j, "metrics"), source);
+  m.axes = member(j, "axes");
+  m.zip = member(j, "zip");
+  m.exclude = member(j, "exclude");
+  if (const json& q = member(j, "quick"); !q.is_null()) apply_quick(q, source, quick, m, e);
+  return m;
+}
 
-  json axes = member(j, "axes"), zip = member(j, "zip"), exclude = member(j, "exclude");
-  const json& q = member(j, "quick");
-  if (!q.is_null()) {
-    if (!q.is_object()) fail(source, "quick", "expected an object, got " + q.dump());
-    for (auto it = q.begin(); it != q.end(); ++it)
-      if (it.key() != "defaults" && it.key() != "axes" && it.key() != "zip" &&
-          it.key() != "exclude" && it.key() != "repetitions" && it.key() != "metrics")
-        fail(source, "quick." + it.key(),
-             "unknown key (known: defaults, axes, zip, exclude, repetitions, metrics)");
-    if (q.contains("defaults")) check_config_object(q["defaults"], source, "quick.defaults.");
-    check_axes(member(q, "axes"), source, "quick.axes");
-    check_zip(member(q, "zip"), source, "quick.zip");
-    check_exclude(member(q, "exclude"), source, "quick.exclude");
-    const int quick_reps = read_repetitions(member(q, "repetitions"), source, "quick.repetitions");
-    // quick.metrics replaces metrics as a whole (smaller frame lists and sample counts).
-    const bool quick_metrics = q.contains("metrics");
-    const MetricsConfig quick_metric_config =
-        quick_metrics ? read_metrics(q["metrics"], source) : MetricsConfig{};
-    if (quick) {
-      if (quick_metrics) e.metrics = quick_metric_config;
-      // defaults: deep merge; axes: per key (a quick axis replaces the full one);
-      // zip, exclude, repetitions: replaced as a whole.
-      if (q.contains("defaults")) defaults.merge_patch(nest_dotted_keys(q["defaults"]));
-      if (q.contains("axes")) {
-        if (axes.is_null()) axes = json::object();
-        for (auto it = q["axes"].begin(); it != q["axes"].end(); ++it) axes[it.key()] = *it;
-      }
-      if (q.contains("zip")) zip = q["zip"];
-      if (q.contains("exclude")) exclude = q["exclude"];
-      if (q.contains("repetitions")) e.repetitions = quick_reps;
-    }
-  }
-
+/// One dimension per axis (keys sorted, as nlohmann keeps them) and per zip group; a key may
+/// vary in one of them only, and no varied key may contain another.
+std::vector<Dimension> dimensions(const MatrixSpec& m, const std::string& source,
+                                  const std::string& axes_where) {
   std::vector<Dimension> dims;
   std::set<std::string> varied;
-  const std::string axes_where = quick ? "axes (with quick.axes)" : "axes";
-  if (axes.is_object())
-    for (auto it = axes.begin(); it != axes.end(); ++it) {  // nlohmann keeps keys sorted
+  if (m.axes.is_object())
+    for (auto it = m.axes.begin(); it != m.axes.end(); ++it) {
       Dimension d;
       d.keys = {it.key()};
       for (const auto& v : *it) d.rows.push_back({v});
       varied.insert(it.key());
       dims.push_back(std::move(d));
     }
-  if (zip.is_array())
-    for (size_t g = 0; g < zip.size(); ++g) {
+  if (m.zip.is_array())
+    for (size_t g = 0; g < m.zip.size(); ++g) {
       Dimension d;
       size_t length = 0;
-      for (auto it = zip[g].begin(); it != zip[g].end(); ++it) {
+      for (auto it = m.zip[g].begin(); it != m.zip[g].end(); ++it) {
         if (!varied.insert(it.key()).second)
           fail(source, "zip[" + std::to_string(g) + "]." + it.key(),
                "key varies twice (also in axes or another zip group)");
@@ -350,7 +361,7 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
       }
       for (size_t i = 0; i < length; ++i) {
         std::vector<json> row;
-        for (const auto& k : d.keys) row.push_back(zip[g][k][i]);
+        for (const auto& k : d.keys) row.push_back(m.zip[g][k][i]);
         d.rows.push_back(std::move(row));
       }
       dims.push_back(std::move(d));
@@ -360,20 +371,25 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
       if (k != other && other.rfind(k + ".", 0) == 0)
         fail(source, axes_where,
              "keys \"" + k + "\" and \"" + other + "\" overlap (one contains the other)");
+  return dims;
+}
 
-  // Odometer over the dimensions, the last one fastest.
-  std::vector<bool> exclude_used(exclude.is_array() ? exclude.size() : 0, false);
+/// The cells: an odometer over the dimensions, the last one fastest, each assignment applied
+/// to the defaults, every repetition of a cell no exclude entry matches (`exclude_used` marks
+/// the entries that matched one).
+void expand_cells(const std::vector<Dimension>& dims, const MatrixSpec& m,
+                  const std::string& source, ExperimentConfig& e, std::vector<bool>& exclude_used) {
   std::vector<size_t> pos(dims.size(), 0);
   int index = 0;
   bool done = false;
   while (!done) {
-    json raw = defaults, assignment = json::object();
+    json raw = m.defaults, assignment = json::object();
     for (size_t d = 0; d < dims.size(); ++d)
       for (size_t k = 0; k < dims[d].keys.size(); ++k) {
         set_json_path(raw, dims[d].keys[k], dims[d].rows[pos[d]][k]);
         assignment[dims[d].keys[k]] = dims[d].rows[pos[d]][k];
       }
-    if (!excluded(raw, exclude, exclude_used)) {
+    if (!excluded(raw, m.exclude, exclude_used)) {
       const std::string where = assignment.empty() ? source + " (defaults)"
                                                    : source + " (cell " + assignment.dump() + ")";
       const FlowConfig flow = flow_config_from_json(raw, where);
@@ -396,22 +412,28 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
       pos[d] = 0;
     }
   }
+}
+
+/// Mistakes only the expanded matrix shows: every cell excluded, an exclude entry or a frame no
+/// cell meets, two cells with one flow config, a reference no cell matches. `own_exclude` and
+/// `own_frames`: whether the variant expanded has its own exclude list and frame list (the full
+/// config's, applied to quick.axes, may rightly match nothing or stop short of them).
+void check_cells(const ExperimentConfig& e, const MatrixSpec& m, const std::string& source,
+                 const std::string& axes_where, const std::vector<bool>& exclude_used,
+                 bool own_exclude, bool own_frames) {
   if (e.cells.empty()) fail(source, "exclude", "every cell of the matrix is excluded");
-  // An entry that excludes nothing is a typo ("hta") or a value no axis has. The full config's
-  // entries applied to quick.axes may rightly match nothing, so a quick run checks only its own.
-  const bool own_exclude = !quick || (q.is_object() && q.contains("exclude"));
+  // An entry that excludes nothing is a typo ("hta") or a value no axis has.
   for (size_t i = 0; own_exclude && i < exclude_used.size(); ++i)
     if (!exclude_used[i])
-      fail(source, std::string(quick ? "quick.exclude" : "exclude") + "[" + std::to_string(i) + "]",
-           "matches no cell of the matrix: " + exclude[i].dump());
-  // A frame no cell reaches would silently save nothing (and give no reference distance). As
-  // with exclude, a quick run inherits the full frame list and may rightly stop short of it.
+      fail(source,
+           std::string(e.quick ? "quick.exclude" : "exclude") + "[" + std::to_string(i) + "]",
+           "matches no cell of the matrix: " + m.exclude[i].dump());
+  // A frame no cell reaches would silently save nothing (and give no reference distance).
   int max_steps = 0;
   for (const Cell& c : e.cells) max_steps = std::max(max_steps, c.flow.steps);
-  const bool own_frames = !quick || (q.is_object() && q.contains("metrics"));
   for (int f : e.metrics.frames)
     if (own_frames && f > max_steps)
-      fail(source, quick ? "quick.metrics.frames" : "metrics.frames",
+      fail(source, e.quick ? "quick.metrics.frames" : "metrics.frames",
            "step " + std::to_string(f) + " is beyond every cell's steps (at most " +
                std::to_string(max_steps) + ")");
   // Two cells with the same full config would share one result file (same key): the second
@@ -429,6 +451,28 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
                    [&](const Cell& c) { return matches_assignment(c, e.metrics.reference); }))
     fail(source, "metrics.reference",
          "matches no cell of the matrix: " + e.metrics.reference.dump());
+}
+
+}  // namespace
+
+ExperimentConfig parse_experiment_config(const json& j, const std::string& source, bool quick,
+                                         const std::string& default_name) {
+  if (!j.is_object()) throw ConfigError(source + ": expected a JSON object at the top level");
+  ExperimentConfig e;
+  e.source = source;
+  e.quick = quick;
+  e.study_config = j;
+  e.name = default_name;
+  read_header(j, source, e);
+  const MatrixSpec m = read_matrix(j, source, quick, e);
+  const std::string axes_where = quick ? "axes (with quick.axes)" : "axes";
+  const std::vector<Dimension> dims = dimensions(m, source, axes_where);
+  std::vector<bool> exclude_used(m.exclude.is_array() ? m.exclude.size() : 0, false);
+  expand_cells(dims, m, source, e, exclude_used);
+  const json& q = member(j, "quick");
+  const bool own_exclude = !quick || (q.is_object() && q.contains("exclude"));
+  const bool own_frames = !quick || (q.is_object() && q.contains("metrics"));
+  check_cells(e, m, source, axes_where, exclude_used, own_exclude, own_frames);
   return e;
 }
 

@@ -1,8 +1,7 @@
 #include "bench/metrics.h"
 
-#include "bench/bvh.h"
-
-#include <tbb/parallel_for.h>
+#include "core/parallel.h"
+#include "datasets/bvh.h"
 
 #include <algorithm>
 #include <cmath>
@@ -56,22 +55,19 @@ std::vector<double> sampled_squared_distances(const TriangleMesh& from, const Tr
     throw std::invalid_argument("mesh_distance: a mesh has zero or non-finite area");
 
   std::vector<double> d2(std::size_t(samples), 0.0);
-  tbb::parallel_for(
-      tbb::blocked_range<long long>(0, samples, 1024), [&](const tbb::blocked_range<long long>& r) {
-        for (long long i = r.begin(); i != r.end(); ++i) {
-          const double u = uniform(seed, std::uint64_t(i), 0) * total;
-          // First triangle whose prefix end exceeds u; zero-area triangles are never picked.
-          auto it = std::upper_bound(prefix.begin() + 1, prefix.end(), u);
-          Eigen::Index t = std::min<Eigen::Index>(Eigen::Index(it - prefix.begin()) - 1, m - 1);
-          const double r1 = std::sqrt(uniform(seed, std::uint64_t(i), 1)),
-                       r2 = uniform(seed, std::uint64_t(i), 2);
-          const Eigen::Vector3d a = from.vertices.row(from.faces(t, 0)),
-                                b = from.vertices.row(from.faces(t, 1)),
-                                c = from.vertices.row(from.faces(t, 2));
-          const Eigen::Vector3d p = (1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c;
-          d2[std::size_t(i)] = to.closest(p).squared_distance;
-        }
-      });
+  parallel_for_indices<long long>(samples, 1024, [&](long long i) {
+    const double u = uniform(seed, std::uint64_t(i), 0) * total;
+    // First triangle whose prefix end exceeds u; zero-area triangles are never picked.
+    auto it = std::upper_bound(prefix.begin() + 1, prefix.end(), u);
+    Eigen::Index t = std::min<Eigen::Index>(Eigen::Index(it - prefix.begin()) - 1, m - 1);
+    const double r1 = std::sqrt(uniform(seed, std::uint64_t(i), 1)),
+                 r2 = uniform(seed, std::uint64_t(i), 2);
+    const Eigen::Vector3d a = from.vertices.row(from.faces(t, 0)),
+                          b = from.vertices.row(from.faces(t, 1)),
+                          c = from.vertices.row(from.faces(t, 2));
+    const Eigen::Vector3d p = (1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c;
+    d2[std::size_t(i)] = to.closest(p).squared_distance;
+  });
   return d2;
 }
 

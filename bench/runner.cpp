@@ -2,8 +2,8 @@
 
 #include "bench/cell_hash.h"
 #include "bench/environment.h"
-#include "bench/metric_hooks.h"
-#include "datasets/atomic_file.h"
+#include "bench/metrics.h"
+#include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "flows/config_reader.h"
 #include "flows/flow.h"
@@ -90,7 +90,6 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   std::vector<int> written;
   std::map<int, json> step_metrics;
   const bool per_step = m.quasi_conformal || m.sphericity;
-  const MetricHooks& hooks = metric_hooks();
   const bool peak_per_cell = reset_peak_memory();
   const double steal_before = cpu_steal_seconds();
 
@@ -102,8 +101,8 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
     TriangleMesh initial;  // X_0 as the flow sees it (after area normalisation, if any)
     auto measure = [&](int step, const Positions& V) {
       json mj = json::object();
-      if (m.quasi_conformal) mj["quasi_conformal"] = hooks.quasi_conformal_error(initial, V);
-      if (m.sphericity) mj["sphericity"] = hooks.sphericity(V, source.mesh.faces);
+      if (m.quasi_conformal) mj["quasi_conformal"] = quasi_conformal_error(initial, V);
+      if (m.sphericity) mj["sphericity"] = sphericity(V, source.mesh.faces);
       step_metrics[step] = std::move(mj);
     };
     FlowObserver observer;
@@ -164,8 +163,8 @@ json reference_distances(const ExperimentConfig& e, const fs::path& out, const C
     const fs::path a = out / "frames" / cell.hash / frame_name(step);
     const fs::path b = out / "frames" / ref.hash / frame_name(step);
     if (!fs::exists(a) || !fs::exists(b)) continue;
-    const MeshDistance d = metric_hooks().mesh_distance(
-        read_mesh(a.string()), read_mesh(b.string()), e.metrics.distance_samples);
+    const MeshDistance d =
+        mesh_distance(read_mesh(a.string()), read_mesh(b.string()), e.metrics.distance_samples);
     list.push_back({{"step", step},
                     {"rms", d.rms},
                     {"max", d.max},
@@ -307,16 +306,6 @@ const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellP
 RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
     throw std::invalid_argument("--shard: expected i/n with 0 <= i < n");
-  const MetricHooks& hooks = metric_hooks();
-  auto missing = [&](const char* key) {
-    throw ConfigError(
-        e.source + ": metrics." + key +
-        ": this build has no implementation of the metric (bench/metrics*.cpp missing)");
-  };
-  if (e.metrics.quasi_conformal && !hooks.quasi_conformal_error) missing("quasi_conformal");
-  if (e.metrics.sphericity && !hooks.sphericity) missing("sphericity");
-  if (!e.metrics.reference.is_null() && !hooks.mesh_distance) missing("reference");
-
   const bool with_reference = !e.metrics.reference.is_null();
   MeshCache meshes;
   // Every mesh this shard needs is loaded (and every cell named) before anything is written,

@@ -92,9 +92,8 @@ std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e,
                           int shard_count);
 inline constexpr const char* kPlanFolder = "plans";
 
-/// Runs the shard. Config problems (including metrics whose hooks this build lacks) throw
-/// before anything is written; an exception inside one cell's flow becomes that cell's
-/// result {"status": "error", "error": ...} and the run goes on.
+/// Runs the shard. Config problems throw before anything is written; an exception inside one
+/// cell's flow becomes that cell's result {"status": "error", "error": ...} and the run goes on.
 RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& options);
 
 /// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the

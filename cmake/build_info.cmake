@@ -9,7 +9,7 @@ if(NOT MCFBENCH_GIT_COMMIT)
 elseif(_dirty)
   # The uncommitted change's own fingerprint, so two different edits of one commit never share
   # a label: result cells are keyed by it, and a run resumed after an edit must not take the
-  # cells of the earlier edit for its own (bench/run_micro.sh names its files the same way).
+  # cells of the earlier edit for its own (benchmarks/run_micro.sh names its files the same way).
   execute_process(COMMAND git diff HEAD WORKING_DIRECTORY ${SOURCE_DIR}
                   OUTPUT_VARIABLE _diff ERROR_QUIET)
   string(SHA1 _diff_hash "${_diff}")

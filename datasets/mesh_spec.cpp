@@ -201,25 +201,125 @@ void fit_unit_cube(TriangleMesh& mesh) {
   }
 }
 
+namespace {
+
+/// Splits "@faces=N" off `spec`: returns N (0 without it) and leaves the rest in `head`.
+long long split_face_target(const std::string& spec, std::string& head) {
+  head = spec;
+  const auto at = spec.rfind('@');
+  if (at == std::string::npos || looks_like_file(spec.substr(at + 1))) return 0;
+  head = spec.substr(0, at);
+  const std::string mod = spec.substr(at + 1);
+  const auto eq = mod.find('=');
+  const std::string key = mod.substr(0, eq);
+  if (key != "faces" || eq == std::string::npos)
+    fail(spec, "unknown modifier key '" + key + "' (only @faces=N)");
+  const long long target_faces =
+      static_cast<long long>(parse_number(spec, "faces", mod.substr(eq + 1), true));
+  if (target_faces < 1 || target_faces > kMaxFaces)
+    fail(spec,
+         "key 'faces' must be in 1.." + std::to_string(kMaxFaces) + ", got " + mod.substr(eq + 1));
+  return target_faces;
+}
+
+/// The generator's values: its defaults, overridden by the spec's key=value items (`args` is
+/// empty and `given` false for "NAME" alone), each key known, given once and in range.
+Values generator_values(const std::string& spec, const Generator& g, const std::string& args,
+                        bool given) {
+  Values values;
+  for (const auto& p : g.params) values[p.key] = p.fallback;
+  std::vector<std::string> seen;
+  size_t pos = 0;
+  while (given && pos <= args.size()) {
+    const size_t comma = std::min(args.find(',', pos), args.size());
+    const std::string item = args.substr(pos, comma - pos);
+    pos = comma + 1;
+    const auto eq = item.find('=');
+    const std::string key = item.substr(0, eq);
+    if (eq == std::string::npos || key.empty())
+      fail(spec, "expected key=value, got '" + item + "' (keys of " + g.name + ": " +
+                     param_list(g) + ")");
+    auto p = std::find_if(g.params.begin(), g.params.end(),
+                          [&](const Param& x) { return x.key == key; });
+    if (p == g.params.end())
+      fail(spec, "unknown key '" + key + "' for " + g.name + " (keys: " + param_list(g) + ")");
+    if (std::find(seen.begin(), seen.end(), key) != seen.end())
+      fail(spec, "key '" + key + "' given twice");
+    seen.push_back(key);
+    values[key] = parse_number(spec, key, item.substr(eq + 1), p->integer);
+    if (p->integer && std::abs(values[key]) > p->max)
+      fail(spec, "key '" + key + "' is out of range (at most " +
+                     std::to_string(static_cast<long long>(p->max)) + "), got " +
+                     item.substr(eq + 1));
+  }
+  // Values the generators refuse (a count or size <= 0) are theirs to name; a size that would
+  // overflow their int counts or exhaust memory is refused here, before anything is built.
+  if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second > 0; })) {
+    const double faces = g.faces(values);
+    if (!(faces <= static_cast<double>(kMaxFaces)))
+      fail(spec, "these values make about " +
+                     std::to_string(static_cast<long long>(std::min(faces, 1e18))) +
+                     " faces, more than the " + std::to_string(kMaxFaces) + " a mesh may have");
+  }
+  return values;
+}
+
+/// A generated mesh ("NAME[:key=value,...]", `given` when the colon is there) into `src`.
+void load_generated(const std::string& spec, const std::string& name, const std::string& args,
+                    bool given, MeshSource& src) {
+  const auto& table = generators();
+  auto g =
+      std::find_if(table.begin(), table.end(), [&](const Generator& x) { return x.name == name; });
+  if (g == table.end()) {
+    std::string known = "cgal";
+    for (const auto& x : table) known += ", " + x.name;
+    fail(spec, "unknown generator '" + name + "' (known: " + known + ", or a file path)");
+  }
+  const Values values = generator_values(spec, *g, args, given);
+  src.kind = name;
+  src.analytic = true;
+  try {
+    src.mesh = g->build(values);
+    // As read_mesh does for files: then every MeshSource's faces hold in a half-edge mesh,
+    // and a flow writes them without checking each frame again (FaceCheck::trusted).
+    check_half_edge_faces(src.mesh, name);
+  } catch (const MeshError& e) {
+    fail(spec, e.what());
+  }
+  if (name == "sphere" || name == "icosphere") src.sphere_radius = values.at("radius");
+  if (name == "open_cylinder") src.cylinder_radius = values.at("radius");
+  // The spiral stands in for the paper's cubical spiral *model*, and the paper scales every
+  // model but the sphere into the unit cube (docs/design.md "Conventions"): so does this one, or
+  // table1's δ and octree would see a 2 x 2 x 3.6 shape instead.
+  if (name == "spiral") {
+    src.analytic = false;
+    fit_unit_cube(src.mesh);
+  }
+}
+
+/// "@faces=N": subdivides to about N faces, with the midpoints of an analytic sphere or
+/// cylinder put back onto it.
+void subdivide_source(MeshSource& src, long long target_faces) {
+  src.mesh = subdivide_to_faces(src.mesh, target_faces);
+  // Midpoints of a sphere lie inside it; put them back so sphere_radius stays exact.
+  if (src.sphere_radius)
+    src.mesh.vertices = src.mesh.vertices.rowwise().normalized() * *src.sphere_radius;
+  // Likewise chord midpoints around a cylinder: back onto radius r about the z axis.
+  if (src.cylinder_radius)
+    for (Eigen::Index v = 0; v < src.mesh.vertices.rows(); ++v) {
+      const double rho = std::hypot(src.mesh.vertices(v, 0), src.mesh.vertices(v, 1));
+      src.mesh.vertices(v, 0) *= *src.cylinder_radius / rho;
+      src.mesh.vertices(v, 1) *= *src.cylinder_radius / rho;
+    }
+}
+
+}  // namespace
+
 MeshSource load_mesh_spec(const std::string& spec) {
   MeshSource src;
   src.spec = spec;
-
-  // Split off "@faces=N".
-  std::string head = spec;
-  long long target_faces = 0;
-  if (auto at = spec.rfind('@'); at != std::string::npos && !looks_like_file(spec.substr(at + 1))) {
-    head = spec.substr(0, at);
-    const std::string mod = spec.substr(at + 1);
-    const auto eq = mod.find('=');
-    const std::string key = mod.substr(0, eq);
-    if (key != "faces" || eq == std::string::npos)
-      fail(spec, "unknown modifier key '" + key + "' (only @faces=N)");
-    target_faces = static_cast<long long>(parse_number(spec, "faces", mod.substr(eq + 1), true));
-    if (target_faces < 1 || target_faces > kMaxFaces)
-      fail(spec, "key 'faces' must be in 1.." + std::to_string(kMaxFaces) + ", got " +
-                     mod.substr(eq + 1));
-  }
+  std::string head;
+  const long long target_faces = split_face_target(spec, head);
   if (head.empty()) fail(spec, "empty mesh spec");
 
   std::string validate_name = spec;
@@ -242,84 +342,10 @@ MeshSource load_mesh_spec(const std::string& spec) {
       }
       fit_unit_cube(src.mesh);
     } else {
-      const auto& table = generators();
-      auto g = std::find_if(table.begin(), table.end(),
-                            [&](const Generator& x) { return x.name == name; });
-      if (g == table.end()) {
-        std::string known = "cgal";
-        for (const auto& x : table) known += ", " + x.name;
-        fail(spec, "unknown generator '" + name + "' (known: " + known + ", or a file path)");
-      }
-      Values values;
-      for (const auto& p : g->params) values[p.key] = p.fallback;
-      std::vector<std::string> seen;
-      size_t pos = 0;
-      while (colon != std::string::npos && pos <= args.size()) {
-        const size_t comma = std::min(args.find(',', pos), args.size());
-        const std::string item = args.substr(pos, comma - pos);
-        pos = comma + 1;
-        const auto eq = item.find('=');
-        const std::string key = item.substr(0, eq);
-        if (eq == std::string::npos || key.empty())
-          fail(spec, "expected key=value, got '" + item + "' (keys of " + name + ": " +
-                         param_list(*g) + ")");
-        auto p = std::find_if(g->params.begin(), g->params.end(),
-                              [&](const Param& x) { return x.key == key; });
-        if (p == g->params.end())
-          fail(spec, "unknown key '" + key + "' for " + name + " (keys: " + param_list(*g) + ")");
-        if (std::find(seen.begin(), seen.end(), key) != seen.end())
-          fail(spec, "key '" + key + "' given twice");
-        seen.push_back(key);
-        values[key] = parse_number(spec, key, item.substr(eq + 1), p->integer);
-        if (p->integer && std::abs(values[key]) > p->max)
-          fail(spec, "key '" + key + "' is out of range (at most " +
-                         std::to_string(static_cast<long long>(p->max)) + "), got " +
-                         item.substr(eq + 1));
-      }
-      // Values the generators refuse (a count or size <= 0) are theirs to name; a size that would
-      // overflow their int counts or exhaust memory is refused here, before anything is built.
-      if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second > 0; })) {
-        const double faces = g->faces(values);
-        if (!(faces <= static_cast<double>(kMaxFaces)))
-          fail(spec, "these values make about " +
-                         std::to_string(static_cast<long long>(std::min(faces, 1e18))) +
-                         " faces, more than the " + std::to_string(kMaxFaces) + " a mesh may have");
-      }
-      src.kind = name;
-      src.analytic = true;
-      try {
-        src.mesh = g->build(values);
-        // As read_mesh does for files: then every MeshSource's faces hold in a half-edge mesh,
-        // and a flow writes them without checking each frame again (FaceCheck::trusted).
-        check_half_edge_faces(src.mesh, name);
-      } catch (const MeshError& e) {
-        fail(spec, e.what());
-      }
-      if (name == "sphere" || name == "icosphere") src.sphere_radius = values.at("radius");
-      if (name == "open_cylinder") src.cylinder_radius = values.at("radius");
-      // The spiral stands in for the paper's cubical spiral *model*, and the paper scales every
-      // model but the sphere into the unit cube (docs/design.md "Conventions"): so does this one,
-      // or table1's δ and octree would see a 2 x 2 x 3.6 shape instead.
-      if (name == "spiral") {
-        src.analytic = false;
-        fit_unit_cube(src.mesh);
-      }
+      load_generated(spec, name, args, colon != std::string::npos, src);
     }
   }
-
-  if (target_faces > 0) {
-    src.mesh = subdivide_to_faces(src.mesh, target_faces);
-    // Midpoints of a sphere lie inside it; put them back so sphere_radius stays exact.
-    if (src.sphere_radius)
-      src.mesh.vertices = src.mesh.vertices.rowwise().normalized() * *src.sphere_radius;
-    // Likewise chord midpoints around a cylinder: back onto radius r about the z axis.
-    if (src.cylinder_radius)
-      for (Eigen::Index v = 0; v < src.mesh.vertices.rows(); ++v) {
-        const double rho = std::hypot(src.mesh.vertices(v, 0), src.mesh.vertices(v, 1));
-        src.mesh.vertices(v, 0) *= *src.cylinder_radius / rho;
-        src.mesh.vertices(v, 1) *= *src.cylinder_radius / rho;
-      }
-  }
+  if (target_faces > 0) subdivide_source(src, target_faces);
   src.report = validate_mesh(src.mesh, validate_name);
   return src;
 }

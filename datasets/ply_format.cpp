@@ -328,16 +328,15 @@ std::string read_file(const std::string& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-}  // namespace
-
-WalkedMesh scan_ply(const std::string& path) {
-  const std::string data = read_file(path);
-  const Header header = parse_header(path, data);
+/// The vertex element and the property index of its x, y and z (`axis_of`); its count is
+/// checked against the body's size (every value takes at least one byte, a digit or a binary
+/// char, so a count beyond that is a broken header) before the coordinates are allocated.
+const Element& vertex_element(const std::string& path, const Header& header, std::size_t file_size,
+                              int axis_of[3]) {
   const Element* vertex = nullptr;
   for (const Element& e : header.elements)
     if (e.name == "vertex") vertex = &e;
   if (!vertex) throw MeshError(path + ": the header declares no vertex element");
-  int axis_of[3] = {-1, -1, -1};  // property index of x, y, z
   for (std::size_t i = 0; i < vertex->properties.size(); ++i) {
     const Property& p = vertex->properties[i];
     for (int c = 0; c < 3; ++c)
@@ -347,69 +346,86 @@ WalkedMesh scan_ply(const std::string& path) {
     if (axis_of[c] < 0)
       throw MeshError(path + ": the vertex element has no scalar property '" +
                       std::string(1, char('x' + c)) + "'");
-
-  // Every value takes at least one byte (a digit, or a binary char), so a count beyond that is a
-  // broken header; checked before the coordinates are allocated.
   if (static_cast<double>(vertex->count) * vertex->properties.size() >
-      static_cast<double>(data.size() - header.body_offset))
+      static_cast<double>(file_size - header.body_offset))
     throw MeshError(path + ": the header declares " + std::to_string(vertex->count) +
                     " vertices, more than the file's body can hold");
   if (vertex->count > std::numeric_limits<int>::max())
     throw MeshError(path + ": the header declares " + std::to_string(vertex->count) +
                     " vertices, more than a mesh's int indices can address");
+  return *vertex;
+}
+
+/// The face element's corner list (found once: names are not compared per record); -1 for
+/// another element.
+int corner_list_of(const std::string& path, const Element& e) {
+  int corner_list = -1;
+  if (e.name == "face")
+    for (std::size_t i = 0; i < e.properties.size(); ++i)
+      if (e.properties[i].is_list() &&
+          (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
+        corner_list = static_cast<int>(i);
+  if (e.name == "face" && corner_list < 0 && e.count > 0)
+    throw MeshError(path + ": the face element has no list property 'vertex_indices'");
+  return corner_list;
+}
+
+/// One list property of record `r`; a face's corner list (`corners`) is fan-triangulated into
+/// `out`, any other list skipped.
+void read_list(BodyReader& body, const Property& p, long long r, bool corners,
+               long long vertex_count, std::vector<int>& corner, WalkedMesh& out) {
+  const long long k = body.next_integer(p.count_type, BodyReader::Part::list_length);
+  if (k < 0) body.fail(body.record() + ": negative list length " + std::to_string(k));
+  if (corners && k < 3)
+    body.fail("face " + std::to_string(r) + " has " + std::to_string(k) + " corners (at least 3)");
+  corner.clear();
+  for (long long j = 0; j < k; ++j) {
+    if (!corners) {
+      body.next(p.type);
+      continue;
+    }
+    const long long index = body.next_integer(p.type, BodyReader::Part::corner, j);
+    if (index < 0 || index >= vertex_count)
+      body.fail("face " + std::to_string(r) + " references vertex " + std::to_string(index) +
+                " but the mesh has " + std::to_string(vertex_count) + " vertices");
+    corner.push_back(static_cast<int>(index));
+  }
+  if (!corners) return;
+  if (out.source.size() + (k - 2) > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    body.fail("more triangles than a mesh's int indices can address");
+  add_fan(out, corner, r);
+}
+
+}  // namespace
+
+WalkedMesh scan_ply(const std::string& path) {
+  const std::string data = read_file(path);
+  const Header header = parse_header(path, data);
+  int axis_of[3] = {-1, -1, -1};  // property index of x, y, z
+  const Element& vertex = vertex_element(path, header, data.size(), axis_of);
   WalkedMesh out;
-  out.coords.resize(3 * static_cast<std::size_t>(vertex->count));
+  out.coords.resize(3 * static_cast<std::size_t>(vertex.count));
   std::vector<int> corner;  // one face's corners, fan-triangulated once the face is read
   BodyReader body(path, data, header);
   for (const Element& e : header.elements) {
-    const bool is_vertex = &e == vertex;
-    // The face element's corner list, found once (names are not compared per record).
-    int corner_list = -1;
-    if (e.name == "face")
-      for (std::size_t i = 0; i < e.properties.size(); ++i)
-        if (e.properties[i].is_list() &&
-            (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
-          corner_list = static_cast<int>(i);
-    if (e.name == "face" && corner_list < 0 && e.count > 0)
-      throw MeshError(path + ": the face element has no list property 'vertex_indices'");
+    const bool is_vertex = &e == &vertex;
+    const int corner_list = corner_list_of(path, e);
     for (long long r = 0; r < e.count; ++r) {
       body.start_record(e, r);
       for (std::size_t i = 0; i < e.properties.size(); ++i) {
         const Property& p = e.properties[i];
-        if (!p.is_list()) {
-          const double v = body.next(p.type);
-          if (is_vertex)
-            for (int c = 0; c < 3; ++c)
-              if (axis_of[c] == static_cast<int>(i)) {
-                if (!std::isfinite(v))
-                  body.fail("vertex " + std::to_string(r) + " has a non-finite coordinate " +
-                            p.name);
-                out.coords[3 * r + c] = v;
-              }
+        if (p.is_list()) {
+          read_list(body, p, r, static_cast<int>(i) == corner_list, vertex.count, corner, out);
           continue;
         }
-        const long long k = body.next_integer(p.count_type, BodyReader::Part::list_length);
-        if (k < 0) body.fail(body.record() + ": negative list length " + std::to_string(k));
-        const bool corners = static_cast<int>(i) == corner_list;
-        if (corners && k < 3)
-          body.fail("face " + std::to_string(r) + " has " + std::to_string(k) +
-                    " corners (at least 3)");
-        corner.clear();
-        for (long long j = 0; j < k; ++j) {
-          if (!corners) {
-            body.next(p.type);
-            continue;
-          }
-          const long long index = body.next_integer(p.type, BodyReader::Part::corner, j);
-          if (index < 0 || index >= vertex->count)
-            body.fail("face " + std::to_string(r) + " references vertex " + std::to_string(index) +
-                      " but the mesh has " + std::to_string(vertex->count) + " vertices");
-          corner.push_back(static_cast<int>(index));
-        }
-        if (!corners) continue;
-        if (out.source.size() + (k - 2) > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-          body.fail("more triangles than a mesh's int indices can address");
-        add_fan(out, corner, r);
+        const double v = body.next(p.type);
+        if (is_vertex)
+          for (int c = 0; c < 3; ++c)
+            if (axis_of[c] == static_cast<int>(i)) {
+              if (!std::isfinite(v))
+                body.fail("vertex " + std::to_string(r) + " has a non-finite coordinate " + p.name);
+              out.coords[3 * r + c] = v;
+            }
       }
       body.end_record();
     }

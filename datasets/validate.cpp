@@ -73,9 +73,8 @@ double face_area(const TriangleMesh& mesh, Eigen::Index f) {
   return 0.5 * (b - a).cross(c - a).norm();
 }
 
-}  // namespace
-
-MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
+/// Non-empty, finite coordinates, vertex indices in range, no vertex twice in a face.
+void check_faces(const TriangleMesh& mesh, const std::string& name) {
   const Eigen::Index n = mesh.num_vertices();
   const Eigen::Index m = mesh.num_faces();
   if (n == 0 || m == 0)
@@ -97,37 +96,46 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
       fail(name, "face " + std::to_string(f) + " repeats a vertex (" + std::to_string(a) + ", " +
                      std::to_string(b) + ", " + std::to_string(c) + ")");
   }
+}
 
-  // Degeneracy relative to the model's size: the studies mix unit-cube models and big analytic
-  // shapes, so an absolute area threshold would be wrong for one of them.
-  const std::vector<char> referenced = referenced_vertices(n, mesh.faces);
+/// The total area; a face degenerate relative to the model's size throws (the studies mix
+/// unit-cube models and big analytic shapes, so an absolute area threshold would be wrong for
+/// one of them).
+double checked_area(const TriangleMesh& mesh, const std::string& name,
+                    const std::vector<char>& referenced) {
   const double diag2 = bounds_of(mesh.vertices, referenced)
                            .extent()
                            .squaredNorm();  // a stray vertex is not the model's size
   const double min_area = 1e-14 * diag2;
-  MeshReport report;
-  report.vertices = n;
-  report.faces = m;
-  for (Eigen::Index f = 0; f < m; ++f) {
+  double total = 0;
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
     const double area = face_area(mesh, f);
     if (area == 0.0 || area <= min_area)
       fail(name, "face " + std::to_string(f) + " is degenerate (area " + std::to_string(area) +
                      ", vertices " + std::to_string(mesh.faces(f, 0)) + ", " +
                      std::to_string(mesh.faces(f, 1)) + ", " + std::to_string(mesh.faces(f, 2)) +
                      ")");
-    report.area += area;
+    total += area;
   }
+  return total;
+}
 
-  // Edges: a run of equal keys in the sorted list is one undirected edge and its faces.
+/// What the edges tell: boundary edges joined into loops, and the edges of each component
+/// (its root in the components' union-find).
+struct EdgeCounts {
+  UnionFind boundary;
+  std::vector<char> on_boundary;
+  std::vector<long long> edges_of_root;
+};
+
+/// Walks the undirected edges (a run of equal keys in the sorted list is one edge and its
+/// faces): a non-manifold edge throws, misoriented ones are counted in `report`.
+EdgeCounts count_edges(const TriangleMesh& mesh, const std::string& name, UnionFind& uf,
+                       MeshReport& report) {
+  const Eigen::Index n = mesh.num_vertices();
   const auto uses = sorted_edge_uses(mesh.faces);
-  UnionFind uf(static_cast<size_t>(n));
-  for (Eigen::Index f = 0; f < m; ++f) {
-    uf.unite(mesh.faces(f, 0), mesh.faces(f, 1));
-    uf.unite(mesh.faces(f, 0), mesh.faces(f, 2));
-  }
-  UnionFind boundary_uf(static_cast<size_t>(n));
-  std::vector<char> on_boundary(n, 0);
-  std::vector<long long> edges_of_root(n, 0);
+  EdgeCounts e{UnionFind(static_cast<size_t>(n)), std::vector<char>(n, 0),
+               std::vector<long long>(n, 0)};
   for (size_t i = 0; i < uses.size();) {
     size_t j = i;
     while (j < uses.size() && uses[j].key == uses[i].key) ++j;
@@ -138,16 +146,21 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
                      std::to_string(uses[i].face) + ", " + std::to_string(uses[i + 1].face) + ", " +
                      std::to_string(uses[i + 2].face) + ", ...)");
     if (j - i == 1) {
-      boundary_uf.unite(a, b);
-      on_boundary[a] = on_boundary[b] = 1;
+      e.boundary.unite(a, b);
+      e.on_boundary[a] = e.on_boundary[b] = 1;
     } else if (uses[i].forward == uses[i + 1].forward) {
       ++report.misoriented_edges;
     }
-    ++edges_of_root[uf.find(a)];
+    ++e.edges_of_root[uf.find(a)];
     i = j;
   }
+  return e;
+}
 
-  // Per component: referenced vertices, edges, faces, boundary loops -> χ_c and genus.
+/// Per component: referenced vertices, edges, faces, boundary loops -> χ_c and genus.
+void count_components(const TriangleMesh& mesh, const std::vector<char>& referenced, UnionFind& uf,
+                      EdgeCounts& e, MeshReport& report) {
+  const Eigen::Index n = mesh.num_vertices();
   std::vector<long long> verts_of_root(n, 0), faces_of_root(n, 0), loops_of_root(n, 0);
   for (Eigen::Index v = 0; v < n; ++v) {
     if (!referenced[v]) {
@@ -156,18 +169,36 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
     }
     const int root = uf.find(static_cast<int>(v));
     ++verts_of_root[root];
-    if (on_boundary[v] && boundary_uf.find(static_cast<int>(v)) == v) ++loops_of_root[root];
+    if (e.on_boundary[v] && e.boundary.find(static_cast<int>(v)) == v) ++loops_of_root[root];
   }
-  for (Eigen::Index f = 0; f < m; ++f) ++faces_of_root[uf.find(mesh.faces(f, 0))];
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) ++faces_of_root[uf.find(mesh.faces(f, 0))];
 
   for (Eigen::Index v = 0; v < n; ++v) {
     if (!referenced[v] || uf.find(static_cast<int>(v)) != v) continue;
     ++report.connected_components;
-    const long long chi = verts_of_root[v] - edges_of_root[v] + faces_of_root[v];
+    const long long chi = verts_of_root[v] - e.edges_of_root[v] + faces_of_root[v];
     report.euler_characteristic += chi;
     report.boundary_loops += loops_of_root[v];
     report.genus += (2 - chi - loops_of_root[v]) / 2;
   }
+}
+
+}  // namespace
+
+MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
+  check_faces(mesh, name);
+  const std::vector<char> referenced = referenced_vertices(mesh.num_vertices(), mesh.faces);
+  MeshReport report;
+  report.vertices = mesh.num_vertices();
+  report.faces = mesh.num_faces();
+  report.area = checked_area(mesh, name, referenced);
+  UnionFind uf(static_cast<size_t>(mesh.num_vertices()));
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
+    uf.unite(mesh.faces(f, 0), mesh.faces(f, 1));
+    uf.unite(mesh.faces(f, 0), mesh.faces(f, 2));
+  }
+  EdgeCounts edges = count_edges(mesh, name, uf, report);
+  count_components(mesh, referenced, uf, edges, report);
   return report;
 }
 

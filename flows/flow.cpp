@@ -1,8 +1,7 @@
 #include "flows/flow.h"
 
+#include "core/parallel.h"
 #include "datasets/validate.h"
-
-#include <Eigen/Geometry>
 #include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
 #include "flows/integrator.h"
@@ -14,9 +13,13 @@
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
+#include <Eigen/Geometry>
 
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
 
 namespace mcf {
 namespace {
@@ -133,6 +136,253 @@ bool all_finite(const Positions& V) {
   return V.allFinite();
 }
 
+nlohmann::json mesh_json(const MeshSource& source) {
+  const MeshReport& rep = source.report;
+  return {{"spec", source.spec},
+          {"vertices", rep.vertices},
+          {"faces", rep.faces},
+          {"boundary_loops", rep.boundary_loops},
+          {"genus", rep.genus},
+          {"components", rep.connected_components},
+          {"unreferenced_vertices", rep.unreferenced_vertices},
+          {"area", rep.area},
+          {"analytic", source.analytic}};
+}
+
+/// x -> (x - centroid) * scale, row by row.
+void apply(const Normalization& n, Coefficients& x) {
+  x = (x.rowwise() - n.centroid) * n.scale;
+}
+
+/// One flow from its set-up to its last step: the basis, solver and integrator it sets up, the
+/// iterates, the stop rules and what result.json records of each step. run_flow drives it.
+class FlowRun {
+ public:
+  /// Set-up: the (normalised) mesh, basis, solver and integrator; result["system"] and
+  /// result["solver_name"]. Throws a ConfigError for a solver that cannot take the basis.
+  FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::json& result);
+
+  const Positions& vertices() const { return V_; }
+  /// Makes step `step`; false when a stop rule ends the flow there (result["stop"] says why).
+  bool advance(int step);
+  /// result["stop"] (if no rule stopped the flow) and result["steps"]; the final mesh.
+  TriangleMesh finish();
+
+ private:
+  void begin_step(int step);
+  nlohmann::json solver_record(int step, double t) const;
+  std::optional<std::string> stop_rule(const Positions& V_new, const Coefficients& x_new,
+                                       double& area, nlohmann::json& record) const;
+  void stop(int step, Clock::time_point step_start, const std::string& reason,
+            nlohmann::json& record);
+  void record_references(const Positions& V_new, double t, nlohmann::json& record);
+
+  const FlowConfig& config_;
+  const MeshSource& source_;
+  nlohmann::json& result_;
+  TriangleMesh mesh_;
+  std::unique_ptr<Basis> basis_;
+  std::unique_ptr<LinearSolver> solver_;
+  std::unique_ptr<Integrator> integrator_;
+  double build_seconds_ = 0;  // a rebuilt basis: its step 1's update
+  std::unique_ptr<FlowStepContext> ctx_;
+  Positions V_;
+  Coefficients x_, x_prev_;
+  bool has_prev_ = false;
+  double area0_ = 0, previous_area_ = 0;
+  std::optional<SphereReference> sphere_;
+  std::optional<CylinderReference> cylinder_;
+  nlohmann::json steps_ = nlohmann::json::array();
+};
+
+FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::json& result)
+    : config_(config), source_(source), result_(result), mesh_(source.mesh) {
+  const Triangles& F = mesh_.faces;
+  if (config.normalize_area) apply(unit_area_normalization(mesh_.vertices, F), mesh_.vertices);
+
+  const auto setup_start = Clock::now();
+  basis_ = make_basis(config, mesh_, source.analytic);
+  build_seconds_ = seconds_since(setup_start);
+  solver_ = make_solver(config.solver);
+  // A solver that takes only small systems (the dense reference) would refuse this one at its
+  // first factorization: say so now, as the configuration error it is, rather than stop the
+  // flow at step 1 as if it had turned singular.
+  if (const Eigen::Index free =
+          basis_->dimension() - Eigen::Index(basis_->locked_functions().size());
+      free > solver_->max_dimension())
+    throw ConfigError(source.spec + ": solver: \"" + config.solver.name + "\" factorizes at most " +
+                      std::to_string(solver_->max_dimension()) + " functions and this basis has " +
+                      std::to_string(free) +
+                      " free ones; use \"cholmod\", \"pcg\" or \"multigrid\"");
+  integrator_ = make_integrator(config.integrator, config.extrapolate);
+  result["system"] = stats_json(basis_->stats());
+  result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);
+  result["solver_name"] = solver_->name();
+
+  ctx_ = std::make_unique<FlowStepContext>(*basis_, *solver_, config.flow, config.dt);
+  V_ = mesh_.vertices;
+  x_ = basis_->initial_coefficients();
+  area0_ = surface_area(mesh_);
+  previous_area_ = area0_;
+  if (source.sphere_radius && !config.normalize_area)
+    sphere_.emplace(*source.sphere_radius, config.flow == "heat");
+  if (source.cylinder_radius && !config.normalize_area)
+    cylinder_.emplace(*source.cylinder_radius, config.flow, V_);
+}
+
+void FlowRun::begin_step(int step) {
+  if (!basis_->rebuilds_every_step()) {
+    ctx_->begin_step(x_, has_prev_ ? &x_prev_ : nullptr);
+    return;
+  }
+  // Step 1 solves on the system the set-up built on X_0, so that build is its update: every
+  // step's update is then one build (a step 1 recorded as ~0 made Table 1's rebuilt mean 20%
+  // low over 5 steps, 33% over the quick run's 3), and X_0 is not built twice.
+  const auto t0 = Clock::now();
+  if (step > 1) {
+    basis_->rebuild(V_);
+    ctx_->rebuilt();
+  }
+  x_ = basis_->initial_coefficients();
+  has_prev_ = false;
+  ctx_->begin_step(x_, nullptr);
+  ctx_->add_update_seconds(step > 1 ? seconds_since(t0) : build_seconds_);
+}
+
+nlohmann::json FlowRun::solver_record(int step, double t) const {
+  const FlowStepContext& ctx = *ctx_;
+  const SolveReport& worst = ctx.worst_;
+  nlohmann::json record = {{"step", step}, {"t", t}};
+  record["solver"] = {
+      {"iterations", ctx.iterations_},
+      {"solves", ctx.solves_},
+      {"residuals",
+       ctx.residuals_per_solve_.empty() ? std::vector<double>{} : ctx.residuals_per_solve_.back()},
+      {"relative_residual", worst.relative_residual},
+      {"status", to_string(worst.status)}};
+  if (ctx.solves_ > 1) record["solver"]["residuals_per_solve"] = ctx.residuals_per_solve_;
+  // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
+  // Gauss-Seidel on a level), or why it failed.
+  if (!worst.message.empty()) record["solver"]["message"] = worst.message;
+  if (ctx.fixed()) record["fixed_functions"] = ctx.fixed();
+  if (basis_->rebuilds_every_step()) {
+    record["dimension"] = basis_->dimension();
+    record["split_triangles"] = basis_->stats().split_triangles;
+    record["setup_seconds"] = basis_->stats().setup_seconds;
+  }
+  return record;
+}
+
+std::optional<std::string> FlowRun::stop_rule(const Positions& V_new, const Coefficients& x_new,
+                                              double& area, nlohmann::json& record) const {
+  if (!all_finite(V_new) || !x_new.allFinite()) return "non-finite vertex positions";
+  area = surface_area(TriangleMesh{V_new, mesh_.faces});
+  if (!(area > 1e-12 * area0_)) {
+    record["area"] = area;
+    return "collapsed area (" + std::to_string(area) + ")";
+  }
+  if (area > 1.05 * previous_area_) {
+    // MCF, cMCF and heat flow never increase the area; a step that grows it by more than 5%
+    // is an unstable (explicit) step, not a flow.
+    record["area"] = area;
+    return "diverged: the area grew by " +
+           std::to_string(int(std::lround(100 * (area / previous_area_ - 1)))) +
+           "% in one step (unstable time step)";
+  }
+  return std::nullopt;
+}
+
+void FlowRun::stop(int step, Clock::time_point step_start, const std::string& reason,
+                   nlohmann::json& record) {
+  // A stopping step is recorded with its seconds too (every step has them: the result.json
+  // contract), then the flow stops.
+  record["seconds"] = {{"update", ctx_->update_seconds_},
+                       {"solve", ctx_->solve_seconds_},
+                       {"total", seconds_since(step_start)}};
+  steps_.push_back(record);
+  result_["status"] = "singular";
+  result_["stop"] = {{"step", step}, {"reason", reason}};
+}
+
+void FlowRun::record_references(const Positions& V_new, double t, nlohmann::json& record) {
+  if (cylinder_) {
+    cylinder_->advance(config_.dt);
+    record["cylinder"] = {{"ring_radius", cylinder_->ring_radius(V_new)},
+                          {"radius_semi_implicit", cylinder_->discrete},
+                          {"radius_continuous", cylinder_->continuous(t)},
+                          {"ring_vertices", cylinder_->ring.size()}};
+  }
+  if (sphere_) {
+    sphere_->advance(config_.dt);
+    const RadialError d = radial_error(V_new, sphere_->discrete);
+    const RadialError c = radial_error(V_new, sphere_->continuous(t));
+    record["radial_error"] = {{"rms", d.rms},
+                              {"max", d.max},
+                              {"rms_continuous", c.rms},
+                              {"max_continuous", c.max},
+                              {"mean_radius", V_new.rowwise().norm().mean()},
+                              {"radius_semi_implicit", sphere_->discrete},
+                              {"radius_continuous", sphere_->continuous(t)}};
+  }
+}
+
+bool FlowRun::advance(int step) {
+  const auto step_start = Clock::now();
+  const double t = step * config_.dt;
+  begin_step(step);
+  Coefficients x_new = integrator_->step(*ctx_);
+  nlohmann::json record = solver_record(step, t);
+  const SolveReport& worst = ctx_->worst_;
+  if (!worst.ok()) {
+    stop(step, step_start,
+         std::string("solver: ") + to_string(worst.status) +
+             (worst.message.empty() ? "" : " (" + worst.message + ")"),
+         record);
+    return false;
+  }
+
+  const auto eval_start = Clock::now();
+  Positions V_new = basis_->evaluate_vertices(x_new);
+  double area = 0;
+  if (const std::optional<std::string> reason = stop_rule(V_new, x_new, area, record)) {
+    stop(step, step_start, *reason, record);
+    return false;
+  }
+  if (config_.normalize_area) {
+    const Normalization n = unit_area_normalization(V_new, mesh_.faces);
+    apply(n, V_new);
+    apply(n, x_new);
+    apply(n, x_);  // becomes X_{n-1}: same frame as X_n for two-step schemes
+    basis_->reframe(n.centroid, n.scale);  // with refine_input, the flowed midpoints follow
+  }
+  const double step_difference = (V_new - V_).norm();
+  previous_area_ = config_.normalize_area ? 1.0 : area;
+  const double evaluate_seconds = seconds_since(eval_start);
+
+  record["area"] = area;
+  record["step_difference"] = step_difference;
+  record_references(V_new, t, record);
+  if (integrator_->uses_previous()) {
+    x_prev_ = std::move(x_);
+    has_prev_ = true;
+  }
+  x_ = std::move(x_new);  // for a one-step scheme this frees X_{n-1}
+  V_ = std::move(V_new);
+  record["seconds"] = {{"update", ctx_->update_seconds_},
+                       {"solve", ctx_->solve_seconds_},
+                       {"evaluate", evaluate_seconds},
+                       {"total", seconds_since(step_start)}};
+  steps_.push_back(std::move(record));
+  return true;
+}
+
+TriangleMesh FlowRun::finish() {
+  if (!result_.contains("stop"))
+    result_["stop"] = {{"step", int(steps_.size())}, {"reason", "completed"}};
+  result_["steps"] = std::move(steps_);
+  return TriangleMesh{V_, mesh_.faces};
+}
+
 }  // namespace
 
 Normalization unit_area_normalization(const Positions& V, const Triangles& F) {
@@ -158,196 +408,21 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
                                   std::size_t(threads));
   // CHOLMOD's BLAS has its own pool: capped alike, at what TBB can run (environment.blas_threads).
-  const ScopedBlasThreads blas(std::min(threads, tbb::info::default_concurrency()));
+  const ScopedBlasThreads blas(runnable_threads(config.threads));
 
   validate_flow_mesh(config, source.report, source.spec);
   FlowOutcome out;
-  nlohmann::json& result = out.result;
-  result["schema"] = 1;
-  result["status"] = "ok";
-  result["config"] = to_json(config);
-  const MeshReport& rep = source.report;
-  result["mesh"] = {{"spec", source.spec},
-                    {"vertices", rep.vertices},
-                    {"faces", rep.faces},
-                    {"boundary_loops", rep.boundary_loops},
-                    {"genus", rep.genus},
-                    {"components", rep.connected_components},
-                    {"unreferenced_vertices", rep.unreferenced_vertices},
-                    {"area", rep.area},
-                    {"analytic", source.analytic}};
-
-  TriangleMesh mesh = source.mesh;
-  const Triangles& F = mesh.faces;
-  auto apply = [](const Normalization& n, Coefficients& x) {
-    x = (x.rowwise() - n.centroid) * n.scale;
-  };
-  if (config.normalize_area) apply(unit_area_normalization(mesh.vertices, F), mesh.vertices);
-
-  const auto setup_start = Clock::now();
-  std::unique_ptr<Basis> basis = make_basis(config, mesh, source.analytic);
-  const double build_seconds = seconds_since(setup_start);  // a rebuilt basis: its step 1's update
-  std::unique_ptr<LinearSolver> solver = make_solver(config.solver);
-  // A solver that takes only small systems (the dense reference) would refuse this one at its
-  // first factorization: say so now, as the configuration error it is, rather than stop the
-  // flow at step 1 as if it had turned singular.
-  if (const Eigen::Index free = basis->dimension() - Eigen::Index(basis->locked_functions().size());
-      free > solver->max_dimension())
-    throw ConfigError(source.spec + ": solver: \"" + config.solver.name + "\" factorizes at most " +
-                      std::to_string(solver->max_dimension()) + " functions and this basis has " +
-                      std::to_string(free) +
-                      " free ones; use \"cholmod\", \"pcg\" or \"multigrid\"");
-  std::unique_ptr<Integrator> integrator = make_integrator(config.integrator, config.extrapolate);
-  result["system"] = stats_json(basis->stats());
-  result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);
-  result["solver_name"] = solver->name();
-
-  FlowStepContext ctx(*basis, *solver, config.flow, config.dt);
-  Positions V = mesh.vertices;
-  Coefficients x = basis->initial_coefficients(), x_prev;
-  bool has_prev = false;
-  const double area0 = surface_area(mesh);
-  double previous_area = area0;
-  std::optional<SphereReference> sphere;
-  if (source.sphere_radius && !config.normalize_area)
-    sphere.emplace(*source.sphere_radius, config.flow == "heat");
-  std::optional<CylinderReference> cylinder;
-  if (source.cylinder_radius && !config.normalize_area)
-    cylinder.emplace(*source.cylinder_radius, config.flow, V);
-
-  if (observer.on_step) observer.on_step(0, 0.0, V);
-  nlohmann::json steps = nlohmann::json::array();
-  auto stop = [&](int step, const std::string& reason) {
-    result["status"] = "singular";
-    result["stop"] = {{"step", step}, {"reason", reason}};
-  };
-
+  out.result["schema"] = 1;
+  out.result["status"] = "ok";
+  out.result["config"] = to_json(config);
+  out.result["mesh"] = mesh_json(source);
+  FlowRun flow(config, source, out.result);
+  if (observer.on_step) observer.on_step(0, 0.0, flow.vertices());
   for (int step = 1; step <= config.steps; ++step) {
-    const auto step_start = Clock::now();
-    const double t = step * config.dt;
-    if (basis->rebuilds_every_step()) {
-      // Step 1 solves on the system the set-up built on X_0, so that build is its update: every
-      // step's update is then one build (a step 1 recorded as ~0 made Table 1's rebuilt mean 20%
-      // low over 5 steps, 33% over the quick run's 3), and X_0 is not built twice.
-      const auto t0 = Clock::now();
-      if (step > 1) {
-        basis->rebuild(V);
-        ctx.rebuilt();
-      }
-      x = basis->initial_coefficients();
-      has_prev = false;
-      ctx.begin_step(x, nullptr);
-      ctx.add_update_seconds(step > 1 ? seconds_since(t0) : build_seconds);
-    } else {
-      ctx.begin_step(x, has_prev ? &x_prev : nullptr);
-    }
-
-    Coefficients x_new = integrator->step(ctx);
-    const SolveReport& worst = ctx.worst_;
-    nlohmann::json record = {{"step", step}, {"t", t}};
-    record["solver"] = {
-        {"iterations", ctx.iterations_},
-        {"solves", ctx.solves_},
-        {"residuals", ctx.residuals_per_solve_.empty() ? std::vector<double>{}
-                                                       : ctx.residuals_per_solve_.back()},
-        {"relative_residual", worst.relative_residual},
-        {"status", to_string(worst.status)}};
-    if (ctx.solves_ > 1) record["solver"]["residuals_per_solve"] = ctx.residuals_per_solve_;
-    // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
-    // Gauss-Seidel on a level), or why it failed.
-    if (!worst.message.empty()) record["solver"]["message"] = worst.message;
-    if (ctx.fixed()) record["fixed_functions"] = ctx.fixed();
-    if (basis->rebuilds_every_step()) {
-      record["dimension"] = basis->dimension();
-      record["split_triangles"] = basis->stats().split_triangles;
-      record["setup_seconds"] = basis->stats().setup_seconds;
-    }
-    // A stopping step is recorded with its seconds too (every step has them: the result.json
-    // contract), then the flow stops.
-    const auto stop_here = [&](const std::string& reason) {
-      record["seconds"] = {{"update", ctx.update_seconds_},
-                           {"solve", ctx.solve_seconds_},
-                           {"total", seconds_since(step_start)}};
-      steps.push_back(record);
-      stop(step, reason);
-    };
-    if (!worst.ok()) {
-      stop_here(std::string("solver: ") + to_string(worst.status) +
-                (worst.message.empty() ? "" : " (" + worst.message + ")"));
-      break;
-    }
-
-    const auto eval_start = Clock::now();
-    Positions V_new = basis->evaluate_vertices(x_new);
-    if (!all_finite(V_new) || !x_new.allFinite()) {
-      stop_here("non-finite vertex positions");
-      break;
-    }
-    const double area = surface_area(TriangleMesh{V_new, F});
-    if (!(area > 1e-12 * area0)) {
-      record["area"] = area;
-      stop_here("collapsed area (" + std::to_string(area) + ")");
-      break;
-    }
-    if (area > 1.05 * previous_area) {
-      // MCF, cMCF and heat flow never increase the area; a step that grows it by more than 5%
-      // is an unstable (explicit) step, not a flow.
-      record["area"] = area;
-      stop_here("diverged: the area grew by " +
-                std::to_string(int(std::lround(100 * (area / previous_area - 1)))) +
-                "% in one step (unstable time step)");
-      break;
-    }
-    double step_difference = 0;
-    if (config.normalize_area) {
-      const Normalization n = unit_area_normalization(V_new, F);
-      apply(n, V_new);
-      apply(n, x_new);
-      apply(n, x);  // becomes X_{n-1}: same frame as X_n for two-step schemes
-      basis->reframe(n.centroid, n.scale);  // with refine_input, the flowed midpoints follow
-    }
-    step_difference = (V_new - V).norm();
-    previous_area = config.normalize_area ? 1.0 : area;
-    const double evaluate_seconds = seconds_since(eval_start);
-
-    record["area"] = area;
-    record["step_difference"] = step_difference;
-    if (cylinder) {
-      cylinder->advance(config.dt);
-      record["cylinder"] = {{"ring_radius", cylinder->ring_radius(V_new)},
-                            {"radius_semi_implicit", cylinder->discrete},
-                            {"radius_continuous", cylinder->continuous(t)},
-                            {"ring_vertices", cylinder->ring.size()}};
-    }
-    if (sphere) {
-      sphere->advance(config.dt);
-      const RadialError d = radial_error(V_new, sphere->discrete);
-      const RadialError c = radial_error(V_new, sphere->continuous(t));
-      record["radial_error"] = {{"rms", d.rms},
-                                {"max", d.max},
-                                {"rms_continuous", c.rms},
-                                {"max_continuous", c.max},
-                                {"mean_radius", V_new.rowwise().norm().mean()},
-                                {"radius_semi_implicit", sphere->discrete},
-                                {"radius_continuous", sphere->continuous(t)}};
-    }
-    if (integrator->uses_previous()) {
-      x_prev = std::move(x);
-      has_prev = true;
-    }
-    x = std::move(x_new);  // for a one-step scheme this frees X_{n-1}
-    V = std::move(V_new);
-    record["seconds"] = {{"update", ctx.update_seconds_},
-                         {"solve", ctx.solve_seconds_},
-                         {"evaluate", evaluate_seconds},
-                         {"total", seconds_since(step_start)}};
-    steps.push_back(std::move(record));
-    if (observer.on_step) observer.on_step(step, t, V);
+    if (!flow.advance(step)) break;
+    if (observer.on_step) observer.on_step(step, step * config.dt, flow.vertices());
   }
-  if (!result.contains("stop"))
-    result["stop"] = {{"step", int(steps.size())}, {"reason", "completed"}};
-  result["steps"] = std::move(steps);
-  out.final_mesh = TriangleMesh{V, F};
+  out.final_mesh = flow.finish();
   return out;
 }
 

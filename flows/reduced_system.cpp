@@ -1,8 +1,7 @@
 #include "flows/reduced_system.h"
 
+#include "core/parallel.h"
 #include "solvers/symmetric_multiply.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -31,29 +30,12 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
   // Views: no copies (the bases keep both on one pattern's index arrays).
   const SparseView M = basis_.mass();
   const SparseView K = basis_.stiffness();
-  const Eigen::Index n = M.rows();
   // S = a M + b K. Bases assemble M and K on one pattern: then S is a value-wise sum, and it is
   // formed here only when functions are held (below); otherwise the solver forms it itself
   // (set_matrix_sum), so no copy of it, as large as M, is kept here.
   const bool shared = shares_pattern(M, K);
   if (!shared) sum_ = general_sum(a, M, b, K);
-
-  // Rows that received no contribution this step (every entry of a M + b K zero; by symmetry
-  // their columns are zero too), apart from the basis's locked functions.
-  std::vector<int> empty;
-  {
-    const int* outer = shared ? M.outerIndexPtr() : sum_.outerIndexPtr();
-    const double* m = shared ? M.valuePtr() : nullptr;
-    const double* k = shared ? K.valuePtr() : nullptr;
-    const double* v = shared ? nullptr : sum_.valuePtr();
-    for (Eigen::Index c = 0; c < n; ++c) {
-      bool is_empty = true;
-      for (int p = outer[c]; p < outer[c + 1] && is_empty; ++p)
-        is_empty = (shared ? sum_entry(a, m[p], b, k[p]) : v[p]) == 0.0;
-      if (is_empty && !std::binary_search(base_fixed_.begin(), base_fixed_.end(), int(c)))
-        empty.push_back(int(c));
-    }
-  }
+  const std::vector<int> empty = empty_rows(a, b, M, K, shared);
   fixed_.clear();
   std::set_union(base_fixed_.begin(), base_fixed_.end(), empty.begin(), empty.end(),
                  std::back_inserter(fixed_));
@@ -61,24 +43,75 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
   // The basis's pattern is fixed while this object lives (a rebuilt basis gets a new
   // ReducedSystem), so a pattern key lets the solver skip comparing it each step. No key when M
   // and K have different patterns: then sum_'s pattern depends on whether b is 0.
-  HierarchyView view{basis_.prolongations(), basis_.colours(), shared ? full_key_ : 0};
-  if (fixed_.empty()) {
-    if (shared) {
-      sum_ = SparseMatrix();  // held functions may have needed it; now it is the solver's
-      report_ = solver_.set_matrix_sum(a, M, b, K, view);
-    } else {
-      report_ = solver_.set_matrix(sum_, view);
-    }
-    Coefficients X = warm;  // solved in place: no n x 3 copies in and out
-    solve_after_set(R, X);
-    return X;
-  }
+  const HierarchyView view{basis_.prolongations(), basis_.colours(), shared ? full_key_ : 0};
+  if (fixed_.empty()) return solve_whole(a, b, M, K, shared, view, R, warm);
   if (shared) {
     if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows())
       sum_ = M;  // M's pattern is fixed
     sum_on_pattern(a, M, b, K, sum_);
   }
+  Anchors anchors = hold_in_place(empty);
+  // Copies of R and the warm start only when rows are held in place (an open surface's steps
+  // without a pinch read the caller's).
+  Coefficients R_held, warm_held;
+  if (!anchors.anchored.empty()) {
+    R_held = R;
+    warm_held = warm;
+    for (int i : anchors.anchored) {
+      R_held.row(i) = anchors.d * fixed_values.row(i);
+      warm_held.row(i) = fixed_values.row(i);
+    }
+  }
+  const Coefficients& R_in = anchors.anchored.empty() ? R : R_held;
+  const Coefficients& warm_in = anchors.anchored.empty() ? warm : warm_held;
+  Coefficients X;
+  if (anchors.eliminated.empty()) {
+    reduction_valid_ = false;
+    report_ = solver_.set_matrix(sum_, view);
+    X = std::move(warm_held);  // anchored is not empty here: fixed_ is
+    solve_after_set(R_in, X);
+  } else {
+    X = solve_reduced(std::move(anchors.eliminated), shared, view, R_in, warm_in, fixed_values);
+  }
+  // The held coefficients exactly (the solve returns them to rounding).
+  for (int i : anchors.anchored) X.row(i) = fixed_values.row(i);
+  return X;
+}
 
+std::vector<int> ReducedSystem::empty_rows(double a, double b, const SparseView& M,
+                                           const SparseView& K, bool shared) const {
+  // Rows that received no contribution this step (every entry of a M + b K zero; by symmetry
+  // their columns are zero too), apart from the basis's locked functions.
+  std::vector<int> empty;
+  const int* outer = shared ? M.outerIndexPtr() : sum_.outerIndexPtr();
+  const double* m = shared ? M.valuePtr() : nullptr;
+  const double* k = shared ? K.valuePtr() : nullptr;
+  const double* v = shared ? nullptr : sum_.valuePtr();
+  for (Eigen::Index c = 0; c < M.rows(); ++c) {
+    bool is_empty = true;
+    for (int p = outer[c]; p < outer[c + 1] && is_empty; ++p)
+      is_empty = (shared ? sum_entry(a, m[p], b, k[p]) : v[p]) == 0.0;
+    if (is_empty && !std::binary_search(base_fixed_.begin(), base_fixed_.end(), int(c)))
+      empty.push_back(int(c));
+  }
+  return empty;
+}
+
+Coefficients ReducedSystem::solve_whole(double a, double b, const SparseView& M,
+                                        const SparseView& K, bool shared, HierarchyView view,
+                                        const Coefficients& R, const Coefficients& warm) {
+  if (shared) {
+    sum_ = SparseMatrix();  // held functions may have needed it; now it is the solver's
+    report_ = solver_.set_matrix_sum(a, M, b, K, view);
+  } else {
+    report_ = solver_.set_matrix(sum_, view);
+  }
+  Coefficients X = warm;  // solved in place: no n x 3 copies in and out (31 MB each at depth 9)
+  solve_after_set(R, X);
+  return X;
+}
+
+ReducedSystem::Anchors ReducedSystem::hold_in_place(const std::vector<int>& empty) {
   // An empty row is held in place (the paper's anchoring, Section 5.3: the coefficient keeps
   // its value): its diagonal becomes d and its right-hand side d times the held value. Its
   // column is zero, so no other unknown sees it and the solution of the others is the one of
@@ -90,24 +123,24 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
   // One pass over the columns: each empty row's diagonal position, and the mean of the others'
   // positive diagonal entries. Rows without a stored diagonal cannot be held in place: they are
   // eliminated.
-  std::vector<int> eliminated = base_fixed_;
-  std::vector<int> anchored, anchored_diagonal;
-  double d = 1.0;
+  Anchors anchors;
+  anchors.eliminated = base_fixed_;
   if (!empty.empty()) {
+    std::vector<int> anchored_diagonal;
     const int* outer = sum_.outerIndexPtr();
     const int* inner = sum_.innerIndexPtr();
     const double* v = sum_.valuePtr();
     double total = 0;
     Eigen::Index count = 0;
     std::size_t e = 0;  // empty is sorted
-    for (Eigen::Index c = 0; c < n; ++c) {
+    for (Eigen::Index c = 0; c < sum_.rows(); ++c) {
       const int* at = std::lower_bound(inner + outer[c], inner + outer[c + 1], int(c));
       const int diagonal = at != inner + outer[c + 1] && *at == c ? int(at - inner) : -1;
       if (e < empty.size() && empty[e] == c) {
         if (diagonal < 0) {
-          eliminated.push_back(int(c));
+          anchors.eliminated.push_back(int(c));
         } else {
-          anchored.push_back(int(c));
+          anchors.anchored.push_back(int(c));
           anchored_diagonal.push_back(diagonal);
         }
         ++e;
@@ -116,63 +149,40 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
         ++count;
       }
     }
-    if (count > 0 && std::isfinite(total / double(count))) d = total / double(count);
-    for (int p : anchored_diagonal) sum_.valuePtr()[p] = d;
+    if (count > 0 && std::isfinite(total / double(count))) anchors.d = total / double(count);
+    for (int p : anchored_diagonal) sum_.valuePtr()[p] = anchors.d;
   }
-  std::sort(eliminated.begin(), eliminated.end());
-  // Copies of R and the warm start only when rows are held in place (an open surface's steps
-  // without a pinch read the caller's).
-  Coefficients R_held, warm_held;
-  if (!anchored.empty()) {
-    R_held = R;
-    warm_held = warm;
-    for (int i : anchored) {
-      R_held.row(i) = d * fixed_values.row(i);
-      warm_held.row(i) = fixed_values.row(i);
-    }
-  }
-  const Coefficients& R_in = anchored.empty() ? R : R_held;
-  const Coefficients& warm_in = anchored.empty() ? warm : warm_held;
-  // The held coefficients exactly (the solve returns them to rounding).
-  const auto hold = [&](Coefficients& Y) {
-    for (int i : anchored) Y.row(i) = fixed_values.row(i);
-  };
+  std::sort(anchors.eliminated.begin(), anchors.eliminated.end());
+  return anchors;
+}
 
-  if (eliminated.empty()) {
-    reduction_valid_ = false;
-    report_ = solver_.set_matrix(sum_, view);
-    Coefficients X = std::move(warm_held);  // anchored is not empty here: fixed_ is
-    solve_after_set(R_in, X);
-    hold(X);
-    return X;
-  }
-
+Coefficients ReducedSystem::solve_reduced(std::vector<int> eliminated, bool shared,
+                                          const HierarchyView& view, const Coefficients& R,
+                                          const Coefficients& warm,
+                                          const Coefficients& fixed_values) {
   // Only a change of the eliminated set (the basis's locked functions, fixed for the basis's
   // life) needs a new reduction (and a new key, rebuild_reduction).
   if (!reduction_valid_ || eliminated != eliminated_) {
     eliminated_ = std::move(eliminated);
     rebuild_reduction(sum_);
   }
-
   // Reduced matrix values.
   {
     double* rv = reduced_.valuePtr();
     const double* sv = sum_.valuePtr();
     const int* src = source_nz_.data();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source_nz_.size(), 1 << 14),
-                      [&](const auto& r) {
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) rv[i] = sv[src[i]];
-                      });
+    parallel_for_indices<std::size_t>(source_nz_.size(), 1 << 14,
+                                      [&](std::size_t i) { rv[i] = sv[src[i]]; });
   }
   // Right-hand side: R_f - S_fl Y_l.
-  Coefficients Yfixed = Coefficients::Zero(n, 3);
+  Coefficients Yfixed = Coefficients::Zero(sum_.rows(), 3);
   for (int i : eliminated_) Yfixed.row(i) = fixed_values.row(i);
   const Coefficients coupling = symmetric_multiply(sum_, Yfixed);  // S is symmetric
   const Eigen::Index nf = Eigen::Index(free_.size());
   Eigen::MatrixXd Rf(nf, 3), Xf(nf, 3);
   for (Eigen::Index i = 0; i < nf; ++i) {
-    Rf.row(i) = R_in.row(free_[i]) - coupling.row(free_[i]);
-    Xf.row(i) = warm_in.row(free_[i]);
+    Rf.row(i) = R.row(free_[i]) - coupling.row(free_[i]);
+    Xf.row(i) = warm.row(free_[i]);
   }
   HierarchyView reduced_view;
   if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
@@ -181,7 +191,6 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
   solve_after_set(Rf, Xf);
   Coefficients Y = Yfixed;
   for (Eigen::Index i = 0; i < nf; ++i) Y.row(free_[i]) = Xf.row(i);
-  hold(Y);
   return Y;
 }
 

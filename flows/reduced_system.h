@@ -32,6 +32,30 @@ class ReducedSystem {
   std::size_t num_fixed() const { return fixed_.size(); }
 
  private:
+  /// What hold_in_place leaves: the functions the reduction leaves out (sorted: the locked
+  /// ones, and empty rows without a stored diagonal), the empty rows held in place by a
+  /// diagonal d, and d.
+  struct Anchors {
+    std::vector<int> eliminated;
+    std::vector<int> anchored;
+    double d = 1.0;
+  };
+
+  /// Rows of a M + b K without a nonzero entry this step, but the locked ones (sorted).
+  std::vector<int> empty_rows(double a, double b, const SparseView& M, const SparseView& K,
+                              bool shared) const;
+  /// No function held: the solver gets a M + b K (or sum_) as it is.
+  Coefficients solve_whole(double a, double b, const SparseView& M, const SparseView& K,
+                           bool shared, HierarchyView view, const Coefficients& R,
+                           const Coefficients& warm);
+  /// Sets the diagonal of sum_'s empty rows that have one (the anchoring); the others are left
+  /// to the reduction.
+  Anchors hold_in_place(const std::vector<int>& empty);
+  /// Solves on the free functions of sum_ (the reduction, rebuilt when `eliminated` changed)
+  /// with the eliminated ones at their fixed values.
+  Coefficients solve_reduced(std::vector<int> eliminated, bool shared, const HierarchyView& view,
+                             const Coefficients& R, const Coefficients& warm,
+                             const Coefficients& fixed_values);
   void rebuild_reduction(const SparseMatrix& S);
   bool shares_pattern(const SparseRef& M, const SparseRef& K);
   /// report_ holds set_matrix's report: when it is ok, solves into X and keeps its note.

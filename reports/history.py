@@ -3,11 +3,11 @@
 
 usage: /usr/bin/python3 reports/history.py HISTORY.jsonl [HISTORY.jsonl ...] OUT_DIR
 
-Reads the history lines that bench/run_micro.sh (results/micro/history.jsonl: Google Benchmark
-real times) and `mcfbench compare --history` (results/history.jsonl: per-cell medians) append,
-one JSON object per measured commit, and writes OUT_DIR/history_<name>.png and history.md.
-Each curve is normalised by its first value, so benchmarks of different sizes share one axis
-and a regression reads as a rise above 1.
+Reads the history lines that benchmarks/run_micro.sh (results/micro/history.jsonl: Google
+Benchmark real times) and `mcfbench compare --history` (results/history.jsonl: per-cell medians)
+append, one JSON object per measured commit, and writes OUT_DIR/history_<name>.png and
+history.md. Each curve is normalised by its first value, so benchmarks of different sizes share
+one axis and a regression reads as a rise above 1.
 """
 
 import json

@@ -1,20 +1,25 @@
 #!/usr/bin/env bash
-# Fails if a layer includes a header of a layer above it (docs/design.md "Layers").
+# Fails if a layer, or its tests (tests/LAYER), includes a header of a layer above it (docs/design.md
+# "Layers"). core is the bottom layer: it includes no other layer, and every layer may include it.
 root=${1:-$(dirname "$0")/..}
-order=(datasets bases solvers flows bench tools)
-# solvers sits beside bases (neither may include the other).
+order=(core datasets bases solvers flows bench benchmarks tools)
+# solvers sits beside bases (neither may include the other), and beside datasets; the
+# micro-benchmarks (benchmarks/) and the executable (tools/) sit beside each other on top.
 declare -A forbidden=(
-  [datasets]="bases solvers flows bench tools"
-  [bases]="solvers flows bench tools"
-  [solvers]="datasets bases flows bench tools"
-  [flows]="bench tools"
-  [bench]="tools"
-  [tools]=""
+  [core]="datasets bases solvers flows bench benchmarks tools"
+  [datasets]="bases solvers flows bench benchmarks tools"
+  [bases]="solvers flows bench benchmarks tools"
+  [solvers]="datasets bases flows bench benchmarks tools"
+  [flows]="bench benchmarks tools"
+  [bench]="benchmarks tools"
+  [benchmarks]="tools"
+  [tools]="benchmarks"
 )
 bad=0
 for layer in "${order[@]}"; do
   for up in ${forbidden[$layer]}; do
-    if hits=$(grep -rnE "#include +\"$up/" "$root/$layer" --include='*.h' --include='*.cpp' 2>/dev/null); then
+    if hits=$(grep -rnE "#include +\"(\.\./)*$up/" "$root/$layer" "$root/tests/$layer" \
+                --include='*.h' --include='*.cpp' 2>/dev/null); then
       echo "layering violation: $layer includes $up:"; echo "$hits"; bad=1
     fi
   done

@@ -4,5 +4,6 @@
 #   out/demo/results/<study>/*.json   out/demo/report/index.md (+ PNG, Markdown)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+bash "$root/scripts/setup.sh"
 bash "$root/scripts/build.sh"
 exec bash "$root/scripts/run_studies.sh" --quick --out "${1:-$root/out/demo}"

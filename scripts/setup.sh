@@ -14,6 +14,7 @@ packages=(
   libcli11-dev
   libbenchmark-dev
   libgtest-dev
+  clang-format                           # scripts/format.sh and the `format` test
   python3-matplotlib python3-numpy
 )
 

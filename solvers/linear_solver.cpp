@@ -1,7 +1,6 @@
 #include "solvers/linear_solver.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "core/parallel.h"
 
 #include <algorithm>
 #include <atomic>
@@ -48,15 +47,13 @@ void sum_on_pattern(const MatrixSum& sum, SparseMatrix& A) {
   const double* q = sum.S ? sum.S->valuePtr() : nullptr;
   const double a = sum.a, b = sum.b, s = sum.s;
   double* out = A.valuePtr();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, sum.M.nonZeros(), 1 << 14),
-                    [&](const auto& r) {
-                      if (q)
-                        for (Eigen::Index i = r.begin(); i != r.end(); ++i)
-                          out[i] = sum_entry(a, m[i], b, k[i], s, q[i]);
-                      else
-                        for (Eigen::Index i = r.begin(); i != r.end(); ++i)
-                          out[i] = sum_entry(a, m[i], b, k[i]);
-                    });
+  if (q)
+    parallel_for_indices<Eigen::Index>(sum.M.nonZeros(), 1 << 14, [&](Eigen::Index i) {
+      out[i] = sum_entry(a, m[i], b, k[i], s, q[i]);
+    });
+  else
+    parallel_for_indices<Eigen::Index>(sum.M.nonZeros(), 1 << 14,
+                                       [&](Eigen::Index i) { out[i] = sum_entry(a, m[i], b, k[i]); });
 }
 
 SparseMatrix general_sum(const MatrixSum& sum) {

@@ -3,8 +3,9 @@
 // through the system they exchange). A solver is given a sparse symmetric positive-definite
 // matrix, optionally with a multigrid hierarchy, and solves several right-hand sides at once.
 
+#include "core/sparse.h"
+
 #include <Eigen/Core>
-#include <Eigen/SparseCore>
 
 #include <cstdint>
 #include <limits>
@@ -14,12 +15,6 @@
 #include <vector>
 
 namespace mcf {
-
-using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-/// Any column-major sparse matrix stored elsewhere — a SparseMatrix or a map of index and value
-/// arrays (a basis's mass and stiffness share one pattern's index arrays: bases/basis.h
-/// SparseView) — without a copy. Functions that read a basis's matrices take this.
-using SparseRef = Eigen::Ref<const SparseMatrix>;
 
 enum class SolveStatus {
   converged,              ///< reached the tolerance (or a direct solve succeeded)

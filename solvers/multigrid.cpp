@@ -1,5 +1,7 @@
 #include "solvers/multigrid.h"
 
+#include "core/vec4.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -13,7 +15,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <limits>
 #include <new>
 #include <stdexcept>
@@ -52,20 +53,11 @@ void for_rows(int n, F&& f) {
 // few more call sites (a fine sweep then took up to 1.5x as long), so they are forced.
 #define MCF_KERNEL_INLINE inline __attribute__((always_inline))
 
-/// Four doubles (GCC/Clang vector extensions: one AVX register when compiled for it, emulated
-/// otherwise). The kernels below hold four right-hand-side columns of one row in one vector.
-using v4 = double __attribute__((vector_size(32)));
-inline v4 splat(double a) {
-  return v4{a, a, a, a};
-}
-inline v4 load4(const double* p) {
-  v4 r;
-  std::memcpy(&r, p, sizeof(r));
-  return r;
-}
-inline void store4(double* p, v4 v) {
-  std::memcpy(p, &v, sizeof(v));
-}
+// The kernels below hold four right-hand-side columns of one row in one vector (core/vec4.h).
+using vec4::load4;
+using vec4::splat;
+using vec4::store4;
+using vec4::v4;
 
 /// Cache-line aligned storage, so that a row's four columns (32 bytes at a multiple of 32) never
 /// straddle two cache lines.

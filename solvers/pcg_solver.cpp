@@ -1,9 +1,7 @@
 #include "solvers/pcg_solver.h"
 
+#include "core/parallel.h"
 #include "solvers/symmetric_multiply.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,12 +21,7 @@ constexpr Index kChunk = 4096;
 
 template <class F>
 void for_chunks(Index n, F&& f) {
-  const Index chunks = (n + kChunk - 1) / kChunk;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, chunks, 1),
-                    [&](const tbb::blocked_range<Index>& r) {
-                      for (Index ch = r.begin(); ch < r.end(); ++ch)
-                        f(ch, ch * kChunk, std::min(n, (ch + 1) * kChunk));
-                    });
+  parallel_for_chunks(n, kChunk, f);
 }
 
 // Eight independent accumulators in a fixed pattern: the lanes map onto SIMD registers without
@@ -253,36 +246,40 @@ void PcgSolver::apply_preconditioner(const MatrixXd& r, MatrixXd& z) const {
   }
 }
 
-SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
-  SolveReport rep;
-  if (!have_matrix_ || matrix_status_ != SolveStatus::converged) {
-    rep.status = matrix_status_;
-    rep.message = matrix_message_;
-    return rep;
-  }
-  const Index n = A_.rows(), k = B.cols();
-  if (B.rows() != n) {
-    rep.status = SolveStatus::failed;
-    rep.message = "right-hand side has wrong size";
-    return rep;
-  }
-  if (options_.preconditioner == PcgPreconditioner::external && !external_) {
-    rep.status = SolveStatus::failed;
-    rep.message = "external preconditioner selected but none set";
-    return rep;
-  }
-  const double tol = options_.relative_tolerance;
+/// One block PCG solve (solve_in_place): k CG recurrences, one per column of B, sharing each
+/// pass over A. Columns converge, and restart after a residual replacement, independently.
+struct PcgSolver::Recurrence {
+  /// What an iteration leaves to the loop: go on, stop with the report, or stop at the cap.
+  enum class Next { go_on, done, cap };
 
-  VectorXd bnorm;
-  column_dots(B, B, bnorm);
-  bnorm = bnorm.cwiseSqrt();
+  Recurrence(const PcgSolver& solver, const ConstMatrixRef& B, MatrixRef& X)
+      : solver(solver),
+        B(B),
+        X(X),
+        n(solver.A_.rows()),
+        k(B.cols()),
+        tol(solver.options_.relative_tolerance),
+        R(n, k),
+        Z(n, k),
+        P(n, k),
+        Q(n, k),
+        res(k),
+        rz(k),
+        pq(k),
+        rr(k),
+        alpha(k),
+        beta(k),
+        active(static_cast<std::size_t>(k), 0),
+        start(static_cast<std::size_t>(k), 0) {
+    column_dots(B, B, bnorm);
+    bnorm = bnorm.cwiseSqrt();
+  }
 
-  MatrixXd R(n, k), Z(n, k), P(n, k), Q(n, k);
-  VectorXd res(k), rz(k), pq(k), rr(k);
+  bool is_active(Index c) const { return active[static_cast<std::size_t>(c)] != 0; }
 
-  // R = B - A X, the true residual; per column relative residual.
-  auto true_residual = [&]() {
-    multiply(X, Q);
+  /// R = B - A X, the true residual; per column relative residual.
+  void true_residual() {
+    solver.multiply(X, Q);
     for_chunks(n, [&](Index, Index b, Index e) {
       for (Index c = 0; c < k; ++c)
         for (Index i = b; i < e; ++i) R(i, c) = B(i, c) - Q(i, c);
@@ -290,139 +287,130 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
     column_dots(R, R, rr);
     for (Index c = 0; c < k; ++c)
       res[c] = bnorm[c] > 0.0 ? std::sqrt(rr[c]) / bnorm[c] : std::sqrt(rr[c]);
-  };
-  auto max_res = [&]() {
+  }
+
+  /// The worst column's relative residual (the first non-finite one, if any).
+  double max_res() const {
     double m = 0.0;
     for (Index c = 0; c < k; ++c) {
       if (!std::isfinite(res[c])) return res[c];
       m = std::max(m, res[c]);
     }
     return m;
-  };
+  }
 
-  // A zero right-hand side has the exact solution 0; CG's ratios would be 0/0 on it.
-  for (Index c = 0; c < k; ++c)
-    if (bnorm[c] == 0.0) X.col(c).setZero();
-  true_residual();
+  /// Marks in `start` the columns not yet at the tolerance (a zero right-hand side never is
+  /// started: its exact solution is 0); returns whether there is one.
+  bool mark_unconverged() {
+    bool any = false;
+    for (Index c = 0; c < k; ++c) {
+      start[static_cast<std::size_t>(c)] = (bnorm[c] > 0.0 && !(res[c] <= tol)) ? 1 : 0;
+      any = any || start[static_cast<std::size_t>(c)];
+    }
+    return any;
+  }
 
-  std::vector<char> active(static_cast<std::size_t>(k), 0);
-  auto start_columns = [&](const std::vector<char>& which) -> bool {
-    // (Re)starts CG on the listed columns from the current R: p = z = M^{-1} r.
-    apply_preconditioner(R, Z);
+  /// (Re)starts CG on the columns marked in `start` from the current R: p = z = M^{-1} r.
+  void start_columns() {
+    solver.apply_preconditioner(R, Z);
     column_dots(R, Z, rz);
     for (Index c = 0; c < k; ++c) {
-      if (!which[static_cast<std::size_t>(c)]) continue;
+      if (!start[static_cast<std::size_t>(c)]) continue;
       P.col(c) = Z.col(c);
       active[static_cast<std::size_t>(c)] = 1;
     }
-    return true;
-  };
-
-  std::vector<char> start(static_cast<std::size_t>(k), 0);
-  bool any = false;
-  for (Index c = 0; c < k; ++c) {
-    start[static_cast<std::size_t>(c)] = (bnorm[c] > 0.0 && !(res[c] <= tol)) ? 1 : 0;
-    any = any || start[static_cast<std::size_t>(c)];
   }
-  rep.relative_residual = max_res();
-  if (!std::isfinite(rep.relative_residual)) {
-    rep.status = SolveStatus::numerical_issue;
-    rep.message = "NaN/inf in the initial residual";
-    return rep;
-  }
-  if (!any) return rep;  // warm start already converged: 0 iterations
-  start_columns(start);
 
-  VectorXd alpha(k), beta(k);
-  auto finish = [&](SolveStatus s, std::string msg) {
-    rep.status = s;
-    rep.message = std::move(msg);
-    return rep;
-  };
-
-  for (int it = 0; it < options_.max_iterations; ++it) {
+  /// The initial residual. Returns false when there is nothing to iterate: a warm start at the
+  /// tolerance already (0 iterations), or NaN/inf (numerical_issue in `rep`).
+  bool begin(SolveReport& rep) {
+    // A zero right-hand side has the exact solution 0; CG's ratios would be 0/0 on it.
     for (Index c = 0; c < k; ++c)
-      if (active[static_cast<std::size_t>(c)] && !(rz[c] > 0.0))
-        return finish(std::isfinite(rz[c]) ? SolveStatus::not_positive_definite
-                                           : SolveStatus::numerical_issue,
-                      "r^T M^-1 r <= 0: preconditioner not positive definite");
+      if (bnorm[c] == 0.0) X.col(c).setZero();
+    true_residual();
+    const bool any = mark_unconverged();
+    rep.relative_residual = max_res();
+    if (!std::isfinite(rep.relative_residual)) {
+      rep.status = SolveStatus::numerical_issue;
+      rep.message = "NaN/inf in the initial residual";
+      return false;
+    }
+    if (!any) return false;
+    start_columns();
+    return true;
+  }
 
-    multiply(P, Q);
+  /// alpha = r^T z / p^T A p per active column, after Q = A P; false on a breakdown (in `rep`).
+  bool step_lengths(SolveReport& rep) {
+    for (Index c = 0; c < k; ++c)
+      if (is_active(c) && !(rz[c] > 0.0))
+        return fail(rep,
+                    std::isfinite(rz[c]) ? SolveStatus::not_positive_definite
+                                         : SolveStatus::numerical_issue,
+                    "r^T M^-1 r <= 0: preconditioner not positive definite");
+    solver.multiply(P, Q);
     column_dots(P, Q, pq);
     for (Index c = 0; c < k; ++c) {
       alpha[c] = 0.0;
-      if (!active[static_cast<std::size_t>(c)]) continue;
-      if (!std::isfinite(pq[c])) return finish(SolveStatus::numerical_issue, "NaN/inf in p^T A p");
+      if (!is_active(c)) continue;
+      if (!std::isfinite(pq[c]))
+        return fail(rep, SolveStatus::numerical_issue, "NaN/inf in p^T A p");
       if (!(pq[c] > 0.0))
-        return finish(SolveStatus::not_positive_definite,
-                      "p^T A p <= 0: matrix not positive definite");
+        return fail(rep, SolveStatus::not_positive_definite,
+                    "p^T A p <= 0: matrix not positive definite");
       alpha[c] = rz[c] / pq[c];
     }
+    return true;
+  }
 
-    // Fused update of x and r plus the partial sums of ||r||^2 (one pass over the block).
-    {
-      const Index chunks = (n + kChunk - 1) / kChunk;
-      std::vector<double> partials(static_cast<std::size_t>(chunks * k), 0.0);
-      for_chunks(n, [&](Index ch, Index b, Index e) {
-        for (Index c = 0; c < k; ++c) {
-          if (active[static_cast<std::size_t>(c)]) {
-            const double a = alpha[c];
-            double* x = X.col(c).data();
-            double* r = R.col(c).data();
-            const double* p = P.col(c).data();
-            const double* q = Q.col(c).data();
-            for (Index i = b; i < e; ++i) {
-              x[i] += a * p[i];
-              r[i] -= a * q[i];
-            }
+  /// Fused update of x and r plus the partial sums of ||r||^2 (one pass over the block), then
+  /// the active columns' relative residuals.
+  void update_iterates() {
+    const Index chunks = (n + kChunk - 1) / kChunk;
+    std::vector<double> partials(static_cast<std::size_t>(chunks * k), 0.0);
+    for_chunks(n, [&](Index ch, Index b, Index e) {
+      for (Index c = 0; c < k; ++c) {
+        if (is_active(c)) {
+          const double a = alpha[c];
+          double* x = X.col(c).data();
+          double* r = R.col(c).data();
+          const double* p = P.col(c).data();
+          const double* q = Q.col(c).data();
+          for (Index i = b; i < e; ++i) {
+            x[i] += a * p[i];
+            r[i] -= a * q[i];
           }
-          partials[static_cast<std::size_t>(ch * k + c)] =
-              chunk_dot(R.col(c).data(), R.col(c).data(), b, e);
         }
-      });
-      combine(partials, k, rr);
-    }
+        partials[static_cast<std::size_t>(ch * k + c)] =
+            chunk_dot(R.col(c).data(), R.col(c).data(), b, e);
+      }
+    });
+    combine(partials, k, rr);
     for (Index c = 0; c < k; ++c)
-      if (active[static_cast<std::size_t>(c)])
-        res[c] = bnorm[c] > 0.0 ? std::sqrt(rr[c]) / bnorm[c] : std::sqrt(rr[c]);
-    rep.iterations = it + 1;
-    rep.residuals.push_back(max_res());
-    if (!std::isfinite(rep.residuals.back()))
-      return finish(SolveStatus::numerical_issue, "NaN/inf in the residual");
+      if (is_active(c)) res[c] = bnorm[c] > 0.0 ? std::sqrt(rr[c]) / bnorm[c] : std::sqrt(rr[c]);
+  }
 
+  /// Deactivates the columns at the tolerance; returns whether none is left active.
+  bool retire_converged() {
     bool all_done = true;
     for (Index c = 0; c < k; ++c) {
-      if (active[static_cast<std::size_t>(c)] && res[c] <= tol)
-        active[static_cast<std::size_t>(c)] = 0;
-      all_done = all_done && !active[static_cast<std::size_t>(c)];
+      if (is_active(c) && res[c] <= tol) active[static_cast<std::size_t>(c)] = 0;
+      all_done = all_done && !is_active(c);
     }
-    if (all_done) {
-      // The recursive residual drifts from b - A x; confirm with the true one and restart the
-      // columns that are not really there yet (residual replacement).
-      true_residual();
-      std::fill(start.begin(), start.end(), 0);
-      any = false;
-      for (Index c = 0; c < k; ++c)
-        if (bnorm[c] > 0.0 && !(res[c] <= tol)) start[static_cast<std::size_t>(c)] = 1, any = true;
-      rep.residuals.back() = max_res();
-      rep.relative_residual = rep.residuals.back();
-      if (!any) return rep;
-      if (it + 1 >= options_.max_iterations) break;
-      start_columns(start);
-      continue;
-    }
-    if (it + 1 >= options_.max_iterations) break;
+    return all_done;
+  }
 
-    apply_preconditioner(R, Z);
+  /// p = z + beta p with z = M^{-1} r and beta = r^T z (new) / r^T z (old); false on NaN/inf.
+  bool update_directions(SolveReport& rep) {
+    solver.apply_preconditioner(R, Z);
     VectorXd rz_new;
     column_dots(R, Z, rz_new);
     if (!all_finite(rz_new))
-      return finish(SolveStatus::numerical_issue, "NaN/inf in the preconditioned residual");
-    for (Index c = 0; c < k; ++c)
-      beta[c] = active[static_cast<std::size_t>(c)] ? rz_new[c] / rz[c] : 0.0;
+      return fail(rep, SolveStatus::numerical_issue, "NaN/inf in the preconditioned residual");
+    for (Index c = 0; c < k; ++c) beta[c] = is_active(c) ? rz_new[c] / rz[c] : 0.0;
     for_chunks(n, [&](Index, Index b, Index e) {
       for (Index c = 0; c < k; ++c) {
-        if (!active[static_cast<std::size_t>(c)]) continue;
+        if (!is_active(c)) continue;
         const double bt = beta[c];
         double* p = P.col(c).data();
         const double* z = Z.col(c).data();
@@ -430,17 +418,89 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
       }
     });
     rz = rz_new;
+    return true;
   }
 
-  // Iteration cap: report the true residual of the last iterate.
-  true_residual();
-  rep.relative_residual = max_res();
-  if (!rep.residuals.empty()) rep.residuals.back() = rep.relative_residual;
-  if (!std::isfinite(rep.relative_residual))
-    return finish(SolveStatus::numerical_issue, "NaN/inf in the residual");
-  if (rep.relative_residual <= tol) return rep;
-  return finish(SolveStatus::max_iterations,
-                "iteration cap " + std::to_string(options_.max_iterations) + " reached");
+  /// Iteration `it` (0-based).
+  Next iterate(int it, SolveReport& rep) {
+    const int cap = solver.options_.max_iterations;
+    if (!step_lengths(rep)) return Next::done;
+    update_iterates();
+    rep.iterations = it + 1;
+    rep.residuals.push_back(max_res());
+    if (!std::isfinite(rep.residuals.back())) {
+      fail(rep, SolveStatus::numerical_issue, "NaN/inf in the residual");
+      return Next::done;
+    }
+    if (retire_converged()) {
+      // The recursive residual drifts from b - A x; confirm with the true one and restart the
+      // columns that are not really there yet (residual replacement).
+      true_residual();
+      const bool any = mark_unconverged();
+      rep.residuals.back() = max_res();
+      rep.relative_residual = rep.residuals.back();
+      if (!any) return Next::done;
+      if (it + 1 >= cap) return Next::cap;
+      start_columns();
+      return Next::go_on;
+    }
+    if (it + 1 >= cap) return Next::cap;
+    return update_directions(rep) ? Next::go_on : Next::done;
+  }
+
+  /// The iteration cap: the report of the last iterate's true residual.
+  SolveReport at_cap(SolveReport& rep) {
+    true_residual();
+    rep.relative_residual = max_res();
+    if (!rep.residuals.empty()) rep.residuals.back() = rep.relative_residual;
+    if (!std::isfinite(rep.relative_residual))
+      fail(rep, SolveStatus::numerical_issue, "NaN/inf in the residual");
+    else if (!(rep.relative_residual <= tol))
+      fail(rep, SolveStatus::max_iterations,
+           "iteration cap " + std::to_string(solver.options_.max_iterations) + " reached");
+    return rep;
+  }
+
+  static bool fail(SolveReport& rep, SolveStatus s, std::string message) {
+    rep.status = s;
+    rep.message = std::move(message);
+    return false;
+  }
+
+  const PcgSolver& solver;
+  const ConstMatrixRef& B;
+  MatrixRef& X;
+  const Index n, k;
+  const double tol;
+  VectorXd bnorm;
+  MatrixXd R, Z, P, Q;
+  VectorXd res, rz, pq, rr, alpha, beta;
+  std::vector<char> active, start;
+};
+
+SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
+  SolveReport rep;
+  if (!have_matrix_ || matrix_status_ != SolveStatus::converged) {
+    rep.status = matrix_status_;
+    rep.message = matrix_message_;
+    return rep;
+  }
+  if (B.rows() != A_.rows()) {
+    Recurrence::fail(rep, SolveStatus::failed, "right-hand side has wrong size");
+    return rep;
+  }
+  if (options_.preconditioner == PcgPreconditioner::external && !external_) {
+    Recurrence::fail(rep, SolveStatus::failed, "external preconditioner selected but none set");
+    return rep;
+  }
+  Recurrence cg(*this, B, X);
+  if (!cg.begin(rep)) return rep;
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    const Recurrence::Next next = cg.iterate(it, rep);
+    if (next == Recurrence::Next::done) return rep;
+    if (next == Recurrence::Next::cap) break;
+  }
+  return cg.at_cap(rep);
 }
 
 }  // namespace mcf

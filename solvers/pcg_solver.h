@@ -72,6 +72,8 @@ class PcgSolver final : public LinearSolver {
   SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) override;
 
  private:
+  struct Recurrence;  ///< the state and steps of one block PCG solve (solve_in_place)
+
   SolveReport build_preconditioner();
   SolveReport matrix_in_place();  ///< A_ holds the new matrix: finite check, preconditioner, status
   bool keeps_pattern(const SparseRef& A,

@@ -1,7 +1,6 @@
 #include "solvers/symmetric_multiply.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "core/parallel.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -51,30 +50,25 @@ void symmetric_multiply(const SparseRef& A, const double* X, Index k, double* Y)
   // Fixed chunks: the partition does not depend on the thread count (no sums cross a chunk
   // anyway, but equal chunks balance the rows).
   constexpr Index kChunk = 4096;
-  const Index chunks = (n + kChunk - 1) / kChunk;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, chunks, 1),
-                    [&](const tbb::blocked_range<Index>& r) {
-                      for (Index ch = r.begin(); ch < r.end(); ++ch) {
-                        const Index b = ch * kChunk, e = std::min(n, b + kChunk);
-                        switch (k) {
-                          case 1:
-                            rows_fixed<1>(outer, inner, val, X, Y, n, b, e);
-                            break;
-                          case 2:
-                            rows_fixed<2>(outer, inner, val, X, Y, n, b, e);
-                            break;
-                          case 3:
-                            rows_fixed<3>(outer, inner, val, X, Y, n, b, e);
-                            break;
-                          case 4:
-                            rows_fixed<4>(outer, inner, val, X, Y, n, b, e);
-                            break;
-                          default:
-                            rows_any(outer, inner, val, X, Y, n, k, b, e);
-                            break;
-                        }
-                      }
-                    });
+  parallel_for_chunks(n, kChunk, [&](Index, Index b, Index e) {
+    switch (k) {
+      case 1:
+        rows_fixed<1>(outer, inner, val, X, Y, n, b, e);
+        break;
+      case 2:
+        rows_fixed<2>(outer, inner, val, X, Y, n, b, e);
+        break;
+      case 3:
+        rows_fixed<3>(outer, inner, val, X, Y, n, b, e);
+        break;
+      case 4:
+        rows_fixed<4>(outer, inner, val, X, Y, n, b, e);
+        break;
+      default:
+        rows_any(outer, inner, val, X, Y, n, k, b, e);
+        break;
+    }
+  });
 }
 
 }  // namespace mcf

@@ -1,26 +1,16 @@
-// `mcfbench compare OLD NEW`: regression check between two result sets (exit 1 when a cell got
-// significantly slower or less accurate), optionally appended to a history file.
+// `mcfbench compare OLD NEW`: the flags of the regression check between two result sets
+// (bench/compare.h: exit 1 when a cell got significantly slower or less accurate), optionally
+// appended to a history file.
 
 #include "bench/compare.h"
 #include "tools/commands.h"
 
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <memory>
 
 namespace mcf {
-namespace {
-
-struct CompareArgs {
-  std::string old_dir, new_dir, history;
-  CompareOptions options;
-};
-
-}  // namespace
 
 void add_compare_command(CLI::App& app, std::function<int()>& run) {
-  auto a = std::make_shared<CompareArgs>();
+  auto a = std::make_shared<CompareRequest>();
   CLI::App* cmd = app.add_subcommand(
       "compare",
       "Compare two result sets cell by cell (speed and accuracy); exit 1 on a regression.");
@@ -44,19 +34,8 @@ void add_compare_command(CLI::App& app, std::function<int()>& run) {
       ->expected(0, 1);
   cmd->callback([cmd, a, &run] {
     run = [cmd, a]() -> int {
-      const ResultSet old_set = load_result_set(a->old_dir, a->options.metric);
-      const ResultSet new_set = load_result_set(a->new_dir, a->options.metric);
-      const CompareReport r = compare_results(old_set, new_set, a->options);
-      std::printf("%s", compare_markdown(r, old_set, new_set, a->options).c_str());
-      if (cmd->count("--history") > 0) {
-        const std::string file = a->history.empty() ? "results/history.jsonl" : a->history;
-        const std::filesystem::path p(file);
-        if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-        std::ofstream out(file, std::ios::app);
-        out << history_entry(new_set, a->options.metric).dump() << "\n";
-        if (!out) throw std::runtime_error(file + ": cannot append");
-      }
-      return r.regression ? 1 : 0;
+      a->append_history = cmd->count("--history") > 0;
+      return compare_and_record(*a);
     };
   });
 }

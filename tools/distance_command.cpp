@@ -1,28 +1,14 @@
-// `mcfbench distance A B`: Metro-style distance between two surfaces (bench/metrics.h).
+// `mcfbench distance A B`: the flags of the Metro-style distance between two surfaces
+// (bench/surface_distance.h).
 
-#include "bench/metrics.h"
-#include "datasets/mesh_io.h"
+#include "bench/surface_distance.h"
 #include "datasets/mesh_spec.h"
 #include "tools/commands.h"
 
-#include <nlohmann/json.hpp>
-
-#include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 
 namespace mcf {
-
-namespace {
-/// An existing file is read as is (no unit-cube scaling: comparing a flow's output with its
-/// reference must not rescale either); anything else is a mesh spec (generators, cgal:..., @faces).
-TriangleMesh load_surface(const std::string& name) {
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(name, ec)) return read_mesh(name);
-  return load_mesh_spec(name).mesh;
-}
-}  // namespace
 
 void add_distance_command(CLI::App& app, std::function<int()>& run) {
   struct Args {
@@ -52,23 +38,8 @@ void add_distance_command(CLI::App& app, std::function<int()>& run) {
       ->capture_default_str();
   cmd->callback([args, &run] {
     run = [args]() -> int {
-      const TriangleMesh a = load_surface(args->a), b = load_surface(args->b);
-      const auto start = std::chrono::steady_clock::now();
-      const MeshDistance d = mesh_distance(a, b, args->samples, args->seed);
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const nlohmann::json j = {{"a", args->a},
-                                {"b", args->b},
-                                {"rms_forward", d.rms_forward},
-                                {"max_forward", d.max_forward},
-                                {"rms_backward", d.rms_backward},
-                                {"max_backward", d.max_backward},
-                                {"rms", d.rms},
-                                {"max", d.max},
-                                {"samples", d.samples},
-                                {"seed", args->seed},
-                                {"seconds", seconds}};
-      std::printf("%s\n", j.dump(2).c_str());
+      std::printf("%s\n",
+                  surface_distance(args->a, args->b, args->samples, args->seed).dump(2).c_str());
       return 0;
     };
   });

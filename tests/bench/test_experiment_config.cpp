@@ -283,8 +283,7 @@ TEST(ExperimentConfig, ConfigFilesAreReadStrictly) {
 TEST(ExperimentConfig, EveryShippedStudyConfigExpandsInBothVariants) {
   // bench/configs/*.json (not the *.reference.json tables the reports read): the studies the
   // docs/studies.md documents must load, full and quick, with this build's keys and checks.
-  const auto configs =
-      std::filesystem::path(MCFBENCH_TEST_DATA).parent_path().parent_path() / "bench" / "configs";
+  const auto configs = std::filesystem::path(MCFBENCH_SOURCE_DIR) / "bench" / "configs";
   int n = 0;
   for (const auto& entry : std::filesystem::directory_iterator(configs)) {
     const std::string name = entry.path().filename().string();

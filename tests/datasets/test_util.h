@@ -1,40 +1,14 @@
 #pragma once
-// Small helpers shared by the datasets tests.
+// Small helpers shared by the datasets tests (and TempDir of the core tests).
 
+#include "../core/temp_dir.h"
 #include "datasets/mesh.h"
 
 #include <Eigen/Geometry>
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
-#include <random>
-#include <string>
-
 namespace mcf::test {
-
-/// A fresh folder under the system temp dir, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() / ("mcf_datasets_test_" + std::to_string(rd()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(file(name), std::ios::binary) << text;
-    return file(name);
-  }
-
- private:
-  std::filesystem::path path_;
-};
 
 /// Signed volume enclosed by a closed mesh: positive when faces are oriented outward.
 inline double signed_volume(const TriangleMesh& m) {

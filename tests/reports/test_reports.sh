@@ -5,7 +5,7 @@ set -u
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 py=/usr/bin/python3
-# bench/summarize_micro.py (no matplotlib needed) on a fabricated Google Benchmark file: the step
+# reports/summarize_micro.py (no matplotlib needed) on a fabricated Google Benchmark file: the step
 # ratios, and each multigrid level's share of a W-cycle (100 of 400 ms = 25%; the 40 ms left are
 # the copies and the final residual, 10%); a benchmark repeated three times (one slow repetition)
 # counts as its median.
@@ -30,7 +30,7 @@ cat >"$sw/micro.json" <<'JSON'
    "real_time": 9000, "update_ms": 900, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
   {"name": "BM_Step_Tracked/threads:1_mean", "run_type": "aggregate", "time_unit": "ms", "real_time": 4267}]}
 JSON
-"$py" "$root/bench/summarize_micro.py" "$sw/micro.json" >"$sw/out.md" 2>&1 || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py"; exit 1; }
+"$py" "$root/reports/summarize_micro.py" "$sw/micro.json" >"$sw/out.md" 2>&1 || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py"; exit 1; }
 for want in '| 1 | 2 | 100 | 25% |' '| outside the cycle (copies, final residual) |  | 40 | 10% |' \
             '| rebuilt / tracked per step | 4× |' '| tracked, 1 thread | 2000 | update 800,' \
             '| tracked 1 thread / 2 threads | 2× |' 'medians of 1–3 repetitions' 'evaluate 1, steal 250 |'; do

@@ -264,7 +264,7 @@ TEST(CholmodSolver, SetMatrixSumIsBitwiseTheFactorOfTheSum) {
   const SparseMatrix M = laplacian3d(7, 6, 5, 0.1, 3);
   const SparseMatrix K = laplacian3d(7, 6, 5, 0.7, 4, 2.5);  // same pattern, other values
   ASSERT_TRUE(same_pattern(M, K));
-  // K's values on M's index arrays, as a basis hands them out (bases/basis.h SparseView).
+  // K's values on M's index arrays, as a basis hands them out (core/sparse.h SparseView).
   const Eigen::Map<const SparseMatrix> K_view(K.rows(), K.cols(), K.nonZeros(), M.outerIndexPtr(),
                                               M.innerIndexPtr(), K.valuePtr());
   const Eigen::MatrixXd B = random_rhs(M.rows());

@@ -1,12 +1,12 @@
 #!/usr/bin/python3
-"""Turns the Google Benchmark JSON of mcfbench_micro (bench/micro_octree.cpp) into the Markdown
+"""Turns the Google Benchmark JSON of mcfbench_micro (benchmarks/micro_octree.cpp) into the Markdown
 tables of docs/benchmarks.md: rebuilt phases per mesh, and the per-step ratios (tracked vs rebuilt,
 tracked vs hat + CHOLMOD, 2 vs 1 threads, W-cycle / SpMV, bytes per cubature point) with their
 targets and the paper's values, and each multigrid level's visits and own time per V- and
 W-cycle. Ratios only compare benchmarks of the same JSON file (same run); with
 --benchmark_repetitions each benchmark counts as the median of its repetitions.
 
-Usage: bench/summarize_micro.py micro_octree.json [> table.md]
+Usage: reports/summarize_micro.py micro_octree.json [> table.md]
 """
 import json
 import sys

@@ -1,9 +1,8 @@
 #pragma once
 // Four doubles as one value (GCC/Clang vector extensions: one AVX register when compiled for it,
-// emulated otherwise), for the integration kernels of the octree bases: bases/cell_blocks.h holds
+// emulated otherwise), for the kernels that handle four lanes at once: bases/cell_blocks.h holds
 // a point's 8 corner lanes in two of them, bases/tracked_octree_basis.cpp four cubature points in
-// one. (solvers/multigrid.cpp has its own copy: solvers may not include bases, docs/design.md
-// "Layers".)
+// one, and the multigrid's kernels (solvers/multigrid.cpp) four right-hand-side columns of a row.
 
 #include <algorithm>
 #include <cmath>

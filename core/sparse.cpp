@@ -1,4 +1,4 @@
-#include "bases/basis.h"
+#include "core/sparse.h"
 
 #include <stdexcept>
 #include <string>

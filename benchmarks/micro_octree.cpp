@@ -14,7 +14,7 @@
 //                              pattern) + W-cycle + evaluate
 //   BM_Step_HatCholmod/threads:2  hat update + M+δK + CHOLMOD refactorize + solve
 //                              (symbolic analysis outside the loop)
-// Ratios: summarize_micro.py turns the JSON into the tables of docs/benchmarks.md.
+// Ratios: reports/summarize_micro.py turns the JSON into the tables of docs/benchmarks.md.
 //
 // Fixtures are large (several GB at depth 9 on 832k faces), so only one lives at a time: taking
 // one frees the previous. Keep benchmarks that share a fixture next to each other.

@@ -1,4 +1,4 @@
-#include "tools/progress.h"
+#include "bench/progress.h"
 
 #include <unistd.h>
 #include <cmath>

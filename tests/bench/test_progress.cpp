@@ -1,7 +1,7 @@
 // Progress lines: rewritten in place on a terminal, a plain line at most every line_seconds
 // elsewhere (so a long run's log shows where it is, a short one's shows nothing extra).
 
-#include "tools/progress.h"
+#include "bench/progress.h"
 
 #include <gtest/gtest.h>
 

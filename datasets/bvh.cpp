@@ -1,4 +1,4 @@
-#include "bench/bvh.h"
+#include "datasets/bvh.h"
 
 #include <algorithm>
 #include <numeric>

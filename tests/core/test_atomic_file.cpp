@@ -2,8 +2,8 @@
 // a process that is gone) is removed by the next write of that target; those of live processes
 // and of other targets stay.
 
-#include "datasets/atomic_file.h"
-#include "test_util.h"
+#include "core/atomic_file.h"
+#include "temp_dir.h"
 
 #include <gtest/gtest.h>
 

@@ -3,15 +3,16 @@
 # in results/micro/<commit>.json, plus one summary line per run in results/micro/history.jsonl.
 # Two such files compare with Google Benchmark's own tool:
 #   compare.py benchmarks results/micro/OLD.json results/micro/NEW.json
-# Usage: bench/run_micro.sh [extra benchmark flags, e.g. --benchmark_filter=Cholmod]
-# Environment: BUILD_DIR (default ./build), MICRO_OUT (default results/micro),
-#              MCFBENCH_BENCH_MESH (mesh of the benchmarks, see bench/micro_hat.cpp).
+# Usage: benchmarks/run_micro.sh [extra benchmark flags, e.g. --benchmark_filter=Cholmod]
+# Environment: MCFBENCH_BUILD (the build folder, as for scripts/build.sh; default build/),
+#              MCFBENCH_MICRO_OUT (default results/micro),
+#              MCFBENCH_BENCH_MESH (mesh of the benchmarks, see benchmarks/micro_hat.cpp).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-build=${BUILD_DIR:-$root/build}
+build=${MCFBENCH_BUILD:-$root/build}
 bin=$build/mcfbench_micro
-out_dir=${MICRO_OUT:-results/micro}
-[ -x "$bin" ] || { echo "run_micro.sh: $bin not built (ninja -C $build mcfbench_micro)" >&2; exit 1; }
+out_dir=${MCFBENCH_MICRO_OUT:-results/micro}
+[ -x "$bin" ] || { echo "run_micro.sh: $bin not built (cmake --build $build --target mcfbench_micro)" >&2; exit 1; }
 
 # Same commit naming as the results of mcfbench (cmake/build_info.cmake): 12 hex, and for an
 # uncommitted change "-dirty-" + the first 8 hex of the SHA-1 of `git diff HEAD`.

@@ -1,0 +1,118 @@
+#include "bench/flow_folder.h"
+
+#include "bench/environment.h"
+#include "bench/experiment_config.h"
+#include "bench/progress.h"
+#include "core/atomic_file.h"
+#include "datasets/mesh_io.h"
+#include "datasets/mesh_spec.h"
+#include "flows/config_reader.h"
+#include "flows/flow.h"
+#include "flows/flow_config.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+namespace mcf {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Hidden (reports' globs and `collect` skip it), and removed by the next flow into OUT when a
+/// killed run left it.
+constexpr const char* kStagingFolder = ".mcfbench-staging";
+
+bool is_frame_file(const fs::path& p) {
+  const std::string stem = p.stem().string();
+  return p.extension() == ".ply" && stem.rfind("frame_", 0) == 0 && stem.size() > 6 &&
+         stem.find_first_not_of("0123456789", 6) == std::string::npos;
+}
+
+FlowConfig flow_config_of(const FlowRequest& request) {
+  nlohmann::json j = nlohmann::json::object();
+  std::string source = "command line";
+  if (!request.config_file.empty()) {
+    j = read_config_file(request.config_file);
+    source = request.config_file + " (+ command line)";
+  }
+  for (const auto& [path, value] : request.settings) set_json_path(j, path, value);
+  return flow_config_from_json(j, source);
+}
+
+/// Runs the flow with its progress on stderr and its frames (every config.save_every steps)
+/// written into `staging`, listed in `frames`.
+FlowOutcome run_staged(const FlowConfig& config, const MeshSource& mesh, const fs::path& staging,
+                       double line_seconds, std::set<std::string>& frames) {
+  Progress progress("step", config.steps, line_seconds);
+  FlowObserver observer;
+  observer.on_step = [&](int step, double, const Positions& V) {
+    progress.update(step);
+    if (config.save_every > 0 && step % config.save_every == 0) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05d.ply", step);
+      write_mesh((staging / name).string(), TriangleMesh{V, mesh.mesh.faces}, true,
+                 FaceCheck::trusted);
+      frames.insert(name);
+    }
+  };
+  FlowOutcome outcome = run_flow(config, mesh, observer);
+  progress.finish();
+  return outcome;
+}
+
+/// Moves the staged files into `out`. The earlier run's result goes first, so from here until
+/// the new one is in place OUT holds no result at all rather than one beside frames that are not
+/// its own; then the earlier run's frames that this run does not replace, then this run's files
+/// move in (rename: each appears whole), and result.json comes last, atomically.
+void publish(const fs::path& out, const fs::path& staging, const std::set<std::string>& frames,
+             const nlohmann::json& result) {
+  fs::remove(out / "result.json");
+  for (const auto& entry : fs::directory_iterator(out))
+    if (entry.is_regular_file() && is_frame_file(entry.path()) &&
+        !frames.count(entry.path().filename().string()))
+      fs::remove(entry.path());
+  for (const std::string& name : frames) fs::rename(staging / name, out / name);
+  fs::rename(staging / "final.ply", out / "final.ply");
+  write_file_atomic((out / "result.json").string(), result.dump(1) + "\n");
+  fs::remove_all(staging);
+}
+
+}  // namespace
+
+void run_flow_into_folder(const FlowRequest& request) {
+  const FlowConfig config = flow_config_of(request);
+  const MeshSource mesh = load_mesh_spec(config.mesh);  // throws naming the file: nothing written
+  const double line_seconds = progress_line_seconds();  // a bad MCFBENCH_PROGRESS_SECONDS too
+
+  const fs::path out(request.out);
+  // A folder this run creates is removed again if the flow throws (a set-up error such as
+  // `--cube unit` on a mesh outside the unit cube): no empty folder or partial frames left.
+  // In a folder that exists, only the staging folder is this run's until the flow is done.
+  const bool created = !fs::exists(out);
+  const fs::path staging = out / kStagingFolder;
+  fs::remove_all(staging);  // a killed run's
+  fs::create_directories(staging);
+  std::set<std::string> frames;
+  FlowOutcome outcome;
+  const double steal_before = cpu_steal_seconds();
+  try {
+    outcome = run_staged(config, mesh, staging, line_seconds, frames);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(created ? out : staging, ec);
+    throw;
+  }
+  outcome.result["environment"] = environment_json(config.threads);
+  outcome.result["peak_memory_bytes"] = peak_memory_bytes();
+  if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
+    outcome.result["steal_seconds"] = steal;
+  write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
+  publish(out, staging, frames, outcome.result);
+  const auto& stop = outcome.result["stop"];
+  std::fprintf(stderr, "mcfbench flow: %s after %d steps (%s); wrote %s\n",
+               outcome.result["status"].get<std::string>().c_str(), stop["step"].get<int>(),
+               stop["reason"].get<std::string>().c_str(), (out / "result.json").c_str());
+}
+
+}  // namespace mcf

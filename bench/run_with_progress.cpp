@@ -1,0 +1,81 @@
+#include "bench/run_with_progress.h"
+
+#include "bench/experiment_config.h"
+#include "bench/progress.h"
+#include "bench/runner.h"
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+namespace mcf {
+namespace {
+
+/// The progress of a run on stderr: a step line inside a running cell, then the cell's own line.
+class RunProgress {
+ public:
+  explicit RunProgress(double line_seconds) : line_seconds_(line_seconds) {}
+
+  void step(const StepReport& r) {
+    if (!steps_) {
+      std::string what = "[";  // not "[" + std::string: GCC 12 warns on it (-Wrestrict, falsely)
+      what += std::to_string(r.cell_number) + "/" + std::to_string(r.total) + "] cell " +
+              std::to_string(r.plan->cell.index) + " step";
+      steps_ = std::make_unique<Progress>(what, r.steps, line_seconds_);
+    }
+    steps_->update(r.step);
+  }
+
+  /// Ends the step line (on a terminal the cell's own line replaces it), so the next cell's first
+  /// step starts a new one.
+  void cell(const CellReport& r) {
+    if (steps_) steps_->clear();
+    steps_.reset();
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (!r.skipped) {
+      run_seconds_ += r.seconds;
+      ++ran_;
+    }
+    const double left = ran_ > 0 ? run_seconds_ / ran_ * (r.total - r.done) : 0.0;
+    std::fprintf(
+        stderr, "[%d/%d] cell %d %s %-8s %7.2f s  elapsed %.1f s  left ~%.1f s  %s%s%s\n", r.done,
+        r.total, r.plan->cell.index, r.plan->hash.c_str(), r.status.c_str(), r.seconds, elapsed,
+        left, r.plan->cell.assignment.dump().c_str(),
+        r.plan->cell.repetition ? (" rep " + std::to_string(r.plan->cell.repetition)).c_str() : "",
+        r.error.empty() ? "" : ("\n    error: " + r.error).c_str());
+  }
+
+ private:
+  double line_seconds_;
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  double run_seconds_ = 0;
+  int ran_ = 0;
+  std::unique_ptr<Progress> steps_;
+};
+
+}  // namespace
+
+int run_experiment_with_progress(const RunRequest& request) {
+  const ExperimentConfig e = load_experiment_config(request.config, request.quick);
+  const double line_seconds = progress_line_seconds();  // a bad value: nothing written
+  RunOptions o;
+  parse_shard(request.shard, o.shard_index, o.shard_count);
+  o.out_dir =
+      !request.out.empty() ? request.out : "results/" + e.name + (request.quick ? "-quick" : "");
+  o.force = request.force;
+  o.threads = request.threads;
+  RunProgress progress(line_seconds);
+  o.on_step = [&](const StepReport& r) { progress.step(r); };
+  o.on_cell = [&](const CellReport& r) { progress.cell(r); };
+  const RunSummary s = run_experiment(e, o);
+  std::printf(
+      "%s: %d cells, %d in shard %d/%d: %d ran%s, %d skipped, %d errors, %d reference "
+      "distances; results in %s\n",
+      e.name.c_str(), s.total, s.in_shard, o.shard_index, o.shard_count, s.ran,
+      s.retried ? (" (" + std::to_string(s.retried) + " retried after an error)").c_str() : "",
+      s.skipped, s.errors, s.distances, o.out_dir.c_str());
+  return s.errors > 0 ? 1 : 0;
+}
+
+}  // namespace mcf

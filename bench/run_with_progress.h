@@ -1,0 +1,24 @@
+#pragma once
+// `mcfbench run CONFIG.json`: runs an experiment matrix (or one shard of it), one result file per
+// cell (bench/runner.h), with its progress on stderr: one line per cell (not a \r progress bar:
+// shard logs under Slurm stay readable) and, inside a running cell, its steps; a summary line on
+// stdout at the end.
+
+#include <string>
+
+namespace mcf {
+
+struct RunRequest {
+  std::string config;  ///< the experiment config (JSON)
+  std::string out;     ///< results folder; empty: results/NAME (results/NAME-quick with quick)
+  std::string shard = "0/1";  ///< "i/n": only cells with index % n == i
+  bool force = false;         ///< rerun cells whose result file exists
+  bool quick = false;         ///< the config's "quick" variant
+  int threads = -1;           ///< >= 0 overrides every cell's thread count
+};
+
+/// Runs the request's cells; returns 1 when a cell errored, else 0. A config error (or a bad
+/// MCFBENCH_PROGRESS_SECONDS) throws before anything is written.
+int run_experiment_with_progress(const RunRequest& request);
+
+}  // namespace mcf

@@ -1,0 +1,34 @@
+#include "datasets/mesh_info.h"
+
+#include "datasets/mesh_io.h"
+#include "datasets/mesh_spec.h"
+
+namespace mcf {
+
+nlohmann::json mesh_info(const std::string& spec, const std::string& write_to) {
+  const MeshSource m = load_mesh_spec(spec);
+  const MeshReport& r = m.report;
+  const Eigen::Vector3d lo = m.mesh.vertices.colwise().minCoeff(),
+                        hi = m.mesh.vertices.colwise().maxCoeff();
+  nlohmann::json j = {{"spec", m.spec},
+                      {"kind", m.kind},
+                      {"analytic", m.analytic},
+                      {"vertices", r.vertices},
+                      {"faces", r.faces},
+                      {"unreferenced_vertices", r.unreferenced_vertices},
+                      {"boundary_loops", r.boundary_loops},
+                      {"connected_components", r.connected_components},
+                      {"euler_characteristic", r.euler_characteristic},
+                      {"genus", r.genus},
+                      {"area", r.area},
+                      {"bbox_min", {lo.x(), lo.y(), lo.z()}},
+                      {"bbox_max", {hi.x(), hi.y(), hi.z()}}};
+  if (m.sphere_radius) j["sphere_radius"] = *m.sphere_radius;
+  if (m.cylinder_radius) j["cylinder_radius"] = *m.cylinder_radius;
+  // Written before the report is printed: a write that fails (an unknown extension, a missing
+  // folder) exits non-zero with nothing on stdout, not after a complete-looking report.
+  if (!write_to.empty()) write_mesh(write_to, m.mesh, true, FaceCheck::trusted);
+  return j;
+}
+
+}  // namespace mcf
