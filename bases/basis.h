@@ -71,7 +71,9 @@ class Basis {
   /// the pattern of M and K, which the flows add, weighted, to the system of an increment
   /// (docs/octree-multigrid.md, "Stabilization"). Empty (0 x 0) for a basis that has none (the hat
   /// basis) or was not asked to assemble it; like mass(), valid until the next rebuild().
-  virtual SparseView normal_gradient() const;
+  virtual SparseView normal_gradient() const {
+    return view_of(std::vector<int>{}, std::vector<int>{}, std::vector<double>{});  // 0 x 0
+  }
 
   /// Multigrid hierarchy (coarsest level first); empty for bases without one.
   virtual const std::vector<SparseMatrix>* prolongations() const { return nullptr; }

@@ -133,8 +133,8 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
 
   if (options_.normal_gradient) {
     t0 = Clock::now();
-    normal_gradient_ = assemble_normal_gradient(*system_, octree_,
-                                                cell_normals(octree_, pieces_, piece_cells_));
+    normal_gradient_ =
+        assemble_normal_gradient(*system_, octree_, cell_normals(octree_, pieces_, piece_cells_));
     stats_.setup_seconds["normal_gradient"] = seconds_since(t0);
   } else {
     std::vector<double>().swap(normal_gradient_);
@@ -154,8 +154,7 @@ void RebuiltOctreeBasis::rebuild(const Positions& vertices) {
                                     cubature_rule(options_.cubature).size();
 }
 
-void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass,
-                                          std::vector<double>& stiffness,
+void RebuiltOctreeBasis::release_assembly(std::vector<double>& mass, std::vector<double>& stiffness,
                                           std::vector<double>& normal_gradient) {
   mass.swap(mass_);
   stiffness.swap(stiffness_);

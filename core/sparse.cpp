@@ -5,13 +5,6 @@
 
 namespace mcf {
 
-SparseView Basis::normal_gradient() const {
-  static const std::vector<int> no_columns;
-  static const std::vector<int> no_rows;
-  static const std::vector<double> no_values;
-  return view_of(no_columns, no_rows, no_values);
-}
-
 SparseView view_of(const SparseMatrix& A) {
   if (!A.isCompressed()) throw std::invalid_argument("view_of: the matrix is not compressed");
   return SparseView(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(),

@@ -52,8 +52,8 @@ void sum_on_pattern(const MatrixSum& sum, SparseMatrix& A) {
       out[i] = sum_entry(a, m[i], b, k[i], s, q[i]);
     });
   else
-    parallel_for_indices<Eigen::Index>(sum.M.nonZeros(), 1 << 14,
-                                       [&](Eigen::Index i) { out[i] = sum_entry(a, m[i], b, k[i]); });
+    parallel_for_indices<Eigen::Index>(
+        sum.M.nonZeros(), 1 << 14, [&](Eigen::Index i) { out[i] = sum_entry(a, m[i], b, k[i]); });
 }
 
 SparseMatrix general_sum(const MatrixSum& sum) {
