@@ -29,6 +29,8 @@
 #include "bases/tracked_octree_basis.h"
 #include "bench/environment.h"
 #include "datasets/mesh_spec.h"
+#include "flows/predicted_start.h"
+#include "flows/stabilization.h"
 #include "solvers/blas_threads.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"
@@ -435,6 +437,107 @@ BENCHMARK(BM_Step_Tracked)
     ->ArgName("threads")
     ->Arg(2)
     ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(5);
+
+// The stabilized tracked step (flows/stabilization.h) as a flow takes it: update, the system
+// M + δK + ρS written into the solver (ρ from the traces), the start along the prediction and the
+// right-hand side -δ K x + ρ S Δ̂ (flows/predicted_start.h), one cycle from Δ̂, and the
+// evaluation of x + Δ. range(0): TBB threads, range(1): 0 = W-cycle, 1 = V-cycle, range(2):
+// Gauss-Seidel sweeps before and after.
+TrackedFixture& stabilized_fixture() {
+  const Case c = arm_case();
+  return acquire<TrackedFixture>("stabilized:" + c.spec + "@" + std::to_string(c.depth), [c] {
+    OctreeOptions o = options(c);
+    o.normal_gradient = true;
+    auto f = std::make_unique<TrackedOctreeBasis>(mesh(c.spec).mesh, o);
+    auto t = std::make_unique<TrackedFixture>();
+    t->c = c;
+    t->source = &mesh(c.spec);
+    t->x = f->initial_coefficients();
+    t->basis = std::move(f);
+    return t;
+  });
+}
+
+void BM_Step_TrackedStabilized(benchmark::State& state) {
+  auto& f = stabilized_fixture();
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              std::size_t(state.range(0)));
+  TrackedOctreeBasis& basis = *f.basis;
+  MultigridOptions o = mg_options(state.range(1) == 0 ? MultigridCycle::W : MultigridCycle::V);
+  o.pre_smooth = o.post_smooth = int(state.range(2));
+  MultigridSolver solver(o);
+  const HierarchyView h{basis.prolongations(), basis.colours(), new_pattern_key()};
+  const double c = 0.5, dt = f.c.dt;
+  const SparseView S = basis.normal_gradient();
+  // The previous step: this step's increment, solved to 1e-6, taken as the last one, so that the
+  // prediction is what a flow at rest in its increments has (the timed cycle's work is the same
+  // whatever its start).
+  basis.update(f.x, true, true);
+  double rho = stabilization_rho(c, 1.0, dt, basis.mass(), basis.stiffness(), S);
+  solver.set_matrix_sum(MatrixSum(1.0, basis.mass(), dt, basis.stiffness(), rho, S), h);
+  Coefficients previous = f.x;
+  {
+    MultigridOptions exact = o;
+    exact.cycles = 20;
+    exact.tolerance = 1e-6;
+    solver.set_options(exact);
+    const PredictedStart s = predicted_start(MatrixSum(1.0, basis.mass(), dt, basis.stiffness()),
+                                             symmetric_multiply(basis.mass(), f.x), f.x, f.x);
+    Eigen::MatrixXd B = s.residual, X = Eigen::MatrixXd::Zero(f.x.rows(), 3);
+    solver.solve(B, X);
+    previous = f.x - X;
+    solver.set_options(o);
+  }
+  const Coefficients prediction = 2.0 * f.x - previous;
+  Eigen::MatrixXd X, B;
+  double t_update = 0, t_set = 0, t_solve = 0, t_eval = 0, residual = 0;
+  const auto step = [&](bool timed) {
+    auto t0 = Clock::now();
+    basis.update(f.x, true, true);
+    auto t1 = Clock::now();
+    rho = stabilization_rho(c, 1.0, dt, basis.mass(), basis.stiffness(), S);
+    solver.set_matrix_sum(MatrixSum(1.0, basis.mass(), dt, basis.stiffness(), rho, S), h);
+    auto t2 = Clock::now();
+    PredictedStart s = predicted_start(MatrixSum(1.0, basis.mass(), dt, basis.stiffness()),
+                                       symmetric_multiply(basis.mass(), f.x), f.x, prediction);
+    s.residual.noalias() += rho * symmetric_multiply(S, s.increment);
+    B = s.residual;
+    X = s.increment;
+    residual = solver.solve(B, X).relative_residual;
+    auto t3 = Clock::now();
+    Positions v = basis.evaluate_vertices(Coefficients(f.x + X));
+    benchmark::DoNotOptimize(v.data());
+    auto t4 = Clock::now();
+    if (!timed) return;
+    t_update += std::chrono::duration<double>(t1 - t0).count();
+    t_set += std::chrono::duration<double>(t2 - t1).count();
+    t_solve += std::chrono::duration<double>(t3 - t2).count();
+    t_eval += std::chrono::duration<double>(t4 - t3).count();
+  };
+  step(false);  // warm-up (see "Warm-up" at the top)
+  timed_steps(state, step);
+  const double n = double(state.iterations());
+  state.counters["update_ms"] = 1e3 * t_update / n;
+  state.counters["set_matrix_ms"] = 1e3 * t_set / n;
+  state.counters["solve_ms"] = 1e3 * t_solve / n;
+  state.counters["evaluate_ms"] = 1e3 * t_eval / n;
+  state.counters["relative_residual"] = residual;
+  state.counters["threads"] = double(state.range(0));
+  state.counters["smooth"] = double(state.range(2));
+  step_counters(state, f.c, *f.source, basis.stats());
+  state.SetLabel(std::string(state.range(1) == 0 ? "W(" : "V(") + std::to_string(state.range(2)) +
+                 "," + std::to_string(state.range(2)) + ") " + f.c.spec);
+}
+BENCHMARK(BM_Step_TrackedStabilized)
+    ->ArgNames({"threads", "vcycle", "smooth"})
+    ->Args({2, 0, 5})
+    ->Args({2, 1, 5})
+    ->Args({2, 1, 3})
+    ->Args({2, 1, 2})
+    ->Args({1, 1, 3})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);

@@ -1,9 +1,22 @@
 #include "core/sparse.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
 namespace mcf {
+
+double diagonal_sum(const SparseRef& A) {
+  double sum = 0.0;
+  const int* inner = A.innerIndexPtr();
+  for (Eigen::Index j = 0; j < A.outerSize(); ++j) {
+    const int* begin = inner + A.outerIndexPtr()[j];
+    const int* end = inner + A.outerIndexPtr()[j + 1];
+    const int* at = std::lower_bound(begin, end, int(j));
+    if (at != end && *at == j) sum += A.valuePtr()[at - inner];
+  }
+  return sum;
+}
 
 SparseView view_of(const SparseMatrix& A) {
   if (!A.isCompressed()) throw std::invalid_argument("view_of: the matrix is not compressed");

@@ -27,4 +27,7 @@ SparseView view_of(const SparseMatrix& A);
 SparseView view_of(const std::vector<int>& outer, const std::vector<int>& inner,
                    const std::vector<double>& values);
 
+/// Σ_j A_jj over the stored diagonal entries of a compressed matrix with sorted row indices.
+double diagonal_sum(const SparseRef& A);
+
 }  // namespace mcf

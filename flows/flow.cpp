@@ -5,9 +5,11 @@
 #include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
 #include "flows/integrator.h"
+#include "flows/predicted_start.h"
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
 #include "flows/sphere_reference.h"
+#include "flows/stabilization.h"
 #include "solvers/blas_threads.h"
 #include "solvers/symmetric_multiply.h"
 
@@ -44,12 +46,17 @@ int severity(SolveStatus s) {
 // heat neither after the first step), the reduced solve, and per-step timing.
 class FlowStepContext final : public StepContext {
  public:
-  FlowStepContext(Basis& basis, LinearSolver& solver, const std::string& flow, double dt)
+  /// stabilization_weight > 0: every solve is one for the increment over its held values, with
+  /// the basis's normal-gradient term added (solve()).
+  FlowStepContext(Basis& basis, LinearSolver& solver, const std::string& flow, double dt,
+                  bool iterative, double stabilization_weight = 0.0)
       : basis_(basis),
         solver_(solver),
         system_(std::make_unique<ReducedSystem>(basis, solver)),
         flow_(flow),
-        dt_(dt) {}
+        dt_(dt),
+        iterative_(iterative),
+        stabilization_weight_(stabilization_weight) {}
 
   double dt() const override { return dt_; }
   const Coefficients& current() const override { return *x_; }
@@ -76,7 +83,17 @@ class FlowStepContext final : public StepContext {
   Coefficients solve(double a, double b, const Coefficients& R, const Coefficients& fixed,
                      const Coefficients& warm) override {
     const auto t0 = Clock::now();
-    Coefficients Y = system_->solve(a, b, R, fixed, warm);
+    Coefficients Y;
+    if (stabilization_weight_ > 0.0) {
+      Y = solve_increment(a, b, R, fixed, warm);
+    } else if (iterative_ && warm != fixed) {
+      // The integrator's prediction, taken as far as it fits (flows/predicted_start.h).
+      const SparseView M = basis_.mass(), K = basis_.stiffness();
+      const PredictedStart start = predicted_start(MatrixSum(a, M, b, K), R, fixed, warm);
+      Y = system_->solve(a, b, R, fixed, Coefficients(fixed + start.increment));
+    } else {
+      Y = system_->solve(a, b, R, fixed, warm);
+    }
     solve_seconds_ += seconds_since(t0);
     const SolveReport& r = system_->report();
     ++solves_;
@@ -101,6 +118,8 @@ class FlowStepContext final : public StepContext {
     assembled_ = false;
   }
   void add_update_seconds(double s) { update_seconds_ += s; }
+  /// ρ of the last stabilized solve (0 without stabilization).
+  double stabilization_rho() const { return rho_; }
 
   double update_seconds_ = 0, solve_seconds_ = 0;
   int solves_ = 0, iterations_ = 0;
@@ -115,6 +134,40 @@ class FlowStepContext final : public StepContext {
   std::unique_ptr<ReducedSystem> system_;
   std::string flow_;
   double dt_;
+  /// The stabilized solve (flows/stabilization.h): Y = F + Δ with F the held values (the current
+  /// coefficients when Y is a position, zero when it is a velocity) and Δ̂ = warm - F, the
+  /// increment the solver starts from, as the prediction (for a position, the previous step's
+  /// increment, since the integrators start position solves at 2 X_n - X_{n-1}).
+  Coefficients solve_increment(double a, double b, const Coefficients& R, const Coefficients& F,
+                               const Coefficients& warm) {
+    const SparseView S = basis_.normal_gradient();
+    if (S.rows() != basis_.dimension())
+      throw std::logic_error("stabilized solve: the basis has no normal-gradient matrix");
+    const SparseView M = basis_.mass(), K = basis_.stiffness();
+    rho_ = mcf::stabilization_rho(stabilization_weight_, a, b, M, K, S);
+    PredictedStart start = predicted_start(MatrixSum(a, M, b, K), R, F, warm);
+    // R - (a M + b K) F + ρ S Δ̂, and Δ̂ is also where the solver starts.
+    Coefficients& rhs = start.residual;
+    if (start.theta > 0.0) rhs.noalias() += rho_ * symmetric_multiply(S, start.increment);
+    // The flow's first step has no previous increment to predict from: its solve starts from
+    // zero, and an iterative solver runs until the residual is down to kStartUpTolerance (what
+    // it leaves of that step's increment would stay in the surface; later steps start from a
+    // prediction and only remove its change).
+    const ReducedSystem::Passes start_up{kStartUpTolerance, kStartUpPasses};
+    const bool first = !started_ && start.theta == 0.0;
+    started_ = true;
+    const ReducedSystem::ExtraTerm term{rho_, S};
+    const Coefficients delta = system_->solve(a, b, rhs, Coefficients::Zero(F.rows(), 3),
+                                              start.increment, &term, first ? &start_up : nullptr);
+    return delta + F;
+  }
+
+  bool iterative_ = false;  ///< the solver starts from the warm start (multigrid, PCG)
+  double stabilization_weight_ = 0.0;
+  double rho_ = 0.0;
+  bool started_ = false;  ///< a stabilized solve ran (the start-up is the first one's)
+  static constexpr double kStartUpTolerance = 1e-8;
+  static constexpr int kStartUpPasses = 20;
   // The caller's iterates, which outlive the step: read in place, not copied.
   const Coefficients* x_ = nullptr;
   const Coefficients* x_prev_ = nullptr;
@@ -186,6 +239,8 @@ class FlowRun {
   std::unique_ptr<Integrator> integrator_;
   double build_seconds_ = 0;  // a rebuilt basis: its step 1's update
   std::unique_ptr<FlowStepContext> ctx_;
+  bool stabilized_ = false;                ///< octree.stabilization normal-gradient
+  bool keeps_previous_for_start_ = false;  ///< X_{n-1} for the solver's start (or prediction)
   Positions V_;
   Coefficients x_, x_prev_;
   bool has_prev_ = false;
@@ -219,7 +274,13 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
   result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);
   result["solver_name"] = solver_->name();
 
-  ctx_ = std::make_unique<FlowStepContext>(*basis_, *solver_, config.flow, config.dt);
+  stabilized_ = config.basis == "octree" && config.octree.stabilization == "normal-gradient";
+  // The start is the stabilized solve's prediction too (FlowStepContext::solve_increment), so a
+  // direct solver needs X_{n-1} then as well.
+  const bool iterative = config.solver.name == "multigrid" || config.solver.name == "pcg";
+  keeps_previous_for_start_ = stabilized_ || iterative;
+  ctx_ = std::make_unique<FlowStepContext>(*basis_, *solver_, config.flow, config.dt, iterative,
+                                           stabilized_ ? config.octree.stabilization_weight : 0.0);
   V_ = mesh_.vertices;
   x_ = basis_->initial_coefficients();
   area0_ = surface_area(mesh_);
@@ -264,6 +325,7 @@ nlohmann::json FlowRun::solver_record(int step, double t) const {
   // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
   // Gauss-Seidel on a level), or why it failed.
   if (!worst.message.empty()) record["solver"]["message"] = worst.message;
+  if (stabilized_) record["solver"]["stabilization_rho"] = ctx.stabilization_rho();
   if (ctx.fixed()) record["fixed_functions"] = ctx.fixed();
   if (basis_->rebuilds_every_step()) {
     record["dimension"] = basis_->dimension();
@@ -362,7 +424,9 @@ bool FlowRun::advance(int step) {
   record["area"] = area;
   record["step_difference"] = step_difference;
   record_references(V_new, t, record);
-  if (integrator_->uses_previous()) {
+  // X_{n-1}: for two-step schemes, and for the extrapolated start 2 X_n - X_{n-1} of a position
+  // solve, which an iterative solver starts from and a stabilized solve predicts with.
+  if (integrator_->uses_previous() || keeps_previous_for_start_) {
     x_prev_ = std::move(x_);
     has_prev_ = true;
   }

@@ -22,6 +22,10 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
       o.fail("cubature", "must be 1, 3 or 6, got " + std::to_string(c.octree.cubature));
     c.octree.cube = o.get_string("cube", c.octree.cube, {"auto", "unit", "tight"});
     c.octree.refine_input = o.get_bool("refine_input", c.octree.refine_input);
+    c.octree.stabilization =
+        o.get_string("stabilization", c.octree.stabilization, {"none", "normal-gradient"});
+    c.octree.stabilization_weight =
+        o.get_number("stabilization_weight", c.octree.stabilization_weight, 0.0, 1e6);
     o.finish();
   }
   {
@@ -62,7 +66,9 @@ nlohmann::json to_json(const FlowConfig& c) {
             {"depth", c.octree.depth},
             {"cubature", c.octree.cubature},
             {"cube", c.octree.cube},
-            {"refine_input", c.octree.refine_input}}},
+            {"refine_input", c.octree.refine_input},
+            {"stabilization", c.octree.stabilization},
+            {"stabilization_weight", c.octree.stabilization_weight}}},
           {"solver",
            {{"name", c.solver.name},
             {"tolerance", c.solver.tolerance},

@@ -26,15 +26,18 @@ bool ReducedSystem::shares_pattern(const SparseRef& M, const SparseRef& K) {
 }
 
 Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
-                                  const Coefficients& fixed_values, const Coefficients& warm) {
+                                  const Coefficients& fixed_values, const Coefficients& warm,
+                                  const ExtraTerm* extra, const Passes* passes) {
+  passes_ = passes ? *passes : Passes{0.0, 1};
   // Views: no copies (the bases keep both on one pattern's index arrays).
   const SparseView M = basis_.mass();
   const SparseView K = basis_.stiffness();
-  // S = a M + b K. Bases assemble M and K on one pattern: then S is a value-wise sum, and it is
-  // formed here only when functions are held (below); otherwise the solver forms it itself
-  // (set_matrix_sum), so no copy of it, as large as M, is kept here.
-  const bool shared = shares_pattern(M, K);
-  if (!shared) sum_ = general_sum(a, M, b, K);
+  const MatrixSum terms = extra ? MatrixSum(a, M, b, K, extra->s, extra->S) : MatrixSum(a, M, b, K);
+  // The system a M + b K [+ s S]. Bases assemble their matrices on one pattern: then it is a
+  // value-wise sum, and it is formed here only when functions are held (below); otherwise the
+  // solver forms it itself (set_matrix_sum), so no copy of it, as large as M, is kept here.
+  const bool shared = shares_pattern(M, K) && (!extra || same_pattern(M, extra->S));
+  if (!shared) sum_ = general_sum(terms);
   const std::vector<int> empty = empty_rows(a, b, M, K, shared);
   fixed_.clear();
   std::set_union(base_fixed_.begin(), base_fixed_.end(), empty.begin(), empty.end(),
@@ -44,13 +47,13 @@ Coefficients ReducedSystem::solve(double a, double b, const Coefficients& R,
   // ReducedSystem), so a pattern key lets the solver skip comparing it each step. No key when M
   // and K have different patterns: then sum_'s pattern depends on whether b is 0.
   const HierarchyView view{basis_.prolongations(), basis_.colours(), shared ? full_key_ : 0};
-  if (fixed_.empty()) return solve_whole(a, b, M, K, shared, view, R, warm);
+  if (fixed_.empty()) return solve_whole(terms, shared, view, R, warm);
   if (shared) {
     if (sum_.nonZeros() != M.nonZeros() || sum_.rows() != M.rows())
       sum_ = M;  // M's pattern is fixed
-    sum_on_pattern(a, M, b, K, sum_);
+    sum_on_pattern(terms, sum_);
   }
-  Anchors anchors = hold_in_place(empty);
+  Anchors anchors = hold_in_place(empty, extra != nullptr);
   // Copies of R and the warm start only when rows are held in place (an open surface's steps
   // without a pinch read the caller's).
   Coefficients R_held, warm_held;
@@ -97,12 +100,11 @@ std::vector<int> ReducedSystem::empty_rows(double a, double b, const SparseView&
   return empty;
 }
 
-Coefficients ReducedSystem::solve_whole(double a, double b, const SparseView& M,
-                                        const SparseView& K, bool shared, HierarchyView view,
+Coefficients ReducedSystem::solve_whole(const MatrixSum& terms, bool shared, HierarchyView view,
                                         const Coefficients& R, const Coefficients& warm) {
   if (shared) {
     sum_ = SparseMatrix();  // held functions may have needed it; now it is the solver's
-    report_ = solver_.set_matrix_sum(a, M, b, K, view);
+    report_ = solver_.set_matrix_sum(terms, view);
   } else {
     report_ = solver_.set_matrix(sum_, view);
   }
@@ -111,7 +113,8 @@ Coefficients ReducedSystem::solve_whole(double a, double b, const SparseView& M,
   return X;
 }
 
-ReducedSystem::Anchors ReducedSystem::hold_in_place(const std::vector<int>& empty) {
+ReducedSystem::Anchors ReducedSystem::hold_in_place(const std::vector<int>& empty,
+                                                    bool eliminate_all) {
   // An empty row is held in place (the paper's anchoring, Section 5.3: the coefficient keeps
   // its value): its diagonal becomes d and its right-hand side d times the held value. Its
   // column is zero, so no other unknown sees it and the solution of the others is the one of
@@ -122,7 +125,8 @@ ReducedSystem::Anchors ReducedSystem::hold_in_place(const std::vector<int>& empt
   // diagonal of the other rows, so the coarse operators the row feeds stay of the usual scale.
   // One pass over the columns: each empty row's diagonal position, and the mean of the others'
   // positive diagonal entries. Rows without a stored diagonal cannot be held in place: they are
-  // eliminated.
+  // eliminated; so are all of them when an extra term couples them to their neighbours
+  // (eliminate_all: their columns are not zero).
   Anchors anchors;
   anchors.eliminated = base_fixed_;
   if (!empty.empty()) {
@@ -137,7 +141,7 @@ ReducedSystem::Anchors ReducedSystem::hold_in_place(const std::vector<int>& empt
       const int* at = std::lower_bound(inner + outer[c], inner + outer[c + 1], int(c));
       const int diagonal = at != inner + outer[c + 1] && *at == c ? int(at - inner) : -1;
       if (e < empty.size() && empty[e] == c) {
-        if (diagonal < 0) {
+        if (diagonal < 0 || eliminate_all) {
           anchors.eliminated.push_back(int(c));
         } else {
           anchors.anchored.push_back(int(c));
@@ -255,6 +259,15 @@ void ReducedSystem::solve_after_set(const ConstMatrixRef& R, MatrixRef X) {
   // records report().message, and the solve's own report used to replace the note unseen.
   std::string note = std::move(report_.message);
   report_ = solver_.solve(R, X);
+  for (int pass = 1;
+       pass < passes_.max && report_.ok() && !(report_.relative_residual <= passes_.tolerance);
+       ++pass) {
+    SolveReport more = solver_.solve(R, X);
+    more.iterations += report_.iterations;
+    more.residuals.insert(more.residuals.begin(), report_.residuals.begin(),
+                          report_.residuals.end());
+    report_ = std::move(more);
+  }
   if (!note.empty())
     report_.message = report_.message.empty() ? std::move(note) : note + "; " + report_.message;
 }

@@ -23,10 +23,28 @@ class ReducedSystem {
  public:
   ReducedSystem(const Basis& basis, LinearSolver& solver);
 
-  /// Solves; `report()` then holds the solver's report, its message also carrying set_matrix's
-  /// note on an accepted matrix. Returns the full solution.
+  /// A third term s S of the system (the normal-gradient stabilization of an increment), S on the
+  /// pattern of M and K.
+  struct ExtraTerm {
+    double s;
+    SparseView S;
+  };
+
+  /// Solves (a M + b K [+ s S]) Y = R; `report()` then holds the solver's report, its message also
+  /// carrying set_matrix's note on an accepted matrix. Returns the full solution. Empty rows are
+  /// those of a M + b K; with an extra term they are eliminated instead of held in place (the
+  /// term couples them to their neighbours).
+  /// An iterative solver's passes: the solve is repeated (each pass continues from the last
+  /// iterate, on the same matrix) until the relative residual is at most `tolerance` or `max`
+  /// passes ran. One pass when absent.
+  struct Passes {
+    double tolerance;
+    int max;
+  };
+
   Coefficients solve(double a, double b, const Coefficients& R, const Coefficients& fixed_values,
-                     const Coefficients& warm);
+                     const Coefficients& warm, const ExtraTerm* extra = nullptr,
+                     const Passes* passes = nullptr);
   const SolveReport& report() const { return report_; }
   /// Functions held in the last solve (boundary + empty rows).
   std::size_t num_fixed() const { return fixed_.size(); }
@@ -45,12 +63,11 @@ class ReducedSystem {
   std::vector<int> empty_rows(double a, double b, const SparseView& M, const SparseView& K,
                               bool shared) const;
   /// No function held: the solver gets a M + b K (or sum_) as it is.
-  Coefficients solve_whole(double a, double b, const SparseView& M, const SparseView& K,
-                           bool shared, HierarchyView view, const Coefficients& R,
-                           const Coefficients& warm);
+  Coefficients solve_whole(const MatrixSum& terms, bool shared, HierarchyView view,
+                           const Coefficients& R, const Coefficients& warm);
   /// Sets the diagonal of sum_'s empty rows that have one (the anchoring); the others are left
   /// to the reduction.
-  Anchors hold_in_place(const std::vector<int>& empty);
+  Anchors hold_in_place(const std::vector<int>& empty, bool eliminate_all);
   /// Solves on the free functions of sum_ (the reduction, rebuilt when `eliminated` changed)
   /// with the eliminated ones at their fixed values.
   Coefficients solve_reduced(std::vector<int> eliminated, bool shared, const HierarchyView& view,
@@ -60,6 +77,7 @@ class ReducedSystem {
   bool shares_pattern(const SparseRef& M, const SparseRef& K);
   /// report_ holds set_matrix's report: when it is ok, solves into X and keeps its note.
   void solve_after_set(const ConstMatrixRef& R, MatrixRef X);
+  Passes passes_{0.0, 1};  // of the solve in progress
 
   const Basis& basis_;
   LinearSolver& solver_;

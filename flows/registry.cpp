@@ -19,6 +19,7 @@ OctreeOptions octree_options(const OctreeConfig& c, bool analytic) {
   o.depth = c.depth;
   o.cubature = c.cubature;
   o.refine_input = c.refine_input;
+  o.normal_gradient = c.stabilization == "normal-gradient";
   // "auto": the unit cube for models normalised into it (the paper's setting), the tight cube
   // around analytic shapes (which keep their own size).
   if (c.cube == "unit")

@@ -20,14 +20,26 @@ namespace mcf {
 /// gives Aᵀ X.
 void symmetric_multiply(const SparseRef& A, const double* X, Eigen::Index k, double* Y);
 
+/// Y = (a M + b K [+ s S]) X for terms on one pattern (same_pattern; summable() is checked), in one
+/// pass over the pattern with the entries formed by MatrixSum::entry: the sum is never stored.
+void symmetric_multiply(const MatrixSum& A, const double* X, Eigen::Index k, double* Y);
+
+inline Eigen::Index rows_of(const SparseRef& A) {
+  return A.rows();
+}
+inline Eigen::Index rows_of(const MatrixSum& A) {
+  return A.M.rows();
+}
+
 /// Y = A X for column-major dense Eigen matrices (MatrixXd, the flows' n x 3 coefficients, an
 /// Eigen::Ref); Y must be resizable.
-template <class In, class Out>
-void symmetric_multiply(const SparseRef& A, const In& X, Out& Y) {
+template <class Matrix, class In, class Out>
+void symmetric_multiply(const Matrix& A, const In& X, Out& Y) {
   static_assert(!In::IsRowMajor && !Out::IsRowMajor,
                 "symmetric_multiply: column-major dense matrices only");
-  if (X.rows() != A.cols()) throw std::invalid_argument("symmetric_multiply: sizes do not match");
-  Y.resize(A.rows(), X.cols());
+  const Eigen::Index n = rows_of(A);
+  if (X.rows() != n) throw std::invalid_argument("symmetric_multiply: sizes do not match");
+  Y.resize(n, X.cols());
   if (X.outerStride() == X.rows()) {
     symmetric_multiply(A, X.data(), X.cols(), Y.data());
   } else {  // columns apart (a block of a larger matrix): the kernel reads one leading dimension
@@ -36,8 +48,8 @@ void symmetric_multiply(const SparseRef& A, const In& X, Out& Y) {
   }
 }
 
-template <class Dense>
-Dense symmetric_multiply(const SparseRef& A, const Dense& X) {
+template <class Matrix, class Dense>
+Dense symmetric_multiply(const Matrix& A, const Dense& X) {
   Dense Y;
   symmetric_multiply(A, X, Y);
   return Y;

@@ -14,10 +14,11 @@ struct FlowArgs {
   std::string config_file, out;
   // Every flag maps to one key of the flow config; only flags given on the command line are
   // set, so --config FILE supplies the rest.
-  std::string mesh, flow, basis, mass, tracking, cube, solver, preconditioner, cycle, integrator;
+  std::string mesh, flow, basis, mass, tracking, cube, stabilization, solver, preconditioner, cycle,
+      integrator;
   int depth = 0, cubature = 0, max_iterations = 0, cycles = 0, smooth = 0, steps = 0, threads = 0,
       save_every = 0;
-  double dt = 0, tolerance = 0;
+  double dt = 0, tolerance = 0, stabilization_weight = 0;
   bool refine_input = false, normalize_area = false, frozen = false;
 };
 
@@ -39,6 +40,11 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
                  "Octree bounding cube: auto (default: unit cube if the mesh fits) | unit | tight");
   cmd.add_flag("--refine-input", args.refine_input,
                "Octree: split the input mesh 1-to-4 once first");
+  cmd.add_option("--stabilization", args.stabilization,
+                 "Octree: none (the paper's system) | normal-gradient (solve each step's "
+                 "increment with the band's normal-gradient term added)");
+  cmd.add_option("--stabilization-weight", args.stabilization_weight,
+                 "Octree: the normal-gradient term's diagonal over the system's (default 0.5)");
   cmd.add_option("--solver", args.solver,
                  "cholmod (default) | pcg | multigrid | dense (LLT of the dense matrix: a "
                  "reference for small meshes)");
@@ -84,6 +90,8 @@ FlowRequest flow_request(const CLI::App& cmd, const FlowArgs& args) {
   set("--depth", "octree.depth", args.depth);
   set("--cubature", "octree.cubature", args.cubature);
   set("--cube", "octree.cube", args.cube);
+  set("--stabilization", "octree.stabilization", args.stabilization);
+  set("--stabilization-weight", "octree.stabilization_weight", args.stabilization_weight);
   set("--refine-input", "octree.refine_input", args.refine_input);
   set("--solver", "solver.name", args.solver);
   set("--tolerance", "solver.tolerance", args.tolerance);
