@@ -71,7 +71,8 @@ TEST(Stabilization, WCyclesReachTheDirectSolutionWithinFifteenCycles) {
 // the paper's system stalls (late cycles above 0.5), warm-started as in a flow (step 3).
 TEST(Stabilization, EveryWCycleGainsTenfold) {
   for (const char* stabilization : {"normal-gradient", "none"}) {
-    json j = octree_flow("icosphere:level=5", 6, stabilization, {{"name", "multigrid"}, {"cycles", 8}});
+    json j =
+        octree_flow("icosphere:level=5", 6, stabilization, {{"name", "multigrid"}, {"cycles", 8}});
     j["steps"] = 3;
     const std::vector<double> r = residuals(run(j));
     ASSERT_EQ(r.size(), 8u);
