@@ -16,10 +16,10 @@ struct OctreeConfig {
   int cubature = 3;                  ///< 1 | 3 | 6 (rule's name, docs/design.md)
   std::string cube = "auto";         ///< auto | unit | tight
   bool refine_input = false;         ///< 1-to-4 split of the initial mesh first (Fig. 6, blue)
-  /// none (the paper's system) | normal-gradient: each step solves for the increment of the
-  /// coefficients with the band's normal-gradient term added (docs/octree-multigrid.md,
-  /// "Stabilization").
-  std::string stabilization = "none";
+  /// normal-gradient (default): each step solves for the increment of the coefficients with the
+  /// band's normal-gradient term added, so that multigrid converges (docs/octree-multigrid.md,
+  /// "Stabilization") | none: the paper's system.
+  std::string stabilization = "normal-gradient";
   /// c: the term's diagonal is c times the system's (ρ = c tr(a M + b K) / tr(S)).
   double stabilization_weight = 0.5;
 };

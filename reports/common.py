@@ -170,8 +170,8 @@ def assignment(result):
     if isinstance(a, dict) and a:
         return a
     cfg = result.get("config", {})
-    keys = ["mesh", "flow", "basis", "octree.tracking", "octree.depth", "octree.cubature",
-            "octree.refine_input", "solver.name", "solver.cycles", "integrator", "extrapolate", "dt"]
+    keys = ["mesh", "flow", "basis", "octree.tracking", "octree.stabilization", "octree.depth",
+            "octree.cubature", "octree.refine_input", "solver.name", "solver.cycles", "integrator", "extrapolate", "dt"]
     return {k: get(cfg, k) for k in keys if get(cfg, k) is not None}
 
 

@@ -47,9 +47,28 @@ def mesh(r):
     return common.get(r, "config.mesh")
 
 
+def stabilized(r):
+    """True for the normal-gradient stabilized system (a result without the key ran the paper's)."""
+    return common.get(r, "config.octree.stabilization", "none") not in ("none", None)
+
+
+def style(cells, stab, index):
+    """Line style: a colour per depth (or cycles) value, solid for the stabilized system and dashed
+    for the paper's when the panel has both, so each pair shares its colour."""
+    both = len({stabilized(r) for r in cells}) > 1
+    return {"color": "C%d" % (index % 10), "ls": "-" if stab or not both else "--"}
+
+
+def system_name(cells, stab):
+    """", stabilized" / ", paper's system" where the panel has both systems, else nothing."""
+    if len({stabilized(r) for r in cells}) < 2:
+        return ""
+    return ", stabilized" if stab else ", paper's system"
+
+
 def line_order(kv):
     """Lines by mesh (first seen) then by their number (depth or cycles), missing ones last."""
-    (m, n), _ = kv
+    n = kv[0][1]
     return (n is None, n or 0)
 
 
@@ -61,10 +80,12 @@ def named(m, text, cells):
 def plot_residuals(ax, cells):
     """Residual vs cycles, one line per mesh and depth. With one cycles value only, the per-cycle
     residual history of the first step stands in (same quantity, read inside a single solve)."""
-    by_depth = common.group_by(cells, lambda r: (mesh(r), depth(r)))
+    by_depth = common.group_by(cells, lambda r: (mesh(r), depth(r), stabilized(r)))
     meshes = list(dict.fromkeys(mesh(r) for r in cells))
+    depths = sorted({depth(r) for r in cells if depth(r) is not None})
     distinct_cycles = {cycles(r) for r in cells}
-    for (m, d), rs in sorted(by_depth.items(), key=lambda kv: (meshes.index(kv[0][0]),) + line_order(kv)):
+    for (m, d, stab), rs in sorted(by_depth.items(),
+                                   key=lambda kv: (meshes.index(kv[0][0]),) + line_order(kv) + (kv[0][2],)):
         if len(distinct_cycles) > 1:
             pts = sorted((cycles(r), final_residual(r)) for r in rs
                          if cycles(r) is not None and common.finite(final_residual(r)))
@@ -72,23 +93,33 @@ def plot_residuals(ax, cells):
             res = common.get((rs[0].get("steps") or [{}])[0], "solver.residuals") or []
             pts = [(i + 1, v) for i, v in enumerate(res) if common.finite(v)]
         if pts:
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3, label=named(m, "depth %s" % d, cells))
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", ms=3,
+                    label=named(m, "depth %s%s" % (d, system_name(cells, stab)), cells),
+                    **style(cells, stab, depths.index(d) if d in depths else len(depths)))
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("W-cycles")
     ax.set_ylabel("relative residual")
     ax.set_yscale("log")
-    ax.set_title("residual (%s)" % ("sphere" if all(is_sphere(r) for r in cells) else "model"), fontsize=9)
+    title = "residual (%s)" % ("sphere" if all(is_sphere(r) for r in cells) else "model")
+    if any(stabilized(r) for r in cells):
+        # The stabilized solve is for the step's increment: its residual is relative to the
+        # increment's right-hand side, far smaller than the position's, so compare slopes.
+        title += "\nstabilized: relative to the increment's right-hand side"
+    ax.set_title(title, fontsize=9)
 
 
 def plot_hausdorff(ax, cells):
     """Hausdorff distance vs depth, one line per mesh and number of cycles."""
     meshes = list(dict.fromkeys(mesh(r) for r in cells))
-    by_cycles = common.group_by(cells, lambda r: (mesh(r), cycles(r)))
-    for (m, c), rs in sorted(by_cycles.items(), key=lambda kv: (meshes.index(kv[0][0]),) + line_order(kv)):
+    by_cycles = common.group_by(cells, lambda r: (mesh(r), cycles(r), stabilized(r)))
+    counts = sorted({cycles(r) for r in cells if cycles(r) is not None})
+    for (m, c, stab), rs in sorted(by_cycles.items(),
+                                   key=lambda kv: (meshes.index(kv[0][0]),) + line_order(kv) + (kv[0][2],)):
         pts = sorted((depth(r), hausdorff(r)) for r in rs if depth(r) is not None and common.finite(hausdorff(r)))
         if pts:
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", ms=3,
-                    label=named(m, "%s W-cycle%s" % (c, "" if c == 1 else "s"), cells))
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", ms=3,
+                    label=named(m, "%s W-cycle%s%s" % (c, "" if c == 1 else "s", system_name(cells, stab)), cells),
+                    **style(cells, stab, counts.index(c) if c in counts else len(counts)))
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("octree depth")
     ax.set_ylabel("Hausdorff distance")

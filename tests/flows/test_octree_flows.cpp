@@ -30,6 +30,13 @@ json octree(const std::string& mesh, const std::string& tracking, int depth, con
               {"solver", solver}};
 }
 
+/// The same on the paper's system (no stabilization): what the tests of its properties run.
+json paper(const std::string& mesh, const std::string& tracking, int depth, const json& solver) {
+  json j = octree(mesh, tracking, depth, solver);
+  j["octree"]["stabilization"] = "none";
+  return j;
+}
+
 TEST(OctreeFlows, MultigridConvergesToCholmod) {
   // Multigrid-preconditioned CG to 1e-12 reproduces the direct solution of the same system.
   for (const char* tracking : {"rebuilt", "tracked"}) {
@@ -49,13 +56,13 @@ TEST(OctreeFlows, PlainCyclesConvergeToCholmod) {
   // Plain V- and W-cycles (no Krylov acceleration) also reach the direct solution, only slowly
   // on the restricted surface system (about 0.95 per cycle after the first few;
   // docs/octree-multigrid.md "Convergence").
-  json ch = octree("icosphere:level=4", "tracked", 5, {{"name", "cholmod"}});
+  json ch = paper("icosphere:level=4", "tracked", 5, {{"name", "cholmod"}});
   ch["steps"] = 1;
   const Positions b = run(ch).final_mesh.vertices;
   for (const char* cycle : {"V", "W"}) {
     json mg =
-        octree("icosphere:level=4", "tracked", 5,
-               {{"name", "multigrid"}, {"cycle", cycle}, {"cycles", 800}, {"tolerance", 1e-11}});
+        paper("icosphere:level=4", "tracked", 5,
+              {{"name", "multigrid"}, {"cycle", cycle}, {"cycles", 800}, {"tolerance", 1e-11}});
     mg["steps"] = 1;
     const auto o = run(mg);
     const auto& r = o.result["steps"][0]["solver"]["residuals"];
@@ -83,7 +90,7 @@ TEST(OctreeFlows, TwoSolveIntegratorsRecordEverySolvesResiduals) {
   // Taylor-2 solves twice a step: `residuals` is the last solve's, `residuals_per_solve` has
   // both, in order, each falling cycle by cycle; one-solve integrators do not write it.
   for (const char* integrator : {"taylor2", "semi-implicit"}) {
-    json j = octree("icosphere:level=3", "tracked", 5, {{"name", "multigrid"}, {"cycles", 3}});
+    json j = paper("icosphere:level=3", "tracked", 5, {{"name", "multigrid"}, {"cycles", 3}});
     j["integrator"] = integrator;
     j["steps"] = 2;
     const auto o = run(j);
@@ -133,8 +140,8 @@ TEST(OctreeFlows, TrackedFollowsTheSemiImplicitRadius) {
   // dominates both; the sphere_error study shows it.)
   for (const json& solver :
        {json{{"name", "cholmod"}}, json{{"name", "multigrid"}, {"cycles", 3}}}) {
-    json tracked = octree("icosphere:level=4", "tracked", 5, solver);
-    json rebuilt = octree("icosphere:level=4", "rebuilt", 5, solver);
+    json tracked = paper("icosphere:level=4", "tracked", 5, solver);
+    json rebuilt = paper("icosphere:level=4", "rebuilt", 5, solver);
     tracked["steps"] = rebuilt["steps"] = 100;
     const auto t = run(tracked), r = run(rebuilt);
     ASSERT_EQ(t.result["status"], "ok");
@@ -198,7 +205,7 @@ TEST(OctreeFlows, EachRebuildDropsTheVerticesTowardTheFlatFaces) {
   EXPECT_NEAR(D, 7.04e-4, 0.2e-4);  // edge 0.0755: h²/8 = 7.1e-4
   // drop(step) = semi-implicit radius - mean vertex radius: > 0 when the vertices are too far in.
   auto drops = [&](const std::string& tracking, int depth, const json& solver, int steps) {
-    json j = octree(mesh, tracking, depth, solver);
+    json j = paper(mesh, tracking, depth, solver);
     j["steps"] = steps;
     j["dt"] = 1e-3;
     const auto o = run(j);
@@ -231,8 +238,8 @@ TEST(OctreeFlows, EachRebuildDropsTheVerticesTowardTheFlatFaces) {
 TEST(OctreeFlows, TrackedAndRebuiltAgreeOnARealModel) {
   // Ten steps of δ = 1e-5 on the bunny: the two discretisations agree to discretisation accuracy
   // (a small fraction of a cell at depth 6, h = 1/64).
-  json tracked = octree("cgal:bunny00", "tracked", 6, {{"name", "cholmod"}});
-  json rebuilt = octree("cgal:bunny00", "rebuilt", 6, {{"name", "cholmod"}});
+  json tracked = paper("cgal:bunny00", "tracked", 6, {{"name", "cholmod"}});
+  json rebuilt = paper("cgal:bunny00", "rebuilt", 6, {{"name", "cholmod"}});
   tracked["steps"] = rebuilt["steps"] = 10;
   tracked["dt"] = rebuilt["dt"] = 1e-5;
   const auto t = run(tracked), r = run(rebuilt);
@@ -315,6 +322,22 @@ TEST(OctreeFlows, ResultRecordsTheGridCube) {
                    .contains("cube"));  // hat
 }
 
+// The stabilization makes the spiral's system definite (S couples the functions that differ only
+// along a wall's normal), so CHOLMOD solves the stabilized flow the paper's system refuses, and
+// the multigrid reaches the same surface.
+TEST(OctreeFlows, FacesParallelToTheGridPlanesAreDefiniteWhenStabilized) {
+  const std::string spiral = "spiral:turns=2,segments_per_turn=32,profile_segments=4";
+  json j = octree(spiral, "tracked", 5, {{"name", "cholmod"}});
+  j["steps"] = 3;
+  const auto cholmod = run(j);
+  ASSERT_EQ(cholmod.result["status"], "ok") << cholmod.result["stop"].dump();
+  j["solver"] = {{"name", "multigrid"}, {"cycles", 30}, {"tolerance", 1e-12}};
+  const auto mg = run(j);
+  ASSERT_EQ(mg.result["status"], "ok");
+  const Positions &a = mg.final_mesh.vertices, &b = cholmod.final_mesh.vertices;
+  EXPECT_LT((a - b).norm() / b.norm(), 1e-9);
+}
+
 TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
   // The cubical spiral's walls are parallel to grid planes: there two trilinear functions that
   // differ only along a wall's normal are multiples of each other on the surface, so M and K are
@@ -324,7 +347,7 @@ TEST(OctreeFlows, FacesParallelToTheGridPlanesSolveWithMultigrid) {
   // never sees the hierarchy, and one W-cycle (the paper's setting) runs without a failure.
   const std::string spiral = "spiral:turns=2,segments_per_turn=32,profile_segments=4";
   const auto with = [&](const json& solver) {
-    json j = octree(spiral, "tracked", 5, solver);
+    json j = paper(spiral, "tracked", 5, solver);
     j["steps"] = 3;
     return run(j);
   };
