@@ -2,7 +2,7 @@
 // Four doubles as one value (GCC/Clang vector extensions: one AVX register when compiled for it,
 // emulated otherwise), for the kernels that handle four lanes at once: bases/cell_blocks.h holds
 // a point's 8 corner lanes in two of them, bases/tracked_octree_basis.cpp four cubature points in
-// one, and the multigrid's kernels (solvers/multigrid.cpp) four right-hand-side columns of a row.
+// one, and the multigrid's kernels (solvers/smoother.h) four right-hand-side columns of a row.
 
 #include <algorithm>
 #include <cmath>

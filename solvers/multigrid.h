@@ -26,7 +26,7 @@
 // once): the sweeps stream the matrix ten times per level visit and are bound by its bytes.
 // Coarse-level sweeps only shape a correction of the finest level's residual, which the
 // residual, the transfers and the coarse operators keep exact, so the cycle converges to the
-// solution of A x = b; a rounded finest-level matrix would not (multigrid.cpp, SmootherRows).
+// solution of A x = b; a rounded finest-level matrix would not (solvers/smoother.h, SmootherRows).
 // A level whose couplings lie farther apart than 16 bits reach keeps CSC sweeps.
 //
 // Internal numbering: every coloured level is stored in tiles of `tile_size` consecutive indices,

@@ -385,9 +385,9 @@ bool same_values(const SparseMatrix& X, const SparseMatrix& Y) {
 }
 
 /// The finest level stores each column's diagonal last and remembers where the caller had it
-/// (multigrid.cpp, diagonal_last): a value refresh and set_matrix_sum must put every entry back
-/// in its place, and the pattern comparison must recognise the caller's order. Checked with the
-/// caller's diagonal at every rank (columns rotated), against the same matrix stored sorted.
+/// (solvers/smoother.h, diagonal_last): a value refresh and set_matrix_sum must put every entry
+/// back in its place, and the pattern comparison must recognise the caller's order. Checked with
+/// the caller's diagonal at every rank (columns rotated), against the same matrix stored sorted.
 TEST(Multigrid, FinestDiagonalStoredLastWhereverTheCallerHasIt) {
   const Problem pm = make_problem(5, 2, 0.0, Drop::shell);
   const Problem pk = make_problem(5, 2, 1.0, Drop::shell);
