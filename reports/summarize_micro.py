@@ -157,6 +157,10 @@ def main():
     # Per-step comparisons.
     t2, t1 = get("BM_Step_Tracked/threads:2"), get("BM_Step_Tracked/threads:1")
     rb, hat = get("BM_Step_Rebuilt/threads:2"), get("BM_Step_HatCholmod/threads:2")
+    # The stabilized tracked steps (docs/octree-multigrid.md "Stabilization"), by cycle and sweeps.
+    stab = [((x.get("label") or "?").split()[0], x) for x in
+            (get(f"BM_Step_TrackedStabilized/threads:2/vcycle:{v}/smooth:{k}")
+             for v, k in ((0, 5), (1, 5), (1, 3), (1, 2))) if x]
     def steal(x):
         # CPU time the hypervisor took per step (all vCPUs); absent from older benchmark files.
         v = x.get("steal_ms")
@@ -170,6 +174,10 @@ def main():
     if t1:
         lines.append(f"| tracked, 1 thread | {fmt(ms(t1))} | update {fmt(t1['update_ms'])}, set_matrix "
                      f"{fmt(t1['set_matrix_ms'])}, solve {fmt(t1['solve_ms'])}, evaluate {fmt(t1['evaluate_ms'])}{steal(t1)} |")
+    for name, x in stab:
+        lines.append(f"| tracked, stabilized, {name}, 2 threads | {fmt(ms(x))} | update {fmt(x['update_ms'])}, "
+                     f"set_matrix {fmt(x['set_matrix_ms'])}, solve {fmt(x['solve_ms'])}, "
+                     f"evaluate {fmt(x['evaluate_ms'])}{steal(x)} |")
     if rb:
         lines.append(f"| rebuilt, 2 threads | {fmt(ms(rb))} | rebuild {fmt(rb['rebuild_ms'])}, set_matrix "
                      f"{fmt(rb['set_matrix_ms'])}, solve {fmt(rb['solve_ms'])}, evaluate {fmt(rb['evaluate_ms'])}{steal(rb)} |")
@@ -186,6 +194,9 @@ def main():
     lines.append(f"| rebuilt / tracked per step | {fmt(ratio(rb, t2))}× | ≥ 7× | ~7× |")
     r = ratio(hat, t2)
     lines.append(f"| hat+CHOLMOD / tracked per step | {fmt(r)}× | ≥ 3× | — |")
+    for name, x in stab:
+        lines.append(f"| tracked, stabilized {name} / hat+CHOLMOD per step | {fmt(ratio(x, hat))}× "
+                     f"| ≤ 0.67× (W(5,5)) | — |")
     lines.append(f"| tracked 1 thread / 2 threads | {fmt(ratio(t1, t2))}× | ≥ 1.7× | — |")
     for m, n in meshes:
         w = get(f"BM_Rebuilt_Cycle/mesh:{m}/W:1")
