@@ -70,6 +70,29 @@ TEST(MeshSpec, SizesBeyondTheLimitsAreRefusedBeforeBuilding) {
   expect_spec_error("torus:n_major=-20000,n_minor=-20000", "n_major, n_minor >= 3");
 }
 
+// parse_mesh_spec reads what load_mesh_spec would build, and refuses what it would refuse, without
+// building or reading anything (the fuzz target relies on it to build small meshes only).
+TEST(MeshSpec, ParseWithoutBuilding) {
+  const MeshSpecRequest g = parse_mesh_spec("torus:n_major=10,n_minor=5@faces=400");
+  EXPECT_EQ(g.kind, "torus");
+  EXPECT_EQ(g.target_faces, 400);
+  EXPECT_EQ(g.generated_faces, 100);
+  for (const char* name : {"sphere", "icosphere", "torus", "spiral", "dumbbell", "rounded_cylinder",
+                           "open_cylinder", "catenoid"})
+    EXPECT_GE(parse_mesh_spec(name).generated_faces, load_mesh_spec(name).mesh.num_faces()) << name;
+  const MeshSpecRequest f = parse_mesh_spec("no/such/file.off@faces=10");
+  EXPECT_EQ(f.kind, "file");
+  EXPECT_EQ(f.target, "no/such/file.off");
+  EXPECT_EQ(f.target_faces, 10);
+  const MeshSpecRequest c = parse_mesh_spec("cgal:no_such_model");
+  EXPECT_EQ(c.kind, "cgal");
+  EXPECT_EQ(c.target, "no_such_model");
+  EXPECT_THROW(parse_mesh_spec("sphere:vertices=300000000"), MeshError);
+  EXPECT_THROW(parse_mesh_spec("torus:foo=1"), MeshError);
+  EXPECT_THROW(parse_mesh_spec("blob"), MeshError);
+  EXPECT_THROW(parse_mesh_spec("@faces=10"), MeshError);
+}
+
 TEST(MeshSpec, Sphere) {
   const MeshSource s = load_mesh_spec("sphere:vertices=1000,radius=2");
   EXPECT_EQ(s.kind, "sphere");
