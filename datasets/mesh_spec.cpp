@@ -62,7 +62,10 @@ const std::vector<Generator>& generators() {
          return make_sphere(static_cast<long long>(v.at("vertices")), v.at("radius"));
        },
        "geodesic sphere with about `vertices` vertices, centred at the origin",
-       [](const Values& v) { return 2 * v.at("vertices"); }},
+       [](const Values& v) {  // make_sphere's frequency k (10 k^2 + 2 vertices, 20 k^2 faces)
+         const double k = std::max(1.0, std::round(std::sqrt((v.at("vertices") - 2) / 10.0)));
+         return 20 * k * k;
+       }},
       {"icosphere",
        {{"level", true, 5, "1-to-4 subdivisions of the icosahedron", 12},
         {"radius", false, 1.0, "radius"}},
