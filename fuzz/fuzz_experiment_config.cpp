@@ -4,6 +4,7 @@
 // is a finding. Nothing is run: a cell's mesh spec is a string here.
 
 #include "bench/experiment_config.h"
+#include "flows/config_reader.h"
 #include "fuzz/fuzz_file.h"
 
 #include <cstddef>
