@@ -343,8 +343,8 @@ MeshSpecRequest parse_mesh_spec(const std::string& spec) {
   }
   const Generator& g = find_generator(spec, r.kind);
   const Values values = generator_values(spec, g, args, colon != std::string::npos);
-  // Values the generator refuses (a count or size <= 0) make nothing.
-  if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second > 0; }))
+  // Negative values the generator refuses make nothing (icosphere's level 0 makes 20 faces).
+  if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second >= 0; }))
     r.generated_faces = g.faces(values);
   return r;
 }

@@ -34,7 +34,8 @@ struct MeshSpecRequest {
   std::string target;          ///< the file's path or the cgal model's name ("" for a generator)
   long long target_faces = 0;  ///< N of "@faces=N"; 0 without it
   double generated_faces = 0;  ///< a generator's upper estimate of the faces it makes (before
-                               ///< @faces); 0 for files and cgal models, whose size is their own
+                               ///< @faces); 0 for files and cgal models, whose size is their
+                               ///< own, and for negative values, which the generator refuses
 };
 
 /// Parses and checks the spec as load_mesh_spec does (the same MeshError on a malformed spec, an

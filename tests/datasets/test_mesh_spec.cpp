@@ -83,6 +83,8 @@ TEST(MeshSpec, ParseWithoutBuilding) {
   // Found by fuzz_mesh_spec: the sphere's estimate was 2 x vertices, but make_sphere rounds its
   // frequency to the nearest, and "sphere:vertices=241" made 500 faces.
   EXPECT_EQ(parse_mesh_spec("sphere:vertices=241").generated_faces, 500);
+  // And "icosphere:level=0" was estimated at 0 faces: its level 0 is valid.
+  EXPECT_EQ(parse_mesh_spec("icosphere:level=0").generated_faces, 20);
   for (long long n = 12; n <= 400; ++n)
     EXPECT_EQ(parse_mesh_spec("sphere:vertices=" + std::to_string(n)).generated_faces,
               make_sphere(n).num_faces())
