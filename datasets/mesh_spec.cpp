@@ -109,8 +109,10 @@ const std::vector<Generator>& generators() {
        },
        "closed capsule (cylinder with hemispherical caps)",
        [](const Values& v) {  // rings spaced as the widest ring's vertices along the profile
+         // (at least 2 rows, rounded), each of at most max(6, n) vertices; F = 2 V - 4.
          const double n = v.at("resolution"), r = v.at("radius"), l = v.at("length");
-         return 2 * n * (n * (std::numbers::pi * r + l) / (2 * std::numbers::pi * r) + 1);
+         const double rows = n * (std::numbers::pi * r + l) / (2 * std::numbers::pi * r);
+         return 2 * std::max(6.0, n) * std::max(2.0, rows + 1);
        }},
       {"open_cylinder",
        {{"radius", false, 0.5, "radius"},

@@ -85,6 +85,9 @@ TEST(MeshSpec, ParseWithoutBuilding) {
   EXPECT_EQ(parse_mesh_spec("sphere:vertices=241").generated_faces, 500);
   // And "icosphere:level=0" was estimated at 0 faces: its level 0 is valid.
   EXPECT_EQ(parse_mesh_spec("icosphere:level=0").generated_faces, 20);
+  // And the rounded cylinder's at small resolutions, whose rings have at least 6 vertices.
+  EXPECT_GE(parse_mesh_spec("rounded_cylinder:radius=0.1,length=1,resolution=4").generated_faces,
+            load_mesh_spec("rounded_cylinder:radius=0.1,length=1,resolution=4").mesh.num_faces());
   for (long long n = 12; n <= 400; ++n)
     EXPECT_EQ(parse_mesh_spec("sphere:vertices=" + std::to_string(n)).generated_faces,
               make_sphere(n).num_faces())
