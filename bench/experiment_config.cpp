@@ -374,6 +374,28 @@ std::vector<Dimension> dimensions(const MatrixSpec& m, const std::string& source
   return dims;
 }
 
+// The most cells a matrix may expand into, repetitions included: far beyond any study that could
+// run, and small enough to expand in seconds. A few lines of axes (or "repetitions": 1000000)
+// would otherwise multiply into billions of cells and exhaust the memory while expanding.
+constexpr double kMaxCells = 100'000;
+
+/// Refuses a matrix of more than kMaxCells cells before any is built (counted before excludes).
+void check_matrix_size(const std::vector<Dimension>& dims, int repetitions,
+                       const std::string& source, const std::string& axes_where) {
+  double cells = repetitions;
+  std::string product;
+  for (const Dimension& d : dims) {
+    cells *= static_cast<double>(d.rows.size());
+    product += std::to_string(d.rows.size()) + " x ";
+  }
+  if (cells > kMaxCells)
+    fail(source, axes_where,
+         "the matrix has " + product + std::to_string(repetitions) +
+             " repetitions = " + std::to_string(static_cast<long long>(std::min(cells, 1e18))) +
+             " cells, more than the " + std::to_string(static_cast<long long>(kMaxCells)) +
+             " an experiment may have");
+}
+
 /// The cells: an odometer over the dimensions, the last one fastest, each assignment applied
 /// to the defaults, every repetition of a cell no exclude entry matches (`exclude_used` marks
 /// the entries that matched one).
@@ -467,6 +489,7 @@ ExperimentConfig parse_experiment_config(const json& j, const std::string& sourc
   const MatrixSpec m = read_matrix(j, source, quick, e);
   const std::string axes_where = quick ? "axes (with quick.axes)" : "axes";
   const std::vector<Dimension> dims = dimensions(m, source, axes_where);
+  check_matrix_size(dims, e.repetitions, source, axes_where);
   std::vector<bool> exclude_used(m.exclude.is_array() ? m.exclude.size() : 0, false);
   expand_cells(dims, m, source, e, exclude_used);
   const json& q = member(j, "quick");

@@ -62,7 +62,10 @@ const std::vector<Generator>& generators() {
          return make_sphere(static_cast<long long>(v.at("vertices")), v.at("radius"));
        },
        "geodesic sphere with about `vertices` vertices, centred at the origin",
-       [](const Values& v) { return 2 * v.at("vertices"); }},
+       [](const Values& v) {  // make_sphere's frequency k (10 k^2 + 2 vertices, 20 k^2 faces)
+         const double k = std::max(1.0, std::round(std::sqrt((v.at("vertices") - 2) / 10.0)));
+         return 20 * k * k;
+       }},
       {"icosphere",
        {{"level", true, 5, "1-to-4 subdivisions of the icosahedron", 12},
         {"radius", false, 1.0, "radius"}},
@@ -106,8 +109,10 @@ const std::vector<Generator>& generators() {
        },
        "closed capsule (cylinder with hemispherical caps)",
        [](const Values& v) {  // rings spaced as the widest ring's vertices along the profile
+         // (at least 2 rows, rounded), each of at most max(6, n) vertices; F = 2 V - 4.
          const double n = v.at("resolution"), r = v.at("radius"), l = v.at("length");
-         return 2 * n * (n * (std::numbers::pi * r + l) / (2 * std::numbers::pi * r) + 1);
+         const double rows = n * (std::numbers::pi * r + l) / (2 * std::numbers::pi * r);
+         return 2 * std::max(6.0, n) * std::max(2.0, rows + 1);
        }},
       {"open_cylinder",
        {{"radius", false, 0.5, "radius"},
@@ -264,9 +269,7 @@ Values generator_values(const std::string& spec, const Generator& g, const std::
   return values;
 }
 
-/// A generated mesh ("NAME[:key=value,...]", `given` when the colon is there) into `src`.
-void load_generated(const std::string& spec, const std::string& name, const std::string& args,
-                    bool given, MeshSource& src) {
+const Generator& find_generator(const std::string& spec, const std::string& name) {
   const auto& table = generators();
   auto g =
       std::find_if(table.begin(), table.end(), [&](const Generator& x) { return x.name == name; });
@@ -275,11 +278,18 @@ void load_generated(const std::string& spec, const std::string& name, const std:
     for (const auto& x : table) known += ", " + x.name;
     fail(spec, "unknown generator '" + name + "' (known: " + known + ", or a file path)");
   }
-  const Values values = generator_values(spec, *g, args, given);
+  return *g;
+}
+
+/// A generated mesh ("NAME[:key=value,...]", `given` when the colon is there) into `src`.
+void load_generated(const std::string& spec, const std::string& name, const std::string& args,
+                    bool given, MeshSource& src) {
+  const Generator& g = find_generator(spec, name);
+  const Values values = generator_values(spec, g, args, given);
   src.kind = name;
   src.analytic = true;
   try {
-    src.mesh = g->build(values);
+    src.mesh = g.build(values);
     // As read_mesh does for files: then every MeshSource's faces hold in a half-edge mesh,
     // and a flow writes them without checking each frame again (FaceCheck::trusted).
     check_half_edge_faces(src.mesh, name);
@@ -314,6 +324,32 @@ void subdivide_source(MeshSource& src, long long target_faces) {
 }
 
 }  // namespace
+
+MeshSpecRequest parse_mesh_spec(const std::string& spec) {
+  MeshSpecRequest r;
+  std::string head;
+  r.target_faces = split_face_target(spec, head);
+  if (head.empty()) fail(spec, "empty mesh spec");
+  if (looks_like_file(head)) {
+    r.kind = "file";
+    r.target = head;
+    return r;
+  }
+  const auto colon = head.find(':');
+  r.kind = head.substr(0, colon);
+  const std::string args = colon == std::string::npos ? "" : head.substr(colon + 1);
+  if (r.kind == "cgal") {
+    if (args.empty()) fail(spec, "cgal needs a model name, e.g. cgal:armadillo");
+    r.target = args;
+    return r;
+  }
+  const Generator& g = find_generator(spec, r.kind);
+  const Values values = generator_values(spec, g, args, colon != std::string::npos);
+  // Negative values the generator refuses make nothing (icosphere's level 0 makes 20 faces).
+  if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second >= 0; }))
+    r.generated_faces = g.faces(values);
+  return r;
+}
 
 MeshSource load_mesh_spec(const std::string& spec) {
   MeshSource src;

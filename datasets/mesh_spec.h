@@ -28,6 +28,21 @@ struct MeshSource {
   MeshReport report;                      ///< validation report (validate_mesh has passed)
 };
 
+/// What a spec asks for, as load_mesh_spec reads it, before anything is built or read.
+struct MeshSpecRequest {
+  std::string kind;            ///< a generator's name, "cgal" or "file"
+  std::string target;          ///< the file's path or the cgal model's name ("" for a generator)
+  long long target_faces = 0;  ///< N of "@faces=N"; 0 without it
+  double generated_faces = 0;  ///< a generator's upper estimate of the faces it makes (before
+                               ///< @faces); 0 for files and cgal models, whose size is their
+                               ///< own, and for negative values, which the generator refuses
+};
+
+/// Parses and checks the spec as load_mesh_spec does (the same MeshError on a malformed spec, an
+/// unknown generator or key, or a size beyond the limit) without building, reading or extracting
+/// anything: the file and the model are not looked at.
+MeshSpecRequest parse_mesh_spec(const std::string& spec);
+
 /// Parses the spec, builds/loads, scales real models to the unit cube, subdivides to @faces,
 /// validates. Throws MeshError naming the spec (and file) on any problem, including an unknown
 /// generator or parameter.

@@ -2,9 +2,10 @@
 # Fails if a layer, or its tests (tests/LAYER), includes a header of a layer above it (docs/design.md
 # "Layers"). core is the bottom layer: it includes no other layer, and every layer may include it.
 root=${1:-$(dirname "$0")/..}
-order=(core datasets bases solvers flows bench benchmarks tools)
+order=(core datasets bases solvers flows bench benchmarks tools fuzz)
 # solvers sits beside bases (neither may include the other), and beside datasets; the
-# micro-benchmarks (benchmarks/) and the executable (tools/) sit beside each other on top.
+# micro-benchmarks (benchmarks/), the executable (tools/) and the fuzz targets (fuzz/) sit beside
+# each other on top.
 declare -A forbidden=(
   [core]="datasets bases solvers flows bench benchmarks tools"
   [datasets]="bases solvers flows bench benchmarks tools"
@@ -13,7 +14,8 @@ declare -A forbidden=(
   [flows]="bench benchmarks tools"
   [bench]="benchmarks tools"
   [benchmarks]="tools"
-  [tools]="benchmarks"
+  [tools]="benchmarks fuzz"
+  [fuzz]="benchmarks tools"
 )
 bad=0
 for layer in "${order[@]}"; do

@@ -215,6 +215,24 @@ TEST(ExperimentConfig, ErrorsNameTheFileAndTheKeyPath) {
                "exclude[0]");
 }
 
+// A matrix of more cells than any study could run is refused before it is expanded: a few lines
+// of axes, or a million repetitions, would otherwise exhaust the memory while expanding.
+TEST(ExperimentConfig, HugeMatricesAreRefusedBeforeExpanding) {
+  json values = json::array();
+  for (int i = 0; i < 100; ++i) values.push_back(i + 1);
+  expect_error({{"defaults", base},
+                {"axes", {{"steps", values}, {"solver.cycles", values}}},
+                {"repetitions", 11}},
+               "the matrix has 100 x 100 x 11 repetitions = 110000 cells");
+  expect_error({{"defaults", base}, {"repetitions", 1000000}}, "= 1000000 cells, more than");
+  json quick = {{"axes", {{"steps", values}}}, {"repetitions", 1001}};
+  expect_error({{"defaults", base}, {"quick", quick}}, "axes (with quick.axes): the matrix", true);
+  // Up to the limit the matrix expands.
+  EXPECT_EQ(expand({{"defaults", base}, {"axes", {{"steps", values}}}, {"repetitions", 1000}})
+                .cells.size(),
+            100000u);
+}
+
 TEST(ExperimentConfig, ExcludeEntriesMustMatchInTheirOwnVariant) {
   // The full matrix's exclude applied to quick.axes may rightly match nothing; quick.exclude
   // entries must match in the quick run.

@@ -59,7 +59,7 @@ TEST(MeshSpec, SizesBeyondTheLimitsAreRefusedBeforeBuilding) {
   expect_spec_error("sphere:vertices=9223372036854775807", "key 'vertices' is out of range");
   expect_spec_error("sphere:vertices=-9223372036854775807", "key 'vertices' is out of range");
   expect_spec_error("sphere:vertices=99999999999", "key 'vertices' is out of range");
-  expect_spec_error("sphere:vertices=300000000", "about 600000000 faces, more than the 200000000");
+  expect_spec_error("sphere:vertices=300000000", "about 599950580 faces, more than the 200000000");
   expect_spec_error("torus:n_major=100000,n_minor=100000", "about 20000000000 faces");
   expect_spec_error("spiral:turns=100000,segments_per_turn=1000,profile_segments=8",
                     "faces, more than the");
@@ -68,6 +68,41 @@ TEST(MeshSpec, SizesBeyondTheLimitsAreRefusedBeforeBuilding) {
   // Below the limit, and the generators' own lower bounds still name themselves.
   EXPECT_EQ(load_mesh_spec("icosphere:level=4").mesh.num_faces(), 20 * 256);
   expect_spec_error("torus:n_major=-20000,n_minor=-20000", "n_major, n_minor >= 3");
+}
+
+// parse_mesh_spec reads what load_mesh_spec would build, and refuses what it would refuse, without
+// building or reading anything (the fuzz target relies on it to build small meshes only).
+TEST(MeshSpec, ParseWithoutBuilding) {
+  const MeshSpecRequest g = parse_mesh_spec("torus:n_major=10,n_minor=5@faces=400");
+  EXPECT_EQ(g.kind, "torus");
+  EXPECT_EQ(g.target_faces, 400);
+  EXPECT_EQ(g.generated_faces, 100);
+  for (const char* name : {"sphere", "icosphere", "torus", "spiral", "dumbbell", "rounded_cylinder",
+                           "open_cylinder", "catenoid"})
+    EXPECT_GE(parse_mesh_spec(name).generated_faces, load_mesh_spec(name).mesh.num_faces()) << name;
+  // Found by fuzz_mesh_spec: the sphere's estimate was 2 x vertices, but make_sphere rounds its
+  // frequency to the nearest, and "sphere:vertices=241" made 500 faces.
+  EXPECT_EQ(parse_mesh_spec("sphere:vertices=241").generated_faces, 500);
+  // And "icosphere:level=0" was estimated at 0 faces: its level 0 is valid.
+  EXPECT_EQ(parse_mesh_spec("icosphere:level=0").generated_faces, 20);
+  // And the rounded cylinder's at small resolutions, whose rings have at least 6 vertices.
+  EXPECT_GE(parse_mesh_spec("rounded_cylinder:radius=0.1,length=1,resolution=4").generated_faces,
+            load_mesh_spec("rounded_cylinder:radius=0.1,length=1,resolution=4").mesh.num_faces());
+  for (long long n = 12; n <= 400; ++n)
+    EXPECT_EQ(parse_mesh_spec("sphere:vertices=" + std::to_string(n)).generated_faces,
+              make_sphere(n).num_faces())
+        << n;
+  const MeshSpecRequest f = parse_mesh_spec("no/such/file.off@faces=10");
+  EXPECT_EQ(f.kind, "file");
+  EXPECT_EQ(f.target, "no/such/file.off");
+  EXPECT_EQ(f.target_faces, 10);
+  const MeshSpecRequest c = parse_mesh_spec("cgal:no_such_model");
+  EXPECT_EQ(c.kind, "cgal");
+  EXPECT_EQ(c.target, "no_such_model");
+  EXPECT_THROW(parse_mesh_spec("sphere:vertices=300000000"), MeshError);
+  EXPECT_THROW(parse_mesh_spec("torus:foo=1"), MeshError);
+  EXPECT_THROW(parse_mesh_spec("blob"), MeshError);
+  EXPECT_THROW(parse_mesh_spec("@faces=10"), MeshError);
 }
 
 TEST(MeshSpec, Sphere) {
