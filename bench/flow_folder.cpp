@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <set>
+#include <stdexcept>
 
 namespace mcf {
 namespace {
@@ -61,12 +62,12 @@ FlowOutcome run_staged(const FlowConfig& config, const MeshSource& mesh, const f
   return outcome;
 }
 
-/// Moves the staged files into `out`. The earlier run's result goes first, so from here until
-/// the new one is in place OUT holds no result at all rather than one beside frames that are not
-/// its own; then the earlier run's frames that this run does not replace, then this run's files
-/// move in (rename: each appears whole), and result.json comes last, atomically.
-void publish(const fs::path& out, const fs::path& staging, const std::set<std::string>& frames,
-             const nlohmann::json& result) {
+/// Moves the staged files into `out`: removals and renames only, which need no space on the disk,
+/// so a full disk has failed the run before the earlier run was touched. The earlier run's result
+/// goes first, so from here until the new one is in place OUT holds no result at all rather than
+/// one beside frames that are not its own; then the earlier run's frames that this run does not
+/// replace, then this run's files move in (rename: each appears whole), result.json last.
+void publish(const fs::path& out, const fs::path& staging, const std::set<std::string>& frames) {
   fs::remove(out / "result.json");
   for (const auto& entry : fs::directory_iterator(out))
     if (entry.is_regular_file() && is_frame_file(entry.path()) &&
@@ -74,7 +75,8 @@ void publish(const fs::path& out, const fs::path& staging, const std::set<std::s
       fs::remove(entry.path());
   for (const std::string& name : frames) fs::rename(staging / name, out / name);
   fs::rename(staging / "final.ply", out / "final.ply");
-  write_file_atomic((out / "result.json").string(), result.dump(1) + "\n");
+  fs::rename(staging / "result.json", out / "result.json");
+  sync_to_disk(out);  // the renames (each file's data was synced when it was written)
   fs::remove_all(staging);
 }
 
@@ -87,28 +89,37 @@ void run_flow_into_folder(const FlowRequest& request) {
 
   const fs::path out(request.out);
   // A folder this run creates is removed again if the flow throws (a set-up error such as
-  // `--cube unit` on a mesh outside the unit cube): no empty folder or partial frames left.
+  // `--cube unit` on a mesh outside the unit cube, a full disk): no empty folder or partial
+  // frames left.
   // In a folder that exists, only the staging folder is this run's until the flow is done.
   const bool created = !fs::exists(out);
   const fs::path staging = out / kStagingFolder;
-  fs::remove_all(staging);  // a killed run's
-  fs::create_directories(staging);
+  std::error_code ec;
+  fs::remove_all(staging, ec);  // a killed run's
+  if (!ec) fs::create_directories(staging, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    if (created) fs::remove_all(out, ec);
+    throw std::runtime_error(staging.string() + ": cannot create the staging folder: " + why);
+  }
   std::set<std::string> frames;
   FlowOutcome outcome;
   const double steal_before = cpu_steal_seconds();
+  // Every file of the run is written into the staging folder first: a write that fails (a full
+  // disk) leaves OUT as it was, whatever it held.
   try {
     outcome = run_staged(config, mesh, staging, line_seconds, frames);
+    outcome.result["environment"] = environment_json(config.threads);
+    outcome.result["peak_memory_bytes"] = peak_memory_bytes();
+    if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
+      outcome.result["steal_seconds"] = steal;
+    write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
+    write_file_atomic((staging / "result.json").string(), outcome.result.dump(1) + "\n");
   } catch (...) {
-    std::error_code ec;
     fs::remove_all(created ? out : staging, ec);
     throw;
   }
-  outcome.result["environment"] = environment_json(config.threads);
-  outcome.result["peak_memory_bytes"] = peak_memory_bytes();
-  if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
-    outcome.result["steal_seconds"] = steal;
-  write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
-  publish(out, staging, frames, outcome.result);
+  publish(out, staging, frames);
   const auto& stop = outcome.result["stop"];
   std::fprintf(stderr, "mcfbench flow: %s after %d steps (%s); wrote %s\n",
                outcome.result["status"].get<std::string>().c_str(), stop["step"].get<int>(),

@@ -3,6 +3,7 @@
 #include "bench/experiment_config.h"
 #include "bench/progress.h"
 #include "bench/runner.h"
+#include "bench/stop_signals.h"
 
 #include <chrono>
 #include <cstdio>
@@ -24,6 +25,12 @@ class RunProgress {
       steps_ = std::make_unique<Progress>(what, r.steps, line_seconds_);
     }
     steps_->update(r.step);
+  }
+
+  /// Ends a step line that a stop interrupted, so the message that follows starts a line.
+  void stopped() {
+    if (steps_) steps_->clear();
+    steps_.reset();
   }
 
   /// Ends the step line (on a terminal the cell's own line replaces it), so the next cell's first
@@ -68,7 +75,22 @@ int run_experiment_with_progress(const RunRequest& request) {
   RunProgress progress(line_seconds);
   o.on_step = [&](const StepReport& r) { progress.step(r); };
   o.on_cell = [&](const CellReport& r) { progress.cell(r); };
-  const RunSummary s = run_experiment(e, o);
+  const StopSignals signals;
+  o.stop_requested = &StopSignals::received;
+  RunSummary s;
+  try {
+    s = run_experiment(e, o);
+  } catch (const RunStopped& stop) {
+    progress.stopped();
+    const std::string plan = run_plan_path(o.out_dir, e, o.shard_index, o.shard_count);
+    std::fprintf(stderr,
+                 "mcfbench run: stopped by %s: %d of %d cells done (%d ran, %d skipped), the cell "
+                 "that was running dropped; the plan %s and the finished cells are kept.\n"
+                 "Rerun the same command to resume: finished cells are skipped.\n",
+                 signal_name(stop.signal).c_str(), stop.done, stop.summary.in_shard,
+                 stop.summary.ran, stop.summary.skipped, plan.c_str());
+    return 128 + stop.signal;  // as a shell reports a process the signal ended
+  }
   std::printf(
       "%s: %d cells, %d in shard %d/%d: %d ran%s, %d skipped, %d errors, %d reference "
       "distances; results in %s\n",

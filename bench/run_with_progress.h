@@ -18,7 +18,10 @@ struct RunRequest {
 };
 
 /// Runs the request's cells; returns 1 when a cell errored, else 0. A config error (or a bad
-/// MCFBENCH_PROGRESS_SECONDS) throws before anything is written.
+/// MCFBENCH_PROGRESS_SECONDS) throws before anything is written. SIGINT or SIGTERM stops the run
+/// after the running step (bench/stop_signals.h): the running cell is dropped, a message on stderr
+/// says how to resume, and it returns 128 + the signal's number (130, 143) as a shell reports a
+/// process that signal ended.
 int run_experiment_with_progress(const RunRequest& request);
 
 }  // namespace mcf

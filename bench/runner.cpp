@@ -48,6 +48,18 @@ long long cell_peak_memory_bytes() {
   return peak_memory_bytes();
 }
 
+/// A stop request met between two steps of a cell: not a std::exception, so the cell's own
+/// handler (which records a flow's failure as the cell's result) lets it through.
+struct Interrupt {
+  int signal;
+};
+
+/// A file of the cell (a frame, its folder) could not be written: the run's output is at fault,
+/// not the cell, so it stops the run instead of becoming the cell's result.
+struct OutputFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 json read_json_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
@@ -96,8 +108,12 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   json result;
   try {
     const MeshSource& source = meshes.get(config.mesh);
-    if (!frames.empty() || config.save_every > 0)
-      fs::create_directories(frame_dir);  // write_mesh does not
+    if (!frames.empty() || config.save_every > 0) {
+      std::error_code ec;
+      fs::create_directories(frame_dir, ec);  // write_mesh does not
+      if (ec)
+        throw OutputFailure(frame_dir.string() + ": cannot create the folder: " + ec.message());
+    }
     TriangleMesh initial;  // X_0 as the flow sees it (after area normalisation, if any)
     auto measure = [&](int step, const Positions& V) {
       json mj = json::object();
@@ -109,8 +125,12 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
     observer.on_step = [&](int step, double, const Positions& V) {
       if (step == 0) initial = TriangleMesh{V, source.mesh.faces};
       if (frames.count(step) || (config.save_every > 0 && step % config.save_every == 0)) {
-        write_mesh((frame_dir / frame_name(step)).string(), TriangleMesh{V, source.mesh.faces},
-                   true, FaceCheck::trusted);
+        try {
+          write_mesh((frame_dir / frame_name(step)).string(), TriangleMesh{V, source.mesh.faces},
+                     true, FaceCheck::trusted);
+        } catch (const std::exception& ex) {
+          throw OutputFailure(ex.what());
+        }
         written.push_back(step);
       }
       // Metrics at step 0 too (the initial sphericity is the baseline of the cMCF plots), then
@@ -134,6 +154,8 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
       auto it = step_metrics.find(s.value("step", -1));
       if (it != step_metrics.end()) s["metrics"] = it->second;
     }
+  } catch (const OutputFailure&) {
+    throw;
   } catch (const std::exception& ex) {
     result = {{"schema", 1},
               {"status", "error"},
@@ -178,6 +200,12 @@ json reference_distances(const ExperimentConfig& e, const fs::path& out, const C
 }
 
 }  // namespace
+
+RunStopped::RunStopped(int signal_number, const RunSummary& run_summary, int cells_done)
+    : std::runtime_error("stopped by signal " + std::to_string(signal_number)),
+      signal(signal_number),
+      summary(run_summary),
+      done(cells_done) {}
 
 const MeshSource& MeshCache::get(const std::string& spec) {
   auto it = meshes_.find(spec);
@@ -326,8 +354,10 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
                     run_plan(e, plans, o.shard_index, o.shard_count).dump(1) + "\n");
   std::set<std::string> ran_now;
   int done = 0;
+  auto stop_requested = [&] { return o.stop_requested ? o.stop_requested() : 0; };
   for (const CellPlan& p : plans) {
     if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
+    if (const int signal = stop_requested()) throw RunStopped(signal, s, done);
     CellReport report;
     report.plan = &p;
     report.total = s.in_shard;
@@ -338,14 +368,35 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
     } else {
       if (!o.force && fs::exists(p.file)) ++s.retried;
       const auto t0 = std::chrono::steady_clock::now();
-      const json result = run_cell(e, p, meshes, out, [&](int step) {
-        if (o.on_step) o.on_step(StepReport{done + 1, s.in_shard, &p, step, p.cell.flow.steps});
-      });
-      write_file_atomic(p.file, result.dump(1) + "\n");
+      // The cell's frames, removed with the cell when it is dropped unless an earlier run left
+      // them (a result of theirs may point to them).
+      const fs::path frame_dir = out / "frames" / p.hash;
+      std::error_code exists_ec;
+      const bool had_frames = fs::exists(frame_dir, exists_ec);
+      auto drop_cell = [&] {
+        std::error_code ec;
+        if (!had_frames) fs::remove_all(frame_dir, ec);
+      };
+      try {
+        const json result = run_cell(e, p, meshes, out, [&](int step) {
+          if (o.on_step) o.on_step(StepReport{done + 1, s.in_shard, &p, step, p.cell.flow.steps});
+          if (const int signal = stop_requested()) throw Interrupt{signal};
+        });
+        write_file_atomic(p.file, result.dump(1) + "\n");
+        report.status = result.value("status", "error");
+        report.error = result.value("error", "");
+      } catch (const Interrupt& stop) {
+        drop_cell();
+        throw RunStopped(stop.signal, s, done);
+      } catch (const std::exception& ex) {  // its frames or its result could not be written
+        drop_cell();
+        throw std::runtime_error(
+            std::string(ex.what()) + "\nThe run stopped at cell " + std::to_string(p.cell.index) +
+            "; its plan and the " + std::to_string(done) + " finished cell(s) in " + o.out_dir +
+            " are kept. Rerun the same command to resume once " + o.out_dir + " can be written.");
+      }
       ++s.ran;
       ran_now.insert(p.hash);
-      report.status = result.value("status", "error");
-      report.error = result.value("error", "");
       if (report.status == "error") ++s.errors;
       report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
@@ -361,6 +412,7 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   if (with_reference) {
     for (const CellPlan& p : plans) {
       if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
+      if (const int signal = stop_requested()) throw RunStopped(signal, s, done);
       const CellPlan* ref = reference_for(e, plans, p);
       if (!ref || !fs::exists(p.file) || !fs::exists(ref->file)) continue;
       json result = read_json_file(p.file);

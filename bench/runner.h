@@ -12,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,9 @@ struct RunOptions {
   std::function<void(const CellReport&)> on_cell;  ///< progress (stderr in the CLI)
   std::function<void(const StepReport&)>
       on_step;  ///< inside a cell that runs (not for skipped ones)
+  /// Asked before each cell and after each step of a running cell: nonzero (the signal that asked,
+  /// see bench/stop_signals.h) stops the run there with RunStopped.
+  std::function<int()> stop_requested;
 };
 
 struct RunSummary {
@@ -92,8 +96,21 @@ std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e,
                           int shard_count);
 inline constexpr const char* kPlanFolder = "plans";
 
+/// Thrown by run_experiment when RunOptions::stop_requested asked it to stop. The cell that was
+/// running is dropped (no result file; the frames it had written are removed); the plan and the
+/// results of the cells before it stay, so the same run resumes where it stopped.
+struct RunStopped : std::runtime_error {
+  RunStopped(int signal, const RunSummary& summary, int done);
+  int signal;          ///< what stop_requested returned
+  RunSummary summary;  ///< the cells ran and skipped before the stop
+  int done;            ///< cells of the shard with a result from this run or an earlier one
+};
+
 /// Runs the shard. Config problems throw before anything is written; an exception inside one
 /// cell's flow becomes that cell's result {"status": "error", "error": ...} and the run goes on.
+/// A file that cannot be written (the plan, a cell's result or frames: a full disk, a read-only
+/// folder) stops the run with std::runtime_error naming the file and the cause: the running cell
+/// is dropped as for RunStopped, finished cells stay.
 RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& options);
 
 /// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the

@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 
 namespace mcf {
@@ -70,19 +69,39 @@ void publish_durably(const fs::path& tmp, const fs::path& target) {
 
 void write_file_atomic(const std::string& path, const std::string& content) {
   const fs::path target(path);
-  if (target.has_parent_path()) fs::create_directories(target.parent_path());
+  if (target.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(target.parent_path(), ec);
+    if (ec)
+      throw std::runtime_error(path + ": cannot create the folder " +
+                               target.parent_path().string() + ": " + ec.message());
+  }
   remove_stale_temporaries(path);
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path + ": cannot open " + tmp.string() + " for writing");
-    out.write(content.data(), std::streamsize(content.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw std::runtime_error(path + ": write failed");
+  // POSIX calls rather than a stream: the message names the cause the system gave (no space left
+  // on device, read-only file system, quota exceeded), which a stream does not keep.
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0)
+    throw std::runtime_error(path + ": cannot create " + tmp.string() + ": " +
+                             std::strerror(errno));
+  const char* data = content.data();
+  size_t left = content.size();
+  int write_errno = 0;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, data, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      write_errno = n < 0 ? errno : EIO;
+      break;
     }
+    data += n;
+    left -= size_t(n);
+  }
+  if (::close(fd) != 0 && write_errno == 0 && errno != EINTR) write_errno = errno;
+  if (write_errno != 0) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw std::runtime_error(path + ": write failed: " + std::strerror(write_errno));
   }
   publish_durably(tmp, target);
 }

@@ -20,6 +20,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -893,10 +894,12 @@ namespace {
 // OFF, OBJ and PLY are written here rather than by OpenMesh, whose writers round coordinates to
 // float: with 17 significant digits a text file reproduces every double, and binary PLY stores
 // doubles. An ASCII PLY body is line for line an OFF body; only their headers differ.
-bool write_exact(const fs::path& file, const TriangleMesh& mesh, const std::string& ext,
-                 bool binary) {
+/// Returns 0, or the errno of the first call that failed (EIO if it set none).
+int write_exact(const fs::path& file, const TriangleMesh& mesh, const std::string& ext,
+                bool binary) {
+  errno = 0;
   std::FILE* out = std::fopen(file.c_str(), "wb");
-  if (!out) return false;
+  if (!out) return errno != 0 ? errno : EIO;
   std::vector<char> buffer(1 << 20);
   std::setvbuf(out, buffer.data(), _IOFBF, buffer.size());
   const bool obj = ext == ".obj";
@@ -921,8 +924,12 @@ bool write_exact(const fs::path& file, const TriangleMesh& mesh, const std::stri
         std::fprintf(out, "3 %d %d %d\n", mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2));
     }
   }
-  const bool ok = std::ferror(out) == 0;
-  return std::fclose(out) == 0 && ok;
+  // A failed write leaves its errno (and later writes to the full or read-only file system the
+  // same one); fclose reports a failure of its final flush.
+  const int write_errno = std::ferror(out) ? (errno != 0 ? errno : EIO) : 0;
+  errno = 0;
+  const int close_errno = std::fclose(out) == 0 ? 0 : (errno != 0 ? errno : EIO);
+  return write_errno != 0 ? write_errno : close_errno;
 }
 
 }  // namespace
@@ -952,12 +959,13 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, bool binary, 
   fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
                         std::to_string(counter++) + target.extension().string());
-  const bool written = ext == ".stl" ? OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17)
-                                     : write_exact(tmp, mesh, ext, binary);
-  if (!written) {
+  const int error = ext == ".stl" ? (OpenMesh::IO::write_mesh(om, tmp.string(), opt, 17) ? 0 : -1)
+                                  : write_exact(tmp, mesh, ext, binary);
+  if (error != 0) {
     std::error_code ec;
     fs::remove(tmp, ec);
-    fail(path, "could not write the file (folder missing or not writable?)");
+    fail(path, error > 0 ? std::string("could not write the file: ") + std::strerror(error)
+                         : "could not write the file (folder missing or not writable?)");
   }
   try {
     publish_durably(tmp, target);  // a frame or final.ply survives a crash of the machine too

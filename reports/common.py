@@ -391,12 +391,51 @@ def sources_line(results, limit=6):
         ", ".join(names[:3]), len(names))
 
 
+class WriteError(Exception):
+    """A file of the report could not be written (a full disk, a read-only folder). Not a module's
+    failure: make_report stops, removes what it wrote and leaves its output folder as it was."""
+
+    def __init__(self, path, error):
+        super().__init__("cannot write %s: %s" % (shown(path), getattr(error, "strerror", None) or error))
+        self.path = shown(path)
+
+
+# (staging folder, report folder) while make_report writes the report into a staging folder, which
+# it moves into the report folder once everything is written. None otherwise.
+_staged = None
+
+
+@contextlib.contextmanager
+def staged(staging, out_dir):
+    """Within the block, paths under `staging` are named as the files they become in `out_dir`."""
+    global _staged
+    before, _staged = _staged, (staging, out_dir)
+    try:
+        yield
+    finally:
+        _staged = before
+
+
+def shown(path):
+    """`path` as it is named once the report is published (see staged)."""
+    if _staged and os.path.dirname(path) == _staged[0]:
+        return os.path.join(_staged[1], os.path.basename(path))
+    return path
+
+
+def write_text(path, text):
+    """Write a text file of the report; an OSError becomes a WriteError naming the file."""
+    try:
+        with open(path, "w") as f:
+            f.write(text)
+    except OSError as e:
+        raise WriteError(path, e) from e
+
+
 def write_sources(out_path, results):
     """Write OUT.sources.txt beside a figure/table: one result file path per line."""
     side = os.path.splitext(out_path)[0] + ".sources.txt"
-    with open(side, "w") as f:
-        for r in results:
-            f.write(r["_path"] + "\n")
+    write_text(side, "".join(r["_path"] + "\n" for r in results))
     return side
 
 
@@ -409,10 +448,14 @@ def save_figure(fig, out_dir, name, results, title, written):
         fig.text(0.5, 1.0, note, ha="center", va="bottom", color="red", fontsize=10, fontweight="bold")
         title = "%s (%s)" % (title, note)
         extra["metadata"] = {"Description": note}
-    fig.savefig(path, dpi=DPI, bbox_inches="tight", **extra)
-    plt.close(fig)
+    try:
+        fig.savefig(path, dpi=DPI, bbox_inches="tight", **extra)
+    except OSError as e:
+        raise WriteError(path, e) from e
+    finally:
+        plt.close(fig)
     write_sources(path, results)
-    print("wrote " + path)
+    print("wrote " + shown(path))
     written.append({"path": path, "title": title, "kind": "figure"})
     return path
 
@@ -425,10 +468,9 @@ def save_markdown(text, out_dir, name, results, title, written):
         text = ("**Incomplete: %d of %d planned cells have results**; the missing cells are listed in "
                 "index.md.\n\n" % _incomplete) + text
         title = "%s (%s)" % (title, incomplete_note())
-    with open(path, "w") as f:
-        f.write(text.rstrip() + "\n\n" + sources_line(results) + "\n")
+    write_text(path, text.rstrip() + "\n\n" + sources_line(results) + "\n")
     write_sources(path, results)
-    print("wrote " + path)
+    print("wrote " + shown(path))
     written.append({"path": path, "title": title, "kind": "table"})
     return path
 

@@ -3,6 +3,8 @@
 
 import os
 
+import common
+
 
 MAX_MISSING_LISTED = 50  # a longer list ends with a count; `mcfbench collect` lists them all
 
@@ -80,7 +82,6 @@ def make(out_dir, sections):
             else:
                 lines += ["- [%s](%s) · [sources](%s)" % (w["title"], rel, side), ""]
     path = os.path.join(out_dir, "index.md")
-    with open(path, "w") as f:
-        f.write("\n".join(lines))
-    print("wrote " + path)
+    common.write_text(path, "\n".join(lines))
+    print("wrote " + common.shown(path))
     return path

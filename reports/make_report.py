@@ -23,6 +23,7 @@ import argparse
 import contextlib
 import importlib
 import os
+import shutil
 import sys
 import traceback
 
@@ -30,6 +31,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import common  # noqa: E402
 import index  # noqa: E402
+
+# Hidden (index.md links nothing in it), and removed by the next report into OUT_DIR when a killed
+# report left it.
+STAGING_FOLDER = ".report-staging"
 
 STUDIES = ["table1", "sphere_error", "model_error", "depth_cycles", "cubature", "cmcf", "time_order"]
 
@@ -49,10 +54,13 @@ def parse_args(argv):
 
 
 def run_module(name, results, out_dir, reference, written):
-    """Call module `name`.make; a failing module is reported, never fatal for the others."""
+    """Call module `name`.make; a failing module is reported, never fatal for the others. A file
+    that cannot be written (common.WriteError) stops the whole report."""
     try:
         importlib.import_module(name).make(results, out_dir, reference, written)
         return True
+    except common.WriteError:
+        raise
     except Exception:  # noqa: BLE001 - partial data must not stop the other studies
         common.warn("%s failed:\n%s" % (name, traceback.format_exc()))
         return False
@@ -126,13 +134,48 @@ def main(argv):
             print("error: --require-complete: the results are incomplete; nothing written "
                   "(rerun `mcfbench run`, or leave out --require-complete to report them as they are)", file=sys.stderr)
             return 1
-    os.makedirs(out_dir, exist_ok=True)
+    # The report is written into a hidden staging folder of OUT_DIR and moved into OUT_DIR once
+    # every file is written, index.md last: a full disk or a read-only folder stops it with
+    # OUT_DIR as it was (an earlier report whole), and a report never half-written.
+    created = not os.path.isdir(out_dir)
+    staging = os.path.join(out_dir, STAGING_FOLDER)
+    try:
+        try:
+            os.makedirs(out_dir, exist_ok=True)
+            shutil.rmtree(staging, ignore_errors=True)  # a killed report's
+            os.makedirs(staging)
+        except OSError as e:
+            raise common.WriteError(e.filename or out_dir, e) from e
+        with common.staged(staging, out_dir):
+            ok = write_report(staging, by_study, gaps, commits, args.references)
+            publish(staging, out_dir)
+    except common.WriteError as e:
+        shutil.rmtree(out_dir if created else staging, ignore_errors=True)
+        print("error: %s; the report was not written and %s is as it was" % (e, out_dir), file=sys.stderr)
+        return 1
+    return 0 if ok else 1
+
+
+def publish(staging, out_dir):
+    """Move the staged report's files into OUT_DIR (renames: each appears whole), index.md last."""
+    names = sorted(os.listdir(staging), key=lambda n: (n == "index.md", n))
+    try:
+        for name in names:
+            os.replace(os.path.join(staging, name), os.path.join(out_dir, name))
+        os.rmdir(staging)
+    except OSError as e:
+        raise common.WriteError(e.filename or out_dir, e) from e
+
+
+def write_report(out_dir, by_study, gaps, commits, references):
+    """Every study's figures and tables, its frame strips and index.md, into `out_dir`; False when
+    a module failed (the others are still drawn)."""
     ok = True
     sections = []
     for study in sorted(by_study, key=lambda s: (STUDIES.index(s) if s in STUDIES else len(STUDIES), s)):
         results, src = by_study[study]
         written = []
-        reference = common.load_reference(study, args.references)
+        reference = common.load_reference(study, references)
         gap = gaps.get(study)
         print("%s: %d result file(s)%s" % (study, len(results), "" if reference is None else ", paper reference found"))
         if study in commits:
@@ -153,6 +196,8 @@ def main(argv):
                 try:
                     sphere_error.plot_radial_errors(results, out_dir, "%s_radial_error" % study,
                                                     "%s: radial error per step" % study, reference, written)
+                except common.WriteError:
+                    raise
                 except Exception:  # noqa: BLE001
                     common.warn("radial error plot for %s failed:\n%s" % (study, traceback.format_exc()))
                     ok = False
@@ -167,7 +212,7 @@ def main(argv):
                         % (study, len(errored)))
         sections.append((study, src, written, errored, gap, commits.get(study)))
     index.make(out_dir, sections)
-    return 0 if ok else 1
+    return ok
 
 
 if __name__ == "__main__":

@@ -16,7 +16,9 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
   cmd->footer(
       "Finished cells are skipped on a rerun and errored ones retried (--force redoes all); a "
       "killed run\n"
-      "leaves no partial file.\n"
+      "leaves no partial file. SIGINT or SIGTERM stops the run after the running step (exit 130 or "
+      "143),\n"
+      "dropping the running cell: rerun the same command to resume.\n"
       "Slurm: sbatch --array=0-15 --wrap 'mcfbench run cfg.json --shard $SLURM_ARRAY_TASK_ID/16'\n"
       "then `mcfbench collect results/NAME` checks that every cell is there (with "
       "metrics.reference, first\n"

@@ -1,6 +1,7 @@
-// The runner in-process (per-step metrics, frames, reference distances, a failing cell)
-// and end to end through the binary (resume after a deleted file, after SIGKILL, shards +
-// collect, collect on a run that finished nothing, config errors that write nothing).
+// The runner in-process (per-step metrics, frames, reference distances, a failing cell, a stop
+// request, an output that cannot be written) and end to end through the binary (resume after a
+// deleted file, after SIGKILL, after SIGTERM and SIGINT, shards + collect, collect on a run that
+// finished nothing, config errors that write nothing).
 
 #include "bench/environment.h"
 #include "bench/runner.h"
@@ -193,6 +194,78 @@ TEST(Runner, OnStepReportsEveryStepOfTheCellsThatRunAndNoneOfTheSkippedOnes) {
   EXPECT_EQ(seen, expected);
 }
 
+TEST(Runner, AStopRequestDropsTheRunningCellAndKeepsThePlanAndTheFinishedCells) {
+  const fs::path out = fresh_dir("stop");
+  const json j = {{"name", "stop"},
+                  {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 4}, {"save_every", 2}}},
+                  {"axes", {{"dt", {1e-3, 2e-3, 3e-3}}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "stop.json", false);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  RunOptions o;
+  o.out_dir = out.string();
+  // Stop once the second cell has written its frame of step 2: between two of its steps.
+  int signal = 0;
+  o.on_step = [&](const StepReport& r) {
+    if (r.plan->cell.index == 1 && r.step == 2) signal = SIGTERM;
+  };
+  o.stop_requested = [&] { return signal; };
+  try {
+    run_experiment(e, o);
+    FAIL() << "the run did not stop";
+  } catch (const RunStopped& stop) {
+    EXPECT_EQ(stop.signal, SIGTERM);
+    EXPECT_EQ(stop.done, 1);
+    EXPECT_EQ(stop.summary.ran, 1);
+  }
+  EXPECT_TRUE(fs::exists(run_plan_path(out.string(), e, 0, 1)));
+  EXPECT_EQ(read_json(plans[0].file)["status"], "ok");
+  EXPECT_TRUE(fs::exists(out / "frames" / plans[0].hash / "frame_00004.ply"));
+  EXPECT_FALSE(fs::exists(plans[1].file)) << "the stopped cell has a result";
+  EXPECT_FALSE(fs::exists(out / "frames" / plans[1].hash)) << "the stopped cell's frames are left";
+  EXPECT_FALSE(fs::exists(plans[2].file));
+
+  // A stop before any cell ran on this pass leaves the results as they are.
+  signal = SIGINT;
+  EXPECT_THROW(run_experiment(e, o), RunStopped);
+  EXPECT_EQ(result_files(out).size(), 1u);
+
+  signal = 0;
+  o.on_step = nullptr;
+  const RunSummary s = run_experiment(e, o);
+  EXPECT_EQ(s.ran, 2);
+  EXPECT_EQ(s.skipped, 1);
+  for (const auto& p : plans) EXPECT_EQ(read_json(p.file)["status"], "ok") << p.file;
+}
+
+TEST(Runner, AFileThatCannotBeWrittenStopsTheRunInsteadOfFailingTheCell) {
+  // A file where the frames folder goes: the first cell cannot write its frames. That is the
+  // output's fault, not the cell's, and would fail every cell after it: the run stops and names
+  // the path; no result is written for the cell, so a rerun once the path is fixed runs it.
+  const fs::path out = fresh_dir("unwritable");
+  write_text(out / "frames", "not a folder");
+  const json j = {{"name", "unwritable"},
+                  {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}, {"save_every", 1}}},
+                  {"axes", {{"dt", {1e-3, 2e-3}}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "unwritable.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  try {
+    run_experiment(e, o);
+    FAIL() << "the run went on";
+  } catch (const RunStopped&) {
+    FAIL() << "not a stop request";
+  } catch (const std::runtime_error& ex) {
+    const std::string what = ex.what();
+    EXPECT_NE(what.find((out / "frames").string()), std::string::npos) << what;
+    EXPECT_NE(what.find("Rerun the same command to resume"), std::string::npos) << what;
+  }
+  EXPECT_TRUE(result_files(out).empty());
+  EXPECT_TRUE(fs::exists(run_plan_path(out.string(), e, 0, 1)));
+  fs::remove(out / "frames");
+  EXPECT_EQ(run_experiment(e, o).ran, 2);
+}
+
 const char* tiny_config = R"({
   "name": "tiny",
   "defaults": {"mesh": "icosphere:level=1", "steps": 2, "basis": "hat", "solver": {"name": "cholmod"}},
@@ -363,6 +436,91 @@ TEST(RunnerCli, KilledRunLosesNoFinishedCellAndRepeatsNone) {
   EXPECT_EQ(result_files(dir / "out").size(), 6u);
   for (const auto& [name, t] : before)
     EXPECT_EQ(fs::last_write_time(dir / "out" / name), t) << name << " recomputed";
+}
+
+/// As start_run, with the run's stderr in `err`.
+pid_t start_logged_run(const fs::path& dir, const char* config, const char* out,
+                       const fs::path& err) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) _exit(127);
+    std::freopen(err.c_str(), "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "run", config, "--out", out,
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Waits (a minute at most) until `dir` holds at least `n` result files.
+void wait_for_results(const fs::path& dir, size_t n) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (result_files(dir).size() < n && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+}
+
+TEST(RunnerCli, SigtermAndSigintStopARunThatThenResumesWhereItStopped) {
+  // What Slurm sends at a time limit (SIGTERM) and Ctrl-C (SIGINT): the run stops after the step
+  // that is running, drops that cell, keeps its plan and the finished cells, says how to resume and
+  // exits with 128 + the signal; running the same command again completes the matrix.
+  const fs::path dir = fresh_dir("signalled");
+  write_text(dir / "slow.json", R"({
+    "name": "slow",
+    "defaults": {"mesh": "icosphere:level=4", "steps": 40, "dt": 1e-4, "threads": 1},
+    "axes": {"dt": [1e-4, 2e-4, 3e-4, 4e-4, 5e-4]}})");
+  const fs::path out = dir / "out";
+  size_t finished = 0;
+  std::map<std::string, fs::file_time_type> before;
+  for (const int signal : {SIGTERM, SIGINT}) {
+    const std::string name = signal == SIGTERM ? "SIGTERM" : "SIGINT";
+    const fs::path err = dir / ("stderr_" + name + ".txt");
+    const pid_t pid = start_logged_run(dir, "slow.json", "out", err);
+    ASSERT_GT(pid, 0);
+    wait_for_results(out, finished + 1);  // one cell more than before: this run is under way
+    ::kill(pid, signal);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && result_files(out).size() == 5u)
+      GTEST_SKIP() << "the run finished before it could be stopped";
+    ASSERT_TRUE(WIFEXITED(status)) << name << " ended the run without its handler";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal) << name;
+    const std::string message = slurp(err);
+    EXPECT_NE(message.find("stopped by " + name), std::string::npos) << message;
+    EXPECT_NE(message.find("Rerun the same command to resume"), std::string::npos) << message;
+    EXPECT_NE(message.find("plans/slow@"), std::string::npos) << message;
+
+    const auto files = result_files(out);
+    EXPECT_GT(files.size(), finished) << name;
+    ASSERT_LT(files.size(), 5u) << name << ": every cell finished";
+    for (const auto& f : files) EXPECT_EQ(read_json(f)["status"], "ok") << f;
+    for (const auto& [file, t] : before)
+      EXPECT_EQ(fs::last_write_time(out / file), t) << file << " was rewritten";
+    size_t plans = 0, temporaries = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(out)) {
+      const std::string file = entry.path().filename().string();
+      plans +=
+          entry.path().parent_path().filename() == "plans" && entry.path().extension() == ".json";
+      temporaries += file.find(".tmp.") != std::string::npos;
+    }
+    EXPECT_EQ(plans, 1u);
+    EXPECT_EQ(temporaries, 0u);
+    finished = files.size();
+    before = age_files(out);
+  }
+
+  const Command c = mcfbench("run slow.json --out out", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_NE(
+      c.out.find(std::to_string(5 - finished) + " ran, " + std::to_string(finished) + " skipped"),
+      std::string::npos)
+      << c.out;
+  for (const auto& [file, t] : before)
+    EXPECT_EQ(fs::last_write_time(out / file), t) << file << " was recomputed";
+  const Command collected = mcfbench("collect out", dir);
+  EXPECT_EQ(collected.status, 0) << collected.out << collected.err;
+  EXPECT_NE(collected.out.find("5 cells found of 5, 0 missing"), std::string::npos)
+      << collected.out;
 }
 
 TEST(RunnerCli, CollectFailsOnARunThatFinishedNothingAndOnAFolderWithNothingToCollect) {
