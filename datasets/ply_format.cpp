@@ -193,6 +193,9 @@ class BodyReader {
     const double v = encoding_ == Encoding::Ascii ? next_text(/*integer=*/true) : next_binary(type);
     if (encoding_ != Encoding::Ascii && v != std::floor(v))
       fail(what() + " is not an integer (" + std::to_string(v) + ")");
+    // A float property can hold any magnitude (and infinity); converting one beyond long long's
+    // range is undefined, so it is refused here (every valid count and index is far below 2^62).
+    if (!(std::fabs(v) < 0x1p62)) fail(what() + " is out of range (" + std::to_string(v) + ")");
     part_ = Part::value;
     return static_cast<long long>(v);
   }

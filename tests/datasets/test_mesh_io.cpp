@@ -554,6 +554,25 @@ TEST(MeshIoPly, BinaryBothByteOrders) {
                           " before face 3 of 4");
 }
 
+// Found by fuzzing: a float-typed list count or index beyond long long's range (or infinite) was
+// converted to an integer, which is undefined; it is now an error naming the value's place.
+TEST(MeshIoPly, FloatCountsAndIndicesOutOfRangeAreErrors) {
+  TempDir dir;
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list float float vertex_indices\nend_header\n";
+  std::string vertices;
+  for (int i = 0; i < 9; ++i) vertices += bytes(float(i % 4 == 0), false);
+  for (float huge : {1e30f, std::numeric_limits<float>::infinity()}) {
+    const std::string as_count = header + vertices + bytes(huge, false);
+    expect_error_naming(dir.write("count.ply", as_count), "out of range");
+    const std::string as_index = header + vertices + bytes(3.0f, false) + bytes(0.0f, false) +
+                                 bytes(huge, false) + bytes(2.0f, false);
+    expect_error_naming(dir.write("index.ply", as_index), "out of range");
+  }
+}
+
 // A binary tetrahedron whose coordinates are of type T (spelled `name` in the header) and whose
 // faces are a list of index type I with count type C: every scalar type, either spelling, read
 // in either byte order. Signed types get the negative corner -1 (a sign-extension check).
