@@ -444,8 +444,10 @@ void walk_obj(const std::string& path, WalkedMesh& walk) {
         // OpenMesh drops a face with a bad index as "non-manifold", which hides the real cause.
         char* end = nullptr;
         const long long v = std::strtoll(tok.c_str(), &end, 10);
+        // v < -vertices rather than -v > vertices: strtoll saturates at LLONG_MIN, whose
+        // negation overflows.
         if (end == tok.c_str() || (*end != '\0' && *end != '/') || v == 0 ||
-            (v < 0 && -v > vertices))
+            (v < 0 && v < -static_cast<long long>(vertices)))
           fail(path, "line " + std::to_string(line_number) + ": face corner '" + tok +
                          "' is not a vertex index (1.." + std::to_string(vertices) + " or -1..-" +
                          std::to_string(vertices) + " so far)");

@@ -154,6 +154,10 @@ TEST(MeshIo, IndexOutOfRange) {
                       "line 4: face corner '0'");
   expect_error_naming(dir.write("back.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n"),
                       "face corner '-4'");
+  // Found by fuzzing: an index below LLONG_MIN saturates there, whose negation overflowed.
+  expect_error_naming(
+      dir.write("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -99999999999999999999999\n"),
+      "face corner '-99999999999999999999999'");
   // Relative (negative) and textured/normal forms of valid indices still load.
   EXPECT_EQ(read_mesh(dir.write("ok.obj",
                                 "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf -3/1/1 2//1 3/1\n"))
