@@ -119,6 +119,12 @@ Header parse_header(const std::string& path, const std::string& data) {
     if (word.empty() || word == "comment" || word == "obj_info") continue;
     if (word == "end_header") {
       if (!have_format) fail(line_number, "the header has no format line");
+      // Records of an element without properties hold nothing, so nothing bounds their count:
+      // reading 1e16 of them would never end. No writer produces such an element.
+      for (const Element& e : h.elements)
+        if (e.count > 0 && e.properties.empty())
+          fail(line_number, "element '" + e.name + "' has " + std::to_string(e.count) +
+                                " records but no properties");
       h.body_offset = pos;
       h.body_line = line_number + 1;
       return h;

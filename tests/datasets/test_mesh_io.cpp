@@ -577,6 +577,18 @@ TEST(MeshIoPly, FloatCountsAndIndicesOutOfRangeAreErrors) {
   }
 }
 
+// Found by fuzzing: an element with records but no properties made the reader loop over its
+// count (1e16 records of nothing) instead of refusing it.
+TEST(MeshIoPly, AnElementWithRecordsButNoPropertiesIsAnError) {
+  TempDir dir;
+  const std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement junk 9999999999999999\nelement vertex 3\n"
+      "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  expect_error_naming(dir.write("empty_element.ply", ply),
+                      "element 'junk' has 9999999999999999 records but no properties");
+}
+
 // A binary tetrahedron whose coordinates are of type T (spelled `name` in the header) and whose
 // faces are a list of index type I with count type C: every scalar type, either spelling, read
 // in either byte order. Signed types get the negative corner -1 (a sign-extension check).
