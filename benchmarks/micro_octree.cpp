@@ -52,6 +52,28 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// The four phases of a timed step (update, set_matrix, solve, evaluate), summed over the timed
+/// steps and reported per step with the last solve's residual and the thread count (range(0)).
+struct StepPhases {
+  double update = 0, set = 0, solve = 0, evaluate = 0;
+  void add(Clock::time_point t0, Clock::time_point t1, Clock::time_point t2, Clock::time_point t3,
+           Clock::time_point t4) {
+    update += std::chrono::duration<double>(t1 - t0).count();
+    set += std::chrono::duration<double>(t2 - t1).count();
+    solve += std::chrono::duration<double>(t3 - t2).count();
+    evaluate += std::chrono::duration<double>(t4 - t3).count();
+  }
+  void report(benchmark::State& state, double residual) const {
+    const double n = double(state.iterations());
+    state.counters["update_ms"] = 1e3 * update / n;
+    state.counters["set_matrix_ms"] = 1e3 * set / n;
+    state.counters["solve_ms"] = 1e3 * solve / n;
+    state.counters["evaluate_ms"] = 1e3 * evaluate / n;
+    state.counters["relative_residual"] = residual;
+    state.counters["threads"] = double(state.range(0));
+  }
+};
+
 // Warm-up: every step and cycle benchmark runs its body once untimed before the timed
 // iterations. The first solve allocates the multigrid's per-level buffers (and the first CHOLMOD
 // factorization its factor); on virtual machines the first use of memory the process has not had
@@ -394,7 +416,8 @@ void BM_Step_Tracked(benchmark::State& state) {
   basis.update(f.x, true, true);
   solver.set_matrix_sum(1.0, basis.mass(), f.c.dt, basis.stiffness(), h);  // Galerkin pattern once
   Eigen::MatrixXd X, B;
-  double t_update = 0, t_set = 0, t_solve = 0, t_eval = 0, residual = 0;
+  StepPhases phases;
+  double residual = 0;
   const auto step = [&](bool timed) {
     auto t0 = Clock::now();
     basis.update(f.x, true, true);
@@ -408,21 +431,11 @@ void BM_Step_Tracked(benchmark::State& state) {
     Positions v = basis.evaluate_vertices(X);
     benchmark::DoNotOptimize(v.data());
     auto t4 = Clock::now();
-    if (!timed) return;
-    t_update += std::chrono::duration<double>(t1 - t0).count();
-    t_set += std::chrono::duration<double>(t2 - t1).count();
-    t_solve += std::chrono::duration<double>(t3 - t2).count();
-    t_eval += std::chrono::duration<double>(t4 - t3).count();
+    if (timed) phases.add(t0, t1, t2, t3, t4);
   };
   step(false);  // warm-up (see "Warm-up" at the top)
   timed_steps(state, step);
-  const double n = double(state.iterations());
-  state.counters["update_ms"] = 1e3 * t_update / n;
-  state.counters["set_matrix_ms"] = 1e3 * t_set / n;
-  state.counters["solve_ms"] = 1e3 * t_solve / n;
-  state.counters["evaluate_ms"] = 1e3 * t_eval / n;
-  state.counters["relative_residual"] = residual;
-  state.counters["threads"] = double(state.range(0));
+  phases.report(state, residual);
   state.counters["bytes_per_cubature_point"] = basis.stats().bytes_per_cubature_point;
   state.counters["preprocessed_bytes"] = double(basis.preprocessed_bytes());
   state.counters["setup_s"] = [&] {
@@ -493,7 +506,8 @@ void BM_Step_TrackedStabilized(benchmark::State& state) {
   }
   const Coefficients prediction = 2.0 * f.x - previous;
   Eigen::MatrixXd X, B;
-  double t_update = 0, t_set = 0, t_solve = 0, t_eval = 0, residual = 0;
+  StepPhases phases;
+  double residual = 0;
   const auto step = [&](bool timed) {
     auto t0 = Clock::now();
     basis.update(f.x, true, true);
@@ -511,21 +525,11 @@ void BM_Step_TrackedStabilized(benchmark::State& state) {
     Positions v = basis.evaluate_vertices(Coefficients(f.x + X));
     benchmark::DoNotOptimize(v.data());
     auto t4 = Clock::now();
-    if (!timed) return;
-    t_update += std::chrono::duration<double>(t1 - t0).count();
-    t_set += std::chrono::duration<double>(t2 - t1).count();
-    t_solve += std::chrono::duration<double>(t3 - t2).count();
-    t_eval += std::chrono::duration<double>(t4 - t3).count();
+    if (timed) phases.add(t0, t1, t2, t3, t4);
   };
   step(false);  // warm-up (see "Warm-up" at the top)
   timed_steps(state, step);
-  const double n = double(state.iterations());
-  state.counters["update_ms"] = 1e3 * t_update / n;
-  state.counters["set_matrix_ms"] = 1e3 * t_set / n;
-  state.counters["solve_ms"] = 1e3 * t_solve / n;
-  state.counters["evaluate_ms"] = 1e3 * t_eval / n;
-  state.counters["relative_residual"] = residual;
-  state.counters["threads"] = double(state.range(0));
+  phases.report(state, residual);
   state.counters["smooth"] = double(state.range(2));
   step_counters(state, f.c, *f.source, basis.stats());
   state.SetLabel(std::string(state.range(1) == 0 ? "W(" : "V(") + std::to_string(state.range(2)) +
