@@ -2,6 +2,7 @@
 
 #include "bench/environment.h"
 #include "bench/experiment_config.h"
+#include "bench/memory_budget.h"
 #include "bench/progress.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
@@ -84,7 +85,13 @@ void publish(const fs::path& out, const fs::path& staging, const std::set<std::s
 
 void run_flow_into_folder(const FlowRequest& request) {
   const FlowConfig config = flow_config_of(request);
+  const MemoryBudget budget = memory_budget(request.max_memory);
+  // Before the mesh is generated or read (a generator's size is known from its spec), then with
+  // the mesh's own sizes before the basis is built.
+  checked_memory_estimate(config, spec_sizes(parse_mesh_spec(config.mesh)), budget, config.mesh);
   const MeshSource mesh = load_mesh_spec(config.mesh);  // throws naming the file: nothing written
+  const MemoryEstimate memory = checked_memory_estimate(
+      config, mesh_sizes(config, mesh.mesh, mesh.analytic), budget, config.mesh);
   const double line_seconds = progress_line_seconds();  // a bad MCFBENCH_PROGRESS_SECONDS too
 
   const fs::path out(request.out);
@@ -111,6 +118,8 @@ void run_flow_into_folder(const FlowRequest& request) {
     outcome = run_staged(config, mesh, staging, line_seconds, frames);
     outcome.result["environment"] = environment_json(config.threads);
     outcome.result["peak_memory_bytes"] = peak_memory_bytes();
+    outcome.result["memory_estimate"] = memory.to_json();
+    outcome.result["memory_budget"] = budget.to_json();
     if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
       outcome.result["steal_seconds"] = steal;
     write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);

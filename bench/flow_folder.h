@@ -18,13 +18,16 @@ struct FlowRequest {
   /// line gives one per flag it was given, so the config file supplies the rest.
   std::vector<std::pair<std::string, nlohmann::json>> settings;
   std::string out;  ///< the output folder
+  /// The memory budget (bench/memory_budget.h): "" = what is available, "none", or a size.
+  std::string max_memory;
 };
 
 /// Assembles one flow config from the request and validates it in one place
 /// (flow_config_from_json, so the command line and experiment configs agree), loads the mesh,
-/// runs the flow with its progress on stderr and publishes its files into `out`; one line on
-/// stderr says how the flow ended. Throws on a configuration or set-up error, before anything is
-/// written or removing what this run created.
+/// refuses a flow whose estimated peak memory exceeds the budget (before the mesh is generated,
+/// from the spec's sizes, and again once it is loaded), runs the flow with its progress on stderr
+/// and publishes its files into `out`; one line on stderr says how the flow ended. Throws on a
+/// configuration or set-up error, before anything is written or removing what this run created.
 void run_flow_into_folder(const FlowRequest& request);
 
 }  // namespace mcf

@@ -72,6 +72,7 @@ int run_experiment_with_progress(const RunRequest& request) {
       !request.out.empty() ? request.out : "results/" + e.name + (request.quick ? "-quick" : "");
   o.force = request.force;
   o.threads = request.threads;
+  o.max_memory = request.max_memory;
   RunProgress progress(line_seconds);
   o.on_step = [&](const StepReport& r) { progress.step(r); };
   o.on_cell = [&](const CellReport& r) { progress.cell(r); };

@@ -15,6 +15,7 @@ struct RunRequest {
   bool force = false;         ///< rerun cells whose result file exists
   bool quick = false;         ///< the config's "quick" variant
   int threads = -1;           ///< >= 0 overrides every cell's thread count
+  std::string max_memory;     ///< memory budget: "" = what is available, "none", or a size
 };
 
 /// Runs the request's cells; returns 1 when a cell errored, else 0. A config error (or a bad

@@ -2,6 +2,7 @@
 
 #include "bench/cell_hash.h"
 #include "bench/environment.h"
+#include "bench/memory_budget.h"
 #include "bench/metrics.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
@@ -106,8 +107,12 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   const double steal_before = cpu_steal_seconds();
 
   json result;
+  json memory;
   try {
     const MeshSource& source = meshes.get(config.mesh);
+    memory = estimate_flow_memory(config, mesh_sizes(config, source.mesh, source.analytic),
+                                  resident_memory_bytes())
+                 .to_json();
     if (!frames.empty() || config.save_every > 0) {
       std::error_code ec;
       fs::create_directories(frame_dir, ec);  // write_mesh does not
@@ -167,6 +172,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   result["environment"] = environment_json(config.threads);
   result["peak_memory_bytes"] = peak_per_cell ? cell_peak_memory_bytes() : peak_memory_bytes();
   result["peak_memory_scope"] = peak_per_cell ? "cell" : "process";
+  if (!memory.is_null()) result["memory_estimate"] = std::move(memory);
   result["cell"] = cell_json(e, p);
   result["study_config"] = e.study_config;
   if (!written.empty()) result["frames"] = {{"dir", "frames/" + p.hash}, {"steps", written}};
@@ -335,6 +341,23 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
     throw std::invalid_argument("--shard: expected i/n with 0 <= i < n");
   const bool with_reference = !e.metrics.reference.is_null();
+  const MemoryBudget budget = memory_budget(o.max_memory);
+  auto cell_name = [&](const Cell& c) {
+    return e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + ")";
+  };
+  // A cell too large for the memory is refused from its spec's sizes before any mesh is built.
+  // A spec that does not parse is left to plan_cells, which names the config and the cell.
+  for (const Cell& c : e.cells) {
+    if (!in_shard(c.index, o.shard_index, o.shard_count)) continue;
+    MeshSpecRequest request;
+    try {
+      request = parse_mesh_spec(c.flow.mesh);
+    } catch (const std::exception&) {
+      continue;
+    }
+    checked_memory_estimate(c.flow, spec_sizes(request), budget,
+                            cell_name(c) + ", mesh " + c.flow.mesh);
+  }
   MeshCache meshes;
   // Every mesh this shard needs is loaded (and every cell named) before anything is written,
   // so a bad mesh spec fails the run cleanly. Reference distances need the names of all cells.
@@ -342,6 +365,14 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
       plan_cells(e, o.out_dir, meshes, o.threads, [&](const Cell& c) {
         return with_reference || in_shard(c.index, o.shard_index, o.shard_count);
       });
+
+  // And from its mesh's sizes once the meshes are loaded: the cells still to run.
+  for (const CellPlan& p : plans)
+    if (in_shard(p.cell.index, o.shard_index, o.shard_count) && (o.force || !finished(p.file))) {
+      const MeshSource& source = meshes.get(p.cell.flow.mesh);
+      checked_memory_estimate(p.cell.flow, mesh_sizes(p.cell.flow, source.mesh, source.analytic),
+                              budget, cell_name(p.cell) + ", mesh " + p.cell.flow.mesh);
+    }
 
   RunSummary s;
   s.total = int(plans.size());

@@ -57,6 +57,9 @@ struct RunOptions {
   int shard_index = 0, shard_count = 1;
   bool force = false;
   int threads = -1;  ///< >= 0 overrides every cell's "threads" (part of the config, so of the key)
+  /// The memory budget (bench/memory_budget.h): "" = what is available, "none", or a size. A cell
+  /// this shard would run whose estimated peak exceeds it stops the run before anything is written.
+  std::string max_memory;
   std::function<void(const CellReport&)> on_cell;  ///< progress (stderr in the CLI)
   std::function<void(const StepReport&)>
       on_step;  ///< inside a cell that runs (not for skipped ones)

@@ -12,8 +12,6 @@
 #include <stdexcept>
 
 namespace mcf {
-namespace {
-
 OctreeOptions octree_options(const OctreeConfig& c, bool analytic) {
   OctreeOptions o;
   o.depth = c.depth;
@@ -30,6 +28,8 @@ OctreeOptions octree_options(const OctreeConfig& c, bool analytic) {
     o.cube = analytic ? OctreeCube::tight : OctreeCube::automatic;
   return o;
 }
+
+namespace {
 
 MultigridOptions multigrid_options(const SolverConfig& c) {
   MultigridOptions o;

@@ -11,7 +11,7 @@ namespace mcf {
 namespace {
 
 struct FlowArgs {
-  std::string config_file, out;
+  std::string config_file, out, max_memory;
   // Every flag maps to one key of the flow config; only flags given on the command line are
   // set, so --config FILE supplies the rest.
   std::string mesh, flow, basis, mass, tracking, cube, stabilization, solver, preconditioner, cycle,
@@ -70,6 +70,9 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
   cmd.add_option("--threads", args.threads, "Worker threads (0 = all cores, default)");
   cmd.add_option("--save-every", args.save_every,
                  "Write OUT/frame_NNNNN.ply every K steps (0 = never)");
+  cmd.add_option("--max-memory", args.max_memory,
+                 "Refuse a flow whose estimated peak memory exceeds SIZE (8G, 512M; none: no "
+                 "check; default: the memory available now)");
   cmd.add_option("--out", args.out, "Output folder")->required();
 }
 
@@ -79,6 +82,7 @@ FlowRequest flow_request(const CLI::App& cmd, const FlowArgs& args) {
   FlowRequest r;
   r.config_file = args.config_file;
   r.out = args.out;
+  r.max_memory = args.max_memory;
   auto set = [&](const char* flag, const char* key, const nlohmann::json& value) {
     if (cmd.count(flag) > 0) r.settings.emplace_back(key, value);
   };

@@ -37,6 +37,9 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--threads", a->threads,
                   "Override every cell's thread count (0 = all cores; changes the cell keys)")
       ->check(CLI::Range(0, 4096));
+  cmd->add_option("--max-memory", a->max_memory,
+                  "Refuse to start if a cell's estimated peak memory exceeds SIZE (8G, 512M; "
+                  "none: no check; default: the memory available now)");
   cmd->callback([a, &run] { run = [a]() -> int { return run_experiment_with_progress(*a); }; });
 }
 

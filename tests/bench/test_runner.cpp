@@ -4,6 +4,7 @@
 // finished nothing, config errors that write nothing).
 
 #include "bench/environment.h"
+#include "bench/memory_budget.h"
 #include "bench/runner.h"
 #include "flows/config_reader.h"
 
@@ -264,6 +265,47 @@ TEST(Runner, AFileThatCannotBeWrittenStopsTheRunInsteadOfFailingTheCell) {
   EXPECT_TRUE(fs::exists(run_plan_path(out.string(), e, 0, 1)));
   fs::remove(out / "frames");
   EXPECT_EQ(run_experiment(e, o).ran, 2);
+}
+
+TEST(Runner, ACellTooLargeForTheMemoryStopsTheRunBeforeAnythingIsWritten) {
+  // Shard 1's cell is refused from its spec's sizes (its sphere is never generated), shard 0's
+  // under a smaller budget from its mesh's sizes once loaded; each shard checks only its cells.
+  const fs::path out = fresh_dir("memory") / "results";
+  const json j = {{"name", "memory"},
+                  {"defaults",
+                   {{"steps", 1},
+                    {"basis", "octree"},
+                    {"octree", {{"depth", 7}}},
+                    {"solver", {{"name", "multigrid"}}}}},
+                  {"axes", {{"mesh", {"icosphere:level=3", "sphere:vertices=20000000"}}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "memory.json", false);
+  for (const auto& [shard, budget] : {std::pair<int, const char*>{1, "1G"}, {0, "64M"}}) {
+    RunOptions o;
+    o.out_dir = out.string();
+    o.max_memory = budget;
+    o.shard_index = shard;
+    o.shard_count = 2;
+    try {
+      run_experiment(e, o);
+      FAIL() << "shard " << shard << " ran";
+    } catch (const MemoryLimitError& ex) {
+      const std::string what = ex.what();
+      for (const std::string part :
+           {"memory.json (cell " + std::to_string(shard), std::string("estimated"),
+            "--max-memory " + std::string(budget)})
+        EXPECT_NE(what.find(part), std::string::npos) << part << " in: " << what;
+    }
+    EXPECT_FALSE(fs::exists(out));
+  }
+  RunOptions o;
+  o.out_dir = out.string();
+  o.max_memory = "1G";
+  o.shard_count = 2;
+  EXPECT_EQ(run_experiment(e, o).ran, 1);
+  ASSERT_EQ(result_files(out).size(), 1u);
+  const json r = read_json(result_files(out)[0]);
+  EXPECT_GT(r["memory_estimate"]["bytes"].get<double>(),
+            r["memory_estimate"]["resident_bytes"].get<double>());
 }
 
 const char* tiny_config = R"({

@@ -301,3 +301,42 @@ TEST(Cli, HelpExplainsEveryOption) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Cli, AFlowTooLargeForTheMemoryIsRefusedWithItsEstimate) {
+  // Refused from the spec's sizes before the sphere is generated (a --max-memory budget, so that
+  // the test does not depend on this machine's memory).
+  expect_flow_rejected("--mesh sphere:vertices=90000000 --steps 1 --max-memory 16G",
+                       {"sphere:vertices=90000000", "estimated", "GiB", "--max-memory"},
+                       temp_dir() / "too_large");
+  expect_flow_rejected("--mesh icosphere:level=3 --basis octree --depth 10 --max-memory 64M",
+                       {"icosphere:level=3", "octree basis depth 10", "--max-memory"},
+                       temp_dir() / "too_deep");
+  expect_flow_rejected("--mesh icosphere:level=1 --max-memory 8X", {"--max-memory", "8X"},
+                       temp_dir() / "bad_size");
+}
+
+TEST(Cli, MemoryEstimateIsWithinTwiceTheMeasuredPeak) {
+  for (const std::string args :
+       {"--mesh sphere:vertices=60000 --basis hat --solver cholmod",
+        "--mesh sphere:vertices=20000 --basis octree --depth 7 --solver multigrid",
+        "--mesh sphere:vertices=20000 --basis octree --depth 7 --tracking rebuilt --solver "
+        "multigrid"}) {
+    const fs::path out = temp_dir() / "estimate";
+    const CommandResult r = mcfbench("flow " + args + " --steps 1 --dt 1e-4 --out " + out.string());
+    ASSERT_EQ(r.status, 0) << args << ": " << r.err;
+    std::ifstream in(out / "result.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    const double estimate = j["memory_estimate"]["bytes"].get<double>();
+    const double peak = j["peak_memory_bytes"].get<double>();
+    EXPECT_GT(estimate, 0.5 * peak) << args << ": estimate " << estimate << ", peak " << peak;
+    EXPECT_LT(estimate, 2.0 * peak) << args << ": estimate " << estimate << ", peak " << peak;
+    // The resident part alone is far from the peak: the model's shares are what is tested.
+    EXPECT_LT(j["memory_estimate"]["resident_bytes"].get<double>(), 0.5 * peak) << args;
+    EXPECT_EQ(j["memory_budget"]["total"], false);
+    fs::remove_all(out);
+  }
+}
+
+}  // namespace

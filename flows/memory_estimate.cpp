@@ -1,0 +1,114 @@
+#include "flows/memory_estimate.h"
+
+#include "bases/octree.h"
+#include "datasets/validate.h"
+#include "flows/registry.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace mcf {
+namespace {
+
+// Bytes per input vertex and per octree function, least-squares fits (relative error) to the peak
+// resident memory of one-step flows on the armadillo at 52k, 208k and 832k faces and a 200k-face
+// sphere, octree depths 6 to 9 (docs/benchmarks.md "Peak memory and set-up"). Each fit was within
+// 12% of every measured peak it was fitted to.
+constexpr double kHatPerVertex = 1066;              // mesh, half-edge check, M, K, the system
+constexpr double kHatCholmodPerVertex = 730;        // the supernodal factor of the surface graph
+constexpr double kTrackedPerVertex = 883;           // mesh, stencils, per-triangle cubature data
+constexpr double kTrackedPerFunction = 1461;        // M, K, S and the sum, hierarchy, vectors
+constexpr double kRebuiltPerVertex = 697;           // mesh, clipped pieces of the working mesh
+constexpr double kRebuiltPerFunction = 1821;        // as tracked, plus the pattern built each step
+constexpr double kOctreeCholmodPerFunction = 1154;  // the factor of the band's 27-point graph
+constexpr double kDensePerUnknown2 = 16;            // the dense matrix and its LLT, 8 bytes each
+
+/// About this many finest functions per (h^2 of surface): measured 2.84-3.02 on the armadillo,
+/// the elephant and spheres at depths 6 to 9.
+constexpr double kFunctionsPerArea = 3.0;
+
+std::string gib(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f GiB", bytes / double(1ull << 30));
+  return text;
+}
+
+}  // namespace
+
+nlohmann::json MemoryEstimate::to_json() const {
+  return {
+      {"bytes", total()},           {"resident_bytes", resident_bytes}, {"mesh_bytes", mesh_bytes},
+      {"basis_bytes", basis_bytes}, {"solver_bytes", solver_bytes},     {"dimension", dimension},
+      {"vertices", vertices},       {"lower_bound", lower_bound}};
+}
+
+std::string MemoryEstimate::describe(const FlowConfig& config) const {
+  char sizes[96];
+  if (lower_bound)
+    std::snprintf(sizes, sizeof sizes, "%.3g vertices; the octree not counted", vertices);
+  else
+    std::snprintf(sizes, sizeof sizes, "%.3g unknowns", dimension);
+  std::string what =
+      gib(total()) + (lower_bound ? " at least" : "") + " (" + config.basis + " basis";
+  if (config.basis == "octree") what += " depth " + std::to_string(config.octree.depth);
+  return what + ", " + config.solver.name + ": " + sizes + ")";
+}
+
+FlowSizes spec_sizes(const MeshSpecRequest& request) {
+  FlowSizes s;
+  s.faces = std::max(request.generated_faces, double(request.target_faces));
+  s.vertices = s.faces / 2;
+  return s;
+}
+
+FlowSizes mesh_sizes(const FlowConfig& config, const TriangleMesh& mesh, bool analytic) {
+  FlowSizes s;
+  s.exact = true;
+  const double split = config.basis == "octree" && config.octree.refine_input ? 4.0 : 1.0;
+  s.faces = double(mesh.faces.rows()) * split;
+  // A 1-to-4 split adds one vertex per edge: about 3/2 per face.
+  s.vertices = double(mesh.vertices.rows()) + (split - 1.0) / 2.0 * double(mesh.faces.rows());
+  if (config.basis != "octree") return s;
+  try {
+    const GridCube cube =
+        choose_cube(mesh, config.octree.depth, octree_options(config.octree, analytic).cube);
+    s.area_over_side2 = surface_area(mesh) / (cube.side * cube.side);
+  } catch (const std::invalid_argument&) {
+    // The basis refuses this cube with its own message.
+  }
+  return s;
+}
+
+double estimated_octree_dimension(double area_over_side2, int depth) {
+  return kFunctionsPerArea * area_over_side2 * std::ldexp(1.0, 2 * depth);
+}
+
+MemoryEstimate estimate_flow_memory(const FlowConfig& config, const FlowSizes& sizes,
+                                    double resident_bytes) {
+  MemoryEstimate e;
+  e.resident_bytes = resident_bytes;
+  e.vertices = sizes.vertices;
+  const bool cholmod = config.solver.name == "cholmod";
+  if (config.basis == "octree") {
+    const bool rebuilt = config.octree.tracking == "rebuilt";
+    e.mesh_bytes = (rebuilt ? kRebuiltPerVertex : kTrackedPerVertex) * sizes.vertices;
+    if (sizes.area_over_side2 < 0) {
+      e.lower_bound = true;
+      return e;
+    }
+    e.dimension = estimated_octree_dimension(sizes.area_over_side2, config.octree.depth);
+    e.basis_bytes = (rebuilt ? kRebuiltPerFunction : kTrackedPerFunction) * e.dimension;
+  } else {
+    e.dimension = sizes.vertices;
+    e.mesh_bytes = kHatPerVertex * sizes.vertices;
+  }
+  if (cholmod)
+    e.solver_bytes =
+        (config.basis == "octree" ? kOctreeCholmodPerFunction : kHatCholmodPerVertex) * e.dimension;
+  else if (config.solver.name == "dense")
+    e.solver_bytes = kDensePerUnknown2 * e.dimension * e.dimension;
+  return e;
+}
+
+}  // namespace mcf
