@@ -1,5 +1,6 @@
 #include "bases/hat_basis.h"
 
+#include "bases/vertex_ordering.h"
 #include "core/parallel.h"
 #include "datasets/validate.h"
 
@@ -20,9 +21,22 @@ Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3
   return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
 }
 
-HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind)
+HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
+                   std::optional<SurfaceHierarchyOptions> hierarchy)
     : vertices0_(mesh.vertices), faces_(mesh.faces), mass_kind_(mass_kind) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (hierarchy) {
+    // Functions numbered so that neighbours are close (bases/vertex_ordering.h), which the
+    // multigrid's parallel relaxation needs; the mesh's own order is restored on evaluation.
+    order_ = bandwidth_ordering(faces_, int(vertices0_.rows()));
+    std::vector<int> rank(order_.size());
+    for (std::size_t k = 0; k < order_.size(); ++k) rank[std::size_t(order_[k])] = int(k);
+    for (std::size_t k = 0; k < order_.size(); ++k)
+      vertices0_.row(Eigen::Index(k)) = mesh.vertices.row(order_[k]);
+    for (Eigen::Index f = 0; f < faces_.rows(); ++f)
+      for (int c = 0; c < 3; ++c) faces_(f, c) = rank[std::size_t(faces_(f, c))];
+  }
+  const auto t0b = std::chrono::steady_clock::now();
   const Eigen::Index m = faces_.rows();
   std::vector<int> rows(9 * m), cols(9 * m);
   for (Eigen::Index f = 0; f < m; ++f)
@@ -32,7 +46,7 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind)
         cols[9 * f + 3 * a + b] = faces_(f, b);
       }
   pattern_ = FixedPattern(vertices0_.rows(), rows, cols);
-  boundary_ = boundary_vertices(mesh);
+  boundary_ = boundary_vertices(TriangleMesh{vertices0_, faces_});
   const auto t1 = std::chrono::steady_clock::now();
   update(vertices0_, true, true);
   const auto t2 = std::chrono::steady_clock::now();
@@ -41,8 +55,25 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind)
   stats_.split_triangles = m;
   stats_.cubature_points = 0;
   stats_.levels = 1;
-  stats_.setup_seconds["pattern"] = std::chrono::duration<double>(t1 - t0).count();
+  stats_.setup_seconds["pattern"] = std::chrono::duration<double>(t1 - t0b).count();
   stats_.setup_seconds["integrate"] = std::chrono::duration<double>(t2 - t1).count();
+  if (hierarchy) {
+    const auto t3 = std::chrono::steady_clock::now();
+    hierarchy_ = build_surface_hierarchy(vertices0_, faces_, *hierarchy);
+    hierarchy_.points.clear();  // only the prolongations and colours are used by the solver
+    hierarchy_.points.shrink_to_fit();
+    stats_.levels = int(hierarchy_.colours.size());
+    stats_.setup_seconds["hierarchy"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t3).count() +
+        std::chrono::duration<double>(t0b - t0).count();
+  }
+}
+
+Positions HatBasis::evaluate_vertices(const Coefficients& x) const {
+  if (order_.empty()) return x;
+  Positions V(x.rows(), 3);
+  for (std::size_t k = 0; k < order_.size(); ++k) V.row(order_[k]) = x.row(Eigen::Index(k));
+  return V;
 }
 
 void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiffness) {

@@ -4,6 +4,9 @@
 
 #include "bases/basis.h"
 #include "bases/fixed_pattern.h"
+#include "bases/surface_hierarchy.h"
+
+#include <optional>
 
 namespace mcf {
 
@@ -13,7 +16,12 @@ class HatBasis final : public Basis {
  public:
   /// Builds the sparsity pattern (vertex adjacency incl. the diagonal) once; mass and stiffness
   /// share it, so M + δK is a value-wise sum. Matrices are assembled at the mesh's positions.
-  HatBasis(const TriangleMesh& mesh, MassKind mass_kind = MassKind::consistent);
+  /// With `hierarchy`, also builds the multigrid hierarchy of the input mesh
+  /// (bases/surface_hierarchy.h) once; it is kept through the flow, as the mesh's connectivity is.
+  /// The functions are then numbered in a bandwidth-reducing order (bases/vertex_ordering.h), not
+  /// the vertices': coefficients are in that order, evaluate_vertices returns the mesh's.
+  HatBasis(const TriangleMesh& mesh, MassKind mass_kind = MassKind::consistent,
+           std::optional<SurfaceHierarchyOptions> hierarchy = std::nullopt);
 
   std::string name() const override { return "hat"; }
   Eigen::Index dimension() const override { return faces_.rows() ? vertices0_.rows() : 0; }
@@ -21,18 +29,27 @@ class HatBasis final : public Basis {
   void update(const Coefficients& x, bool update_mass, bool update_stiffness) override;
   SparseView mass() const override { return pattern_.view(mass_); }
   SparseView stiffness() const override { return pattern_.view(stiffness_); }
-  Positions evaluate_vertices(const Coefficients& x) const override { return x; }
+  /// The coefficients in the mesh's vertex order (the functions are renumbered with a hierarchy).
+  Positions evaluate_vertices(const Coefficients& x) const override;
   std::vector<int> locked_functions() const override { return boundary_; }
   const BasisStats& stats() const override { return stats_; }
+  const std::vector<SparseMatrix>* prolongations() const override {
+    return hierarchy_.prolongations.empty() ? nullptr : &hierarchy_.prolongations;
+  }
+  const std::vector<std::vector<std::uint8_t>>* colours() const override {
+    return hierarchy_.prolongations.empty() ? nullptr : &hierarchy_.colours;
+  }
 
  private:
-  Positions vertices0_;
-  Triangles faces_;
+  Positions vertices0_;     // in the functions' order
+  Triangles faces_;         // on the functions' numbers
+  std::vector<int> order_;  // function k is vertex order_[k]; empty: the mesh's own order
   MassKind mass_kind_;
   FixedPattern pattern_;                              // 9 slots per face, gathered per nonzero
   std::vector<double> mass_, stiffness_;              // values on pattern_
   std::vector<double> local_mass_, local_stiffness_;  // per-face 3x3 blocks, reused every step
   std::vector<int> boundary_;
+  SurfaceHierarchy hierarchy_;  // empty unless asked for
   BasisStats stats_;
 };
 

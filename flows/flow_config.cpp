@@ -96,10 +96,6 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
     fail("mass", "\"" + c.mass +
                      "\" applies to the hat basis only; the octree basis integrates its "
                      "consistent mass matrix by cubature");
-  if (c.basis == "hat" &&
-      (c.solver.name == "multigrid" || c.solver.preconditioner == "multigrid") &&
-      (c.solver.name != "pcg" || c.solver.preconditioner == "multigrid"))
-    fail("solver", "multigrid needs a hierarchy: use basis \"octree\" (the hat basis has none)");
   if (rebuilt && c.flow == "cmcf")
     fail("flow",
          "cmcf keeps the stiffness of t=0, which needs a fixed basis; the rebuilt octree "

@@ -44,9 +44,15 @@ MultigridOptions multigrid_options(const SolverConfig& c) {
 
 std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& mesh,
                                   bool analytic) {
-  if (config.basis == "hat")
+  if (config.basis == "hat") {
+    // The surface hierarchy only where a multigrid uses it: it costs set-up time and memory.
+    const SolverConfig& s = config.solver;
+    std::optional<SurfaceHierarchyOptions> hierarchy;
+    if (s.name == "multigrid" || (s.name == "pcg" && s.preconditioner == "multigrid"))
+      hierarchy = SurfaceHierarchyOptions{};
     return std::make_unique<HatBasis>(
-        mesh, config.mass == "lumped" ? MassKind::lumped : MassKind::consistent);
+        mesh, config.mass == "lumped" ? MassKind::lumped : MassKind::consistent, hierarchy);
+  }
   if (config.basis == "octree") {
     const OctreeOptions o = octree_options(config.octree, analytic);
     if (config.octree.tracking == "rebuilt") return std::make_unique<RebuiltOctreeBasis>(mesh, o);

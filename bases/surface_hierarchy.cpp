@@ -1,0 +1,302 @@
+#include "bases/surface_hierarchy.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <tuple>
+
+namespace mcf {
+namespace {
+
+/// One level as the coarsening sees it: points, the vertex graph (CSR, sorted, no self loops) and
+/// triangles.
+struct LevelMesh {
+  Positions points;
+  std::vector<int> start, neighbour;  // neighbours of v: neighbour[start[v] .. start[v+1])
+  std::vector<std::array<int, 3>> triangles;
+  int size() const { return int(points.rows()); }
+};
+
+/// CSR of the undirected graph of `pairs` (each given once or twice) on n vertices.
+void build_graph(int n, std::vector<std::pair<int, int>>& pairs, LevelMesh& level) {
+  std::vector<std::pair<int, int>> both;
+  both.reserve(2 * pairs.size());
+  for (const auto& [a, b] : pairs) {
+    if (a == b) continue;
+    both.emplace_back(a, b);
+    both.emplace_back(b, a);
+  }
+  std::sort(both.begin(), both.end());
+  both.erase(std::unique(both.begin(), both.end()), both.end());
+  level.start.assign(std::size_t(n) + 1, 0);
+  for (const auto& e : both) ++level.start[std::size_t(e.first) + 1];
+  for (int v = 0; v < n; ++v) level.start[std::size_t(v) + 1] += level.start[std::size_t(v)];
+  level.neighbour.resize(both.size());
+  for (std::size_t k = 0; k < both.size(); ++k) level.neighbour[k] = both[k].second;
+}
+
+LevelMesh finest_level(const Positions& vertices, const Triangles& faces) {
+  LevelMesh level;
+  level.points = vertices;
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(std::size_t(3 * faces.rows()));
+  level.triangles.resize(std::size_t(faces.rows()));
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const std::array<int, 3> t = {faces(f, 0), faces(f, 1), faces(f, 2)};
+    level.triangles[std::size_t(f)] = t;
+    for (int c = 0; c < 3; ++c) edges.emplace_back(t[std::size_t(c)], t[std::size_t((c + 1) % 3)]);
+  }
+  build_graph(int(vertices.rows()), edges, level);
+  return level;
+}
+
+/// Barycentric coordinates of x projected onto the plane of (a, b, c); false for a degenerate
+/// triangle.
+bool barycentric(const Eigen::RowVector3d& x, const Eigen::RowVector3d& a,
+                 const Eigen::RowVector3d& b, const Eigen::RowVector3d& c,
+                 std::array<double, 3>& w) {
+  const Eigen::RowVector3d e0 = b - a, e1 = c - a, p = x - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+  const double d20 = p.dot(e0), d21 = p.dot(e1);
+  const double denom = d00 * d11 - d01 * d01;
+  if (!(denom > 1e-14 * d00 * d11)) return false;
+  w[1] = (d11 * d20 - d01 * d21) / denom;
+  w[2] = (d00 * d21 - d01 * d20) / denom;
+  w[0] = 1.0 - w[1] - w[2];
+  return true;
+}
+
+/// One coarsening step (header, steps 1-4): the coarse level and the prolongation (fine x coarse).
+std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
+  const int n = fine.size();
+  // 1. A maximal independent set, greedily in index order.
+  std::vector<int> coarse_index(std::size_t(n), -1);
+  std::vector<char> blocked(std::size_t(n), 0);
+  int nc = 0;
+  for (int v = 0; v < n; ++v) {
+    if (blocked[std::size_t(v)]) continue;
+    coarse_index[std::size_t(v)] = nc++;
+    blocked[std::size_t(v)] = 1;
+    for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k)
+      blocked[std::size_t(fine.neighbour[std::size_t(k)])] = 1;
+  }
+  // 2. Graph Voronoi cells: (distance, sample) ordered lexicographically, so ties go to the
+  // smaller coarse index whatever the order of the queue.
+  std::vector<double> dist(std::size_t(n), std::numeric_limits<double>::infinity());
+  std::vector<int> label(std::size_t(n), std::numeric_limits<int>::max());
+  using Entry = std::tuple<double, int, int>;  // distance, label, vertex
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (int v = 0; v < n; ++v)
+    if (coarse_index[std::size_t(v)] >= 0) {
+      dist[std::size_t(v)] = 0;
+      label[std::size_t(v)] = coarse_index[std::size_t(v)];
+      queue.emplace(0.0, label[std::size_t(v)], v);
+    }
+  while (!queue.empty()) {
+    const auto [d, lab, v] = queue.top();
+    queue.pop();
+    if (d != dist[std::size_t(v)] || lab != label[std::size_t(v)]) continue;
+    for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
+      const int w = fine.neighbour[std::size_t(k)];
+      const double nd = d + (fine.points.row(v) - fine.points.row(w)).norm();
+      if (nd < dist[std::size_t(w)] || (nd == dist[std::size_t(w)] && lab < label[std::size_t(w)])) {
+        dist[std::size_t(w)] = nd;
+        label[std::size_t(w)] = lab;
+        queue.emplace(nd, lab, w);
+      }
+    }
+  }
+  // 3. The coarse level.
+  LevelMesh coarse;
+  coarse.points.resize(nc, 3);
+  for (int v = 0; v < n; ++v)
+    if (coarse_index[std::size_t(v)] >= 0) coarse.points.row(coarse_index[std::size_t(v)]) = fine.points.row(v);
+  std::vector<std::pair<int, int>> edges;
+  for (int v = 0; v < n; ++v)
+    for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
+      const int a = label[std::size_t(v)], b = label[std::size_t(fine.neighbour[std::size_t(k)])];
+      if (a < b) edges.emplace_back(a, b);
+    }
+  build_graph(nc, edges, coarse);
+  // Triangles with three distinct cells, rotated to start at their smallest index (orientation
+  // kept); the first of several fine triangles that map to one coarse triangle is kept.
+  std::vector<std::pair<std::array<int, 3>, std::array<int, 3>>> keyed;  // sorted key, rotated
+  for (const auto& t : fine.triangles) {
+    std::array<int, 3> c = {label[std::size_t(t[0])], label[std::size_t(t[1])],
+                            label[std::size_t(t[2])]};
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    const int r = int(std::min_element(c.begin(), c.end()) - c.begin());
+    std::rotate(c.begin(), c.begin() + r, c.end());
+    std::array<int, 3> key = c;
+    std::sort(key.begin(), key.end());
+    keyed.emplace_back(key, c);
+  }
+  std::stable_sort(keyed.begin(), keyed.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (std::size_t k = 0; k < keyed.size(); ++k)
+    if (k == 0 || keyed[k].first != keyed[k - 1].first) coarse.triangles.push_back(keyed[k].second);
+  // Triangles around each coarse vertex.
+  std::vector<int> tri_start(std::size_t(nc) + 1, 0), tri_of;
+  for (const auto& t : coarse.triangles)
+    for (int c : t) ++tri_start[std::size_t(c) + 1];
+  for (int c = 0; c < nc; ++c) tri_start[std::size_t(c) + 1] += tri_start[std::size_t(c)];
+  tri_of.resize(std::size_t(tri_start.back()));
+  {
+    std::vector<int> fill(tri_start.begin(), tri_start.end() - 1);
+    for (std::size_t t = 0; t < coarse.triangles.size(); ++t)
+      for (int c : coarse.triangles[t]) tri_of[std::size_t(fill[std::size_t(c)]++)] = int(t);
+  }
+  // 4. Prolongation.
+  std::vector<Eigen::Triplet<double, int>> entries;
+  entries.reserve(std::size_t(3 * n));
+  for (int v = 0; v < n; ++v) {
+    const int s = label[std::size_t(v)];
+    if (coarse_index[std::size_t(v)] >= 0) {
+      entries.emplace_back(v, s, 1.0);
+      continue;
+    }
+    double best = -std::numeric_limits<double>::infinity();
+    std::array<double, 3> best_w{};
+    int best_t = -1;
+    auto consider = [&](int c) {
+      for (int k = tri_start[std::size_t(c)]; k < tri_start[std::size_t(c) + 1]; ++k) {
+        const int tk = tri_of[std::size_t(k)];
+        const auto& t = coarse.triangles[std::size_t(tk)];
+        std::array<double, 3> w;
+        if (!barycentric(fine.points.row(v), coarse.points.row(t[0]), coarse.points.row(t[1]),
+                         coarse.points.row(t[2]), w))
+          continue;
+        const double score = std::min({w[0], w[1], w[2]});
+        if (score > best) {
+          best = score;
+          best_w = w;
+          best_t = tk;
+        }
+      }
+    };
+    consider(s);
+    // Outside every triangle around its own sample (a cell that reaches past them): the
+    // triangles around the cells its neighbours belong to, which lie next to it.
+    if (best < 0)
+      for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
+        const int c = label[std::size_t(fine.neighbour[std::size_t(k)])];
+        if (c != s) consider(c);
+      }
+    if (best_t < 0) {
+      entries.emplace_back(v, s, 1.0);
+      continue;
+    }
+    double sum = 0;
+    for (double& w : best_w) sum += (w = std::max(w, 0.0));
+    const auto& t = coarse.triangles[std::size_t(best_t)];
+    for (int c = 0; c < 3; ++c)
+      if (best_w[std::size_t(c)] > 0) entries.emplace_back(v, t[std::size_t(c)], best_w[std::size_t(c)] / sum);
+  }
+  SparseMatrix P(n, nc);
+  P.setFromTriplets(entries.begin(), entries.end());
+  P.makeCompressed();
+  return {std::move(coarse), std::move(P)};
+}
+
+/// The symmetric pattern (ones) of a level's graph with its diagonal.
+SparseMatrix graph_pattern(const LevelMesh& level) {
+  const int n = level.size();
+  std::vector<Eigen::Triplet<double, int>> t;
+  t.reserve(level.neighbour.size() + std::size_t(n));
+  for (int v = 0; v < n; ++v) {
+    t.emplace_back(v, v, 1.0);
+    for (int k = level.start[std::size_t(v)]; k < level.start[std::size_t(v) + 1]; ++k)
+      t.emplace_back(level.neighbour[std::size_t(k)], v, 1.0);
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+std::vector<std::uint8_t> solver_colours(const SparseMatrix& pattern) {
+  int count = 0;
+  const std::vector<int> c = greedy_colouring(pattern, &count);
+  if (count > 8) return {};
+  return std::vector<std::uint8_t>(c.begin(), c.end());
+}
+
+}  // namespace
+
+std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
+  const int n = int(A.cols());
+  std::vector<int> degree(std::size_t(n), 0);
+  for (int j = 0; j < n; ++j)
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+      if (it.row() != j) ++degree[std::size_t(j)];
+  // Smallest-last order: repeatedly remove a vertex of least remaining degree (lazy buckets: a
+  // vertex is pushed again whenever its degree drops, stale entries are skipped).
+  const int max_degree = n ? *std::max_element(degree.begin(), degree.end()) : 0;
+  std::vector<std::vector<int>> bucket(std::size_t(max_degree) + 1);
+  for (int v = n - 1; v >= 0; --v) bucket[std::size_t(degree[std::size_t(v)])].push_back(v);
+  std::vector<char> removed(std::size_t(n), 0);
+  std::vector<int> order;
+  order.reserve(std::size_t(n));
+  int low = 0;
+  while (int(order.size()) < n) {
+    while (bucket[std::size_t(low)].empty()) ++low;
+    const int v = bucket[std::size_t(low)].back();
+    bucket[std::size_t(low)].pop_back();
+    if (removed[std::size_t(v)] || degree[std::size_t(v)] != low) continue;
+    removed[std::size_t(v)] = 1;
+    order.push_back(v);
+    for (SparseMatrix::InnerIterator it(A, v); it; ++it) {
+      const int w = int(it.row());
+      if (w == v || removed[std::size_t(w)]) continue;
+      bucket[std::size_t(--degree[std::size_t(w)])].push_back(w);
+    }
+    low = std::max(0, low - 1);
+  }
+  std::vector<int> colour(std::size_t(n), -1);
+  std::vector<int> used_by(std::size_t(max_degree) + 2, -1);  // colour -> last vertex that saw it
+  int colours = 0;
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const int v = *it;
+    for (SparseMatrix::InnerIterator e(A, v); e; ++e)
+      if (e.row() != v && colour[std::size_t(e.row())] >= 0)
+        used_by[std::size_t(colour[std::size_t(e.row())])] = v;
+    int c = 0;
+    while (used_by[std::size_t(c)] == v) ++c;
+    colour[std::size_t(v)] = c;
+    colours = std::max(colours, c + 1);
+  }
+  if (count) *count = colours;
+  return colour;
+}
+
+SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triangles& faces,
+                                         const SurfaceHierarchyOptions& options) {
+  std::vector<LevelMesh> levels;  // finest first while building
+  std::vector<SparseMatrix> P;    // P[k]: level k (fine) x level k+1 (coarse)
+  levels.push_back(finest_level(vertices, faces));
+  while (levels.back().size() > options.coarsest_size && int(levels.size()) < options.max_levels) {
+    auto [coarse, prolongation] = coarsen(levels.back());
+    if (coarse.size() > 0.9 * levels.back().size()) break;  // no longer shrinking
+    levels.push_back(std::move(coarse));
+    P.push_back(std::move(prolongation));
+  }
+  // Colourings of the Galerkin patterns, finest first.
+  std::vector<std::vector<std::uint8_t>> colours(levels.size());
+  SparseMatrix pattern = graph_pattern(levels.front());
+  colours[0] = solver_colours(pattern);
+  for (std::size_t k = 0; k < P.size(); ++k) {
+    SparseMatrix next = SparseMatrix(P[k].transpose()) * pattern * P[k];
+    next.makeCompressed();
+    pattern = std::move(next);
+    colours[k + 1] = solver_colours(pattern);
+  }
+  SurfaceHierarchy h;
+  for (auto it = levels.rbegin(); it != levels.rend(); ++it) h.points.push_back(std::move(it->points));
+  for (auto it = P.rbegin(); it != P.rend(); ++it) h.prolongations.push_back(std::move(*it));
+  h.colours.assign(colours.rbegin(), colours.rend());
+  return h;
+}
+
+}  // namespace mcf

@@ -1,0 +1,221 @@
+// The hat basis's multigrid hierarchy (bases/surface_hierarchy.h): prolongations reproduce
+// constants everywhere and linear functions on a flat mesh, a 1-to-4 subdivided mesh coarsens back
+// to its coarse vertices, levels shrink to the coarsest size, colourings are valid on the patterns
+// the Galerkin matrices will have, and the build is deterministic.
+
+#include "bases/hat_basis.h"
+#include "bases/surface_hierarchy.h"
+#include "bases/vertex_ordering.h"
+#include "datasets/mesh_spec.h"
+
+#include "test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace mcf {
+namespace {
+
+/// An n x n grid of squares on [0,1]^2 (z = 0), each split into two triangles along alternating
+/// diagonals, its vertices numbered in a shuffled order (so nothing depends on a lexicographic one).
+TriangleMesh flat_grid(int n) {
+  const int nv = (n + 1) * (n + 1);
+  std::vector<int> order(static_cast<std::size_t>(nv));
+  for (int i = 0; i < nv; ++i) order[std::size_t(i)] = int((std::int64_t(i) * 7919) % nv);
+  TriangleMesh m;
+  m.vertices.resize(nv, 3);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      m.vertices.row(order[std::size_t(j * (n + 1) + i)]) << double(i) / n, double(j) / n, 0.0;
+  m.faces.resize(2 * n * n, 3);
+  int f = 0;
+  auto id = [&](int i, int j) { return order[std::size_t(j * (n + 1) + i)]; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      if ((i + j) % 2 == 0) {
+        m.faces.row(f++) << id(i, j), id(i + 1, j), id(i + 1, j + 1);
+        m.faces.row(f++) << id(i, j), id(i + 1, j + 1), id(i, j + 1);
+      } else {
+        m.faces.row(f++) << id(i, j), id(i + 1, j), id(i, j + 1);
+        m.faces.row(f++) << id(i + 1, j), id(i + 1, j + 1), id(i, j + 1);
+      }
+    }
+  return m;
+}
+
+/// Pattern (ones) of the mesh's vertex adjacency with the diagonal: the hat basis's matrices'.
+SparseMatrix adjacency(const TriangleMesh& m) {
+  std::vector<Eigen::Triplet<double, int>> t;
+  for (Eigen::Index f = 0; f < m.faces.rows(); ++f)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) t.emplace_back(m.faces(f, a), m.faces(f, b), 1.0);
+  SparseMatrix A(m.vertices.rows(), m.vertices.rows());
+  A.setFromTriplets(t.begin(), t.end());
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(A, k); it; ++it) it.valueRef() = 1.0;
+  return A;
+}
+
+void expect_valid_colouring(const SparseMatrix& pattern, const std::vector<std::uint8_t>& c) {
+  ASSERT_EQ(Eigen::Index(c.size()), pattern.rows());
+  for (int j = 0; j < pattern.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(pattern, j); it; ++it)
+      if (it.row() != j) ASSERT_NE(c[std::size_t(it.row())], c[std::size_t(j)]) << it.row() << " " << j;
+}
+
+TEST(SurfaceHierarchy, ProlongationRowsSumToOneAndLevelsShrink) {
+  for (const char* spec : {"torus", "dumbbell", "cgal:armadillo"}) {
+    const TriangleMesh m = load_mesh_spec(spec).mesh;
+    const SurfaceHierarchy h = build_surface_hierarchy(m.vertices, m.faces, {500, 16});
+    ASSERT_GE(h.levels(), 2) << spec;
+    EXPECT_LE(h.points.front().rows(), 500) << spec;
+    EXPECT_EQ(h.points.back().rows(), m.vertices.rows());
+    for (std::size_t l = 0; l < h.prolongations.size(); ++l) {
+      const SparseMatrix& P = h.prolongations[l];
+      ASSERT_EQ(P.rows(), h.points[l + 1].rows());
+      ASSERT_EQ(P.cols(), h.points[l].rows());
+      // Coarsening by an independent set of the vertex graph keeps 1/7 to 1/3 of the vertices.
+      EXPECT_GT(double(P.rows()) / double(P.cols()), 3.0) << spec << " level " << l;
+      EXPECT_LT(double(P.rows()) / double(P.cols()), 7.0) << spec << " level " << l;
+      const Eigen::VectorXd ones = P * Eigen::VectorXd::Ones(P.cols());
+      EXPECT_LT((ones.array() - 1.0).abs().maxCoeff(), 1e-12) << spec << " level " << l;
+      for (int k = 0; k < P.outerSize(); ++k)
+        for (SparseMatrix::InnerIterator it(P, k); it; ++it) ASSERT_GT(it.value(), 0.0);
+      // A coarse vertex is one of the finer level's, at its own position.
+      const Eigen::MatrixXd moved = P * h.points[l];
+      int exact = 0;
+      for (Eigen::Index i = 0; i < P.rows(); ++i)
+        exact += (moved.row(i) - h.points[l + 1].row(i)).norm() == 0.0;
+      EXPECT_GE(exact, P.cols()) << spec << " level " << l;
+    }
+  }
+}
+
+TEST(SurfaceHierarchy, LinearFunctionsAreReproducedOnAFlatMesh) {
+  const TriangleMesh m = flat_grid(60);
+  const SurfaceHierarchy h = build_surface_hierarchy(m.vertices, m.faces, {100, 16});
+  ASSERT_GE(h.levels(), 3);
+  const Eigen::Vector3d g(0.7, -1.3, 0.0);
+  for (std::size_t l = 0; l < h.prolongations.size(); ++l) {
+    const Eigen::VectorXd coarse = h.points[l] * g, fine = h.points[l + 1] * g;
+    const Eigen::VectorXd interpolated = h.prolongations[l] * (coarse.array() + 0.25).matrix();
+    // Away from the boundary every vertex lies inside a coarse triangle around its cell's sample.
+    int checked = 0;
+    for (Eigen::Index i = 0; i < fine.size(); ++i) {
+      const Eigen::RowVector3d p = h.points[l + 1].row(i);
+      // Three of the finer level's spacings: the coarse triangles cover the square up to there.
+      const double margin = 3.0 / std::sqrt(double(fine.size()));
+      if (p.x() < margin || p.y() < margin || p.x() > 1 - margin || p.y() > 1 - margin) continue;
+      EXPECT_NEAR(interpolated[i], fine[i] + 0.25, 1e-12) << "level " << l << " vertex " << i;
+      ++checked;
+    }
+    EXPECT_GT(checked, fine.size() / 5) << "level " << l;
+  }
+}
+
+TEST(SurfaceHierarchy, ASubdividedMeshCoarsensBackToItsCoarseVertices) {
+  // test_icosphere numbers the vertices of each subdivision after those of the one before: the
+  // greedy independent set in index order picks exactly the coarser icosphere's vertices.
+  const TriangleMesh fine = test_icosphere(5), coarse = test_icosphere(4);
+  const SurfaceHierarchy h = build_surface_hierarchy(fine.vertices, fine.faces, {3000, 2});
+  ASSERT_EQ(h.levels(), 2);
+  ASSERT_EQ(h.points[0].rows(), coarse.vertices.rows());
+  EXPECT_EQ((h.points[0] - coarse.vertices).cwiseAbs().maxCoeff(), 0.0);
+  // Each new vertex is the midpoint of its edge, projected: half and half of the two ends.
+  const SparseMatrix& P = h.prolongations[0];
+  for (Eigen::Index i = coarse.vertices.rows(); i < P.rows(); ++i) {
+    std::vector<double> w;
+    for (int k = 0; k < P.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(P, k); it; ++it)
+        if (it.row() == i) w.push_back(it.value());
+    // On the sphere the midpoint lies off the coarse triangles' planes: its projection is half way
+    // along the edge up to the curvature's share.
+    ASSERT_GE(w.size(), 2u) << i;
+    std::sort(w.rbegin(), w.rend());
+    EXPECT_NEAR(w[0], 0.5, 1e-3) << i;
+    EXPECT_NEAR(w[1], 0.5, 1e-3) << i;
+    if (i > coarse.vertices.rows() + 200) break;  // rows are in column storage: a sample suffices
+  }
+}
+
+TEST(SurfaceHierarchy, ColouringsAreValidOnTheGalerkinPatterns) {
+  const TriangleMesh m = load_mesh_spec("cgal:armadillo").mesh;
+  const SurfaceHierarchy h = build_surface_hierarchy(m.vertices, m.faces, {500, 16});
+  SparseMatrix pattern = adjacency(m);
+  int coloured = 0;
+  for (int l = h.levels() - 1; l >= 0; --l) {
+    if (!h.colours[std::size_t(l)].empty()) {
+      expect_valid_colouring(pattern, h.colours[std::size_t(l)]);
+      for (std::uint8_t c : h.colours[std::size_t(l)]) ASSERT_LT(c, 8);
+      ++coloured;
+    }
+    if (l > 0) {
+      const SparseMatrix& P = h.prolongations[std::size_t(l - 1)];
+      pattern = SparseMatrix(P.transpose()) * pattern * P;
+    }
+  }
+  // A triangle mesh's graph is planar, so smallest-last greedy colours it with at most six.
+  int count = 0;
+  greedy_colouring(adjacency(m), &count);
+  EXPECT_LE(count, 6);
+  EXPECT_FALSE(h.colours.back().empty());
+  EXPECT_GE(coloured, 1);
+}
+
+TEST(SurfaceHierarchy, TheBuildIsDeterministic) {
+  const TriangleMesh m = load_mesh_spec("dumbbell").mesh;
+  const SurfaceHierarchy a = build_surface_hierarchy(m.vertices, m.faces, {300, 16});
+  const SurfaceHierarchy b = build_surface_hierarchy(m.vertices, m.faces, {300, 16});
+  ASSERT_EQ(a.levels(), b.levels());
+  EXPECT_EQ(a.colours, b.colours);
+  for (std::size_t l = 0; l < a.prolongations.size(); ++l) {
+    const SparseMatrix d = a.prolongations[l] - b.prolongations[l];
+    EXPECT_EQ(d.norm(), 0.0) << l;
+  }
+}
+
+/// The largest |number(i) - number(j)| over the mesh's edges under `rank` (vertex -> number).
+int bandwidth(const Triangles& F, const std::vector<int>& rank) {
+  int b = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      b = std::max(b, std::abs(rank[std::size_t(F(f, c))] - rank[std::size_t(F(f, (c + 1) % 3))]));
+  return b;
+}
+
+TEST(VertexOrdering, APermutationWithASmallBandwidth) {
+  for (const char* spec : {"cgal:armadillo@faces=208000", "sphere:vertices=50000", "torus"}) {
+    const TriangleMesh m = load_mesh_spec(spec).mesh;
+    const int n = int(m.vertices.rows());
+    const std::vector<int> order = bandwidth_ordering(m.faces, n);
+    ASSERT_EQ(int(order.size()), n);
+    std::vector<int> rank(static_cast<std::size_t>(n), -1), identity(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+      ASSERT_EQ(rank[std::size_t(order[std::size_t(k)])], -1) << "twice: " << order[std::size_t(k)];
+      rank[std::size_t(order[std::size_t(k)])] = k;
+      identity[std::size_t(k)] = k;
+    }
+    // A breadth-first level of a surface holds about sqrt(n) vertices.
+    const int b = bandwidth(m.faces, rank);
+    EXPECT_LT(b, 20.0 * std::sqrt(double(n))) << spec;
+    EXPECT_LE(b, bandwidth(m.faces, identity)) << spec;
+  }
+}
+
+TEST(VertexOrdering, TheHatBasisWithAHierarchyEvaluatesInTheMeshsOrder) {
+  const TriangleMesh m = load_mesh_spec("cgal:armadillo").mesh;
+  const HatBasis plain(m), ordered(m, MassKind::consistent, SurfaceHierarchyOptions{});
+  EXPECT_EQ(plain.evaluate_vertices(plain.initial_coefficients()), m.vertices);
+  EXPECT_EQ(ordered.evaluate_vertices(ordered.initial_coefficients()), m.vertices);
+  EXPECT_NE(ordered.initial_coefficients(), m.vertices);  // renumbered
+  // The same operator in another numbering: the energies of the embedding agree.
+  const Coefficients x0 = plain.initial_coefficients(), y0 = ordered.initial_coefficients();
+  const double ep = (x0.transpose() * (SparseMatrix(plain.stiffness()) * x0)).trace();
+  const double eo = (y0.transpose() * (SparseMatrix(ordered.stiffness()) * y0)).trace();
+  EXPECT_NEAR(ep, eo, 1e-10 * ep);
+}
+
+}  // namespace
+}  // namespace mcf

@@ -1,0 +1,133 @@
+// The hat basis with the multigrid solver: the Galerkin coarse operators of its surface hierarchy
+// against P^T A P formed directly, cycles converging to CHOLMOD's solution, the same bits for one
+// and two threads, and flows with multigrid and multigrid-preconditioned CG against CHOLMOD's.
+
+#include "flow_test_util.h"
+
+#include "bases/hat_basis.h"
+#include "solvers/cholmod_solver.h"
+#include "solvers/multigrid.h"
+
+#include <gtest/gtest.h>
+#include <algorithm>
+#include <tbb/global_control.h>
+
+namespace mcf {
+namespace {
+
+using nlohmann::json;
+
+struct HatSystem {
+  TriangleMesh mesh;
+  std::unique_ptr<HatBasis> basis;
+  SparseMatrix A;
+  Eigen::MatrixXd B;
+};
+
+/// M + dt K of a mesh's hat basis with its hierarchy, and the right-hand sides M X.
+HatSystem hat_system(const std::string& spec, double dt, int coarsest = 300) {
+  HatSystem s;
+  s.mesh = load_mesh_spec(spec).mesh;
+  s.basis = std::make_unique<HatBasis>(s.mesh, MassKind::consistent,
+                                       SurfaceHierarchyOptions{coarsest, 16});
+  const SparseMatrix M = s.basis->mass(), K = s.basis->stiffness();
+  s.A = M + dt * K;
+  s.A.makeCompressed();
+  s.B = M * s.basis->initial_coefficients();
+  return s;
+}
+
+HierarchyView view(const HatBasis& b) {
+  return HierarchyView{b.prolongations(), b.colours()};
+}
+
+TEST(HatMultigrid, GalerkinOperatorsArePTAPFormedDirectly) {
+  const HatSystem s = hat_system("cgal:armadillo", 1e-3);
+  MultigridSolver mg;
+  ASSERT_TRUE(mg.set_matrix(s.A, view(*s.basis)).ok());
+  const auto& P = *s.basis->prolongations();
+  ASSERT_EQ(mg.levels(), int(P.size()) + 1);
+  ASSERT_GE(mg.levels(), 4);
+  SparseMatrix Af = s.A;
+  for (int l = int(P.size()) - 1; l >= 0; --l) {
+    const SparseMatrix& Pl = P[std::size_t(l)];
+    const SparseMatrix direct = SparseMatrix(Pl.transpose()) * (Af * Pl);
+    const SparseMatrix ours = mg.level_matrix(l);
+    ASSERT_EQ(ours.rows(), direct.rows());
+    EXPECT_LT(SparseMatrix(ours - direct).norm() / direct.norm(), 1e-13) << "level " << l;
+    Af = ours;
+  }
+  // The finest level (a planar graph) is relaxed colour by colour.
+  EXPECT_TRUE(mg.level_is_coloured(mg.levels() - 1));
+}
+
+TEST(HatMultigrid, CyclesConvergeToTheCholmodSolution) {
+  for (double dt : {1e-5, 1e-3}) {
+    const HatSystem s = hat_system("cgal:armadillo", dt);
+    CholmodSolver direct;
+    ASSERT_TRUE(direct.set_matrix(s.A).ok());
+    Eigen::MatrixXd exact(s.B.rows(), 3);
+    ASSERT_TRUE(direct.solve(s.B, exact).ok());
+    for (MultigridCycle cycle : {MultigridCycle::V, MultigridCycle::W}) {
+      MultigridOptions o;
+      o.cycle = cycle;
+      o.cycles = 200;
+      o.tolerance = 1e-13;
+      o.pre_smooth = o.post_smooth = cycle == MultigridCycle::V ? 2 : 5;
+      MultigridSolver mg(o);
+      ASSERT_TRUE(mg.set_matrix(s.A, view(*s.basis)).ok());
+      Eigen::MatrixXd x;
+      const SolveReport r = mg.solve(s.B, x);
+      EXPECT_EQ(r.status, SolveStatus::converged) << dt;
+      EXPECT_LT((x - exact).norm() / exact.norm(), 1e-10) << "dt " << dt << " " << to_string(cycle);
+      // Each cycle reduces the residual: the smoother and the coarse correction work together.
+      for (std::size_t c = 1; c < r.residuals.size(); ++c)
+        ASSERT_LT(r.residuals[c], r.residuals[c - 1]) << "dt " << dt << " cycle " << c;
+    }
+  }
+}
+
+TEST(HatMultigrid, OneAndTwoThreadsGiveTheSameBits) {
+  const HatSystem s = hat_system("sphere:vertices=60000", 1e-3);
+  auto solve = [&](int threads) {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, threads);
+    MultigridOptions o;
+    o.cycles = 3;
+    MultigridSolver mg(o);
+    EXPECT_TRUE(mg.set_matrix(s.A, view(*s.basis)).ok());
+    // Blocks of one parity are relaxed in parallel only where the finest level has several.
+    const std::vector<int> blocks = mg.relaxation_blocks(mg.levels() - 1);
+    EXPECT_GE(*std::max_element(blocks.begin(), blocks.end()), 3);
+    Eigen::MatrixXd x;
+    mg.solve(s.B, x);
+    return x;
+  };
+  const Eigen::MatrixXd one = solve(1), two = solve(2);
+  EXPECT_EQ((one - two).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(HatMultigrid, FlowsWithMultigridFollowCholmod) {
+  const json base = {{"mesh", "cgal:armadillo"}, {"basis", "hat"}, {"flow", "cmcf"},
+                     {"dt", 1e-3},               {"steps", 5}};
+  json cholmod = base, cycles = base, pcg = base;
+  cholmod["solver"] = {{"name", "cholmod"}};
+  cycles["solver"] = {{"name", "multigrid"}, {"cycles", 4}};
+  pcg["solver"] = {{"name", "pcg"}, {"preconditioner", "multigrid"}, {"tolerance", 1e-10}};
+  const FlowOutcome exact = testing::run(cholmod);
+  const double size = (exact.final_mesh.vertices.colwise().maxCoeff() -
+                       exact.final_mesh.vertices.colwise().minCoeff())
+                          .norm();
+  for (const json* j : {&cycles, &pcg}) {
+    const FlowOutcome o = testing::run(*j);
+    ASSERT_EQ(o.result["status"], "ok") << (*j)["solver"];
+    EXPECT_GT(o.result["system"]["levels"].get<int>(), 2);
+    EXPECT_GT(o.result["system"]["setup_seconds"]["hierarchy"].get<double>(), 0.0);
+    const double rms = std::sqrt(
+        (o.final_mesh.vertices - exact.final_mesh.vertices).rowwise().squaredNorm().mean());
+    EXPECT_LT(rms / size, 1e-7) << (*j)["solver"];
+    EXPECT_EQ(o.result["steps"].back()["solver"]["status"], "converged") << (*j)["solver"];
+  }
+}
+
+}  // namespace
+}  // namespace mcf
