@@ -1,10 +1,15 @@
 // Micro-benchmarks of the hat basis and the direct/iterative solvers on a paper-sized mesh
-// (docs/benchmarks.md): hat assembly, CHOLMOD refactorization + solve, PCG solve.
+// (docs/benchmarks.md): hat assembly, CHOLMOD refactorization + solve, PCG solve, and the hat
+// basis's multigrid (docs/surface-multigrid.md): the hierarchy's build, the Galerkin refresh of a
+// step and one cycle.
 // Mesh: $MCFBENCH_BENCH_MESH (default cgal:armadillo@faces=832000).
 
 #include "bases/hat_basis.h"
+#include "bases/surface_hierarchy.h"
+#include "bases/vertex_ordering.h"
 #include "datasets/mesh_spec.h"
 #include "solvers/cholmod_solver.h"
+#include "solvers/multigrid.h"
 #include "solvers/pcg_solver.h"
 #include "solvers/symmetric_multiply.h"
 
@@ -86,6 +91,82 @@ void BM_PcgSolve(benchmark::State& state) {
   label(state, f);
 }
 BENCHMARK(BM_PcgSolve)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace mcf
+
+namespace mcf {
+namespace {
+
+/// The hat basis with its hierarchy (functions in Cuthill–McKee order) on the same mesh.
+struct HatMultigridFixture {
+  std::unique_ptr<HatBasis> basis;
+  SparseMatrix system;
+  Eigen::MatrixXd rhs;
+
+  static HatMultigridFixture& get() {
+    static HatMultigridFixture f = [] {
+      HatMultigridFixture h;
+      const HatFixture& plain = HatFixture::get();
+      h.basis = std::make_unique<HatBasis>(plain.source.mesh, MassKind::consistent,
+                                           SurfaceHierarchyOptions{});
+      h.system = h.basis->mass() + 1e-3 * h.basis->stiffness();
+      symmetric_multiply(h.basis->mass(), h.basis->initial_coefficients(), h.rhs);
+      return h;
+    }();
+    return f;
+  }
+  HierarchyView view() const { return {basis->prolongations(), basis->colours()}; }
+};
+
+void BM_SurfaceHierarchyBuild(benchmark::State& state) {
+  const HatFixture& f = HatFixture::get();
+  int levels = 0;
+  for (auto _ : state) {
+    const std::vector<int> order =
+        bandwidth_ordering(f.source.mesh.faces, int(f.source.mesh.num_vertices()));
+    benchmark::DoNotOptimize(order.data());
+    const SurfaceHierarchy h = build_surface_hierarchy(f.source.mesh.vertices, f.source.mesh.faces);
+    levels = h.levels();
+  }
+  state.counters["levels"] = levels;
+  label(state, f);
+}
+BENCHMARK(BM_SurfaceHierarchyBuild)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// A step's set_matrix: the Galerkin values on the kept pattern and the coarsest factor.
+void BM_HatMultigridSetMatrix(benchmark::State& state) {
+  auto& f = HatMultigridFixture::get();
+  MultigridSolver mg;
+  mg.set_matrix(f.system, f.view());  // the pattern, outside the timed loop
+  for (auto _ : state) mg.set_matrix(f.system, f.view());
+  state.counters["levels"] = mg.levels();
+  label(state, HatFixture::get());
+}
+BENCHMARK(BM_HatMultigridSetMatrix)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// One cycle from a warm start: Arg 0 a V(2,2)-cycle, 1 a W(5,5)-cycle.
+void BM_HatMultigridCycle(benchmark::State& state) {
+  auto& f = HatMultigridFixture::get();
+  MultigridOptions o;
+  o.cycle = state.range(0) == 0 ? MultigridCycle::V : MultigridCycle::W;
+  o.pre_smooth = o.post_smooth = state.range(0) == 0 ? 2 : 5;
+  o.cycles = 1;
+  MultigridSolver mg(o);
+  mg.set_matrix(f.system, f.view());
+  const Eigen::MatrixXd start = f.basis->initial_coefficients();
+  Eigen::MatrixXd X = start;
+  mg.solve(f.rhs, X);  // first touch of the cycle's buffers
+  double ratio = 0;
+  for (auto _ : state) {
+    X = start;
+    const SolveReport r = mg.solve(f.rhs, X);
+    ratio = r.residuals.empty() ? 0 : r.residuals.back();
+  }
+  state.counters["relative_residual"] = ratio;
+  label(state, HatFixture::get());
+}
+BENCHMARK(BM_HatMultigridCycle)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace mcf

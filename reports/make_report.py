@@ -36,7 +36,8 @@ import index  # noqa: E402
 # report left it.
 STAGING_FOLDER = ".report-staging"
 
-STUDIES = ["table1", "sphere_error", "model_error", "depth_cycles", "cubature", "cmcf", "time_order"]
+STUDIES = ["table1", "sphere_error", "model_error", "depth_cycles", "cubature", "cmcf", "time_order",
+           "hat_multigrid", "hat_scaling"]
 
 
 def parse_args(argv):

@@ -19,7 +19,8 @@ namespace mcf {
 namespace {
 
 /// An n x n grid of squares on [0,1]^2 (z = 0), each split into two triangles along alternating
-/// diagonals, its vertices numbered in a shuffled order (so nothing depends on a lexicographic one).
+/// diagonals, its vertices numbered in a shuffled order (so nothing depends on a lexicographic
+/// one).
 TriangleMesh flat_grid(int n) {
   const int nv = (n + 1) * (n + 1);
   std::vector<int> order(static_cast<std::size_t>(nv));
@@ -62,7 +63,8 @@ void expect_valid_colouring(const SparseMatrix& pattern, const std::vector<std::
   ASSERT_EQ(Eigen::Index(c.size()), pattern.rows());
   for (int j = 0; j < pattern.outerSize(); ++j)
     for (SparseMatrix::InnerIterator it(pattern, j); it; ++it)
-      if (it.row() != j) ASSERT_NE(c[std::size_t(it.row())], c[std::size_t(j)]) << it.row() << " " << j;
+      if (it.row() != j)
+        ASSERT_NE(c[std::size_t(it.row())], c[std::size_t(j)]) << it.row() << " " << j;
 }
 
 TEST(SurfaceHierarchy, ProlongationRowsSumToOneAndLevelsShrink) {

@@ -9,8 +9,8 @@
 #include "solvers/multigrid.h"
 
 #include <gtest/gtest.h>
-#include <algorithm>
 #include <tbb/global_control.h>
+#include <algorithm>
 
 namespace mcf {
 namespace {
@@ -107,8 +107,8 @@ TEST(HatMultigrid, OneAndTwoThreadsGiveTheSameBits) {
 }
 
 TEST(HatMultigrid, FlowsWithMultigridFollowCholmod) {
-  const json base = {{"mesh", "cgal:armadillo"}, {"basis", "hat"}, {"flow", "cmcf"},
-                     {"dt", 1e-3},               {"steps", 5}};
+  const json base = {
+      {"mesh", "cgal:armadillo"}, {"basis", "hat"}, {"flow", "cmcf"}, {"dt", 1e-3}, {"steps", 5}};
   json cholmod = base, cycles = base, pcg = base;
   cholmod["solver"] = {{"name", "cholmod"}};
   cycles["solver"] = {{"name", "multigrid"}, {"cycles", 4}};

@@ -315,6 +315,23 @@ def main(root):
     frames(os.path.join(root, s), "cell_001", 3, 110, 220)  # ~48k faces: decimated
     # time_order: two integrators × dts (error ∝ dt and dt²), one unstable explicit run.
     time_order_cells(os.path.join(root, "time_order"))
+    # hat_multigrid: CHOLMOD, one W-cycle and a PCG on one flow; the cycle's residuals drop 10x per
+    # iteration, its distance to CHOLMOD 1e-5 and its steps half as long.
+    s = "hat_multigrid"
+    solvers = [({"name": "cholmod"}, 1.0, None), ({"name": "multigrid", "cycle": "W", "cycles": 2, "smooth": 5}, 0.5, 1e-5),
+               ({"name": "pcg", "preconditioner": "ichol"}, 3.0, 1e-11)]
+    for i, (solver, slow, dist) in enumerate(solvers):
+        extra = {"reference_distance": [{"step": 10, "rms": dist, "max": 2 * dist}]} if dist else {}
+        write(os.path.join(root, s), "cell_%03d" % i,
+              result(s, i, {"solver.name": solver["name"]}, config(basis="hat", solver=solver),
+                     [step(n, 1e-3, slow=slow) for n in range(1, 11)], **extra))
+    # hat_scaling: two solvers at two sizes.
+    s = "hat_scaling"
+    for i, (name, faces) in enumerate([("cholmod", 1000), ("cholmod", 4000), ("multigrid", 1000), ("multigrid", 4000)]):
+        r = result(s, i, {"solver.name": name, "mesh": "m%d" % faces}, config(basis="hat", solver={"name": name}),
+                   [step(n, 1e-3, slow=faces / 1000.0) for n in range(1, 4)])
+        r["mesh"]["faces"] = faces
+        write(os.path.join(root, s), "cell_%03d" % i, r)
     # A study with one cell and no steps at all.
     write(os.path.join(root, "single"), "only", result("cubature", 0, {"octree.cubature": 3}, config(), []))
     # Files a results folder may also hold: the runner's index, a truncated file, a non-result.

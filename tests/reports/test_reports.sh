@@ -42,7 +42,7 @@ if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
 fi
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 "$py" "$here/make_fake_results.py" "$work/results" || { echo "FAIL: fake results generator"; exit 1; }
-studies="table1 sphere_error model_error depth_cycles cubature cmcf time_order"
+studies="table1 sphere_error model_error depth_cycles cubature cmcf time_order hat_multigrid hat_scaling"
 dirs=""; for s in $studies single; do dirs="$dirs $work/results/$s"; done
 "$py" "$root/reports/make_report.py" $dirs "$work/out" --references "$work/results/references" >"$work/log" 2>&1
 rc=$?
@@ -52,7 +52,14 @@ fail=0
 expect() { [ -s "$work/out/$1" ] || { echo "FAIL: missing or empty $1"; fail=1; }; }
 for f in table1.md sphere_error.png model_error.png depth_cycles.png cubature.png cmcf_00.png \
          cmcf_summary.md time_order.png time_order.md index.md frames_sphere_error_00.png \
-         frames_cmcf_00.png frames_cmcf_01.png; do expect "$f"; done
+         frames_cmcf_00.png frames_cmcf_01.png hat_multigrid.md hat_multigrid.png hat_scaling.png \
+         hat_scaling.md; do expect "$f"; done
+# hat_multigrid: the cycle at 0.59 of CHOLMOD's step (its update half as long), its contraction and
+# distance named.
+grep -F "| hat, multigrid W(5,5) x2 | ok |" "$work/out/hat_multigrid.md" | grep -qF "| 0.59 |" ||
+  { echo "FAIL: hat_multigrid lacks the cycle's ratio to CHOLMOD"; fail=1; }
+grep -F "| hat, multigrid W(5,5) x2 | ok |" "$work/out/hat_multigrid.md" | grep -qF "| 0.10 | 1e-05 | 10 |" ||
+  { echo "FAIL: hat_multigrid lacks the cycle's contraction and distance"; fail=1; }
 for f in "$work"/out/*.png "$work"/out/*.md; do
   case "$f" in */index.md) continue;; esac
   [ -s "${f%.*}.sources.txt" ] || { echo "FAIL: no sources sidecar for $(basename "$f")"; fail=1; }

@@ -1,0 +1,35 @@
+#!/usr/bin/python3
+"""Time per step of the hat basis's flow against mesh size, per solver (docs/surface-multigrid.md):
+hat_scaling.png (log-log) and hat_scaling.md."""
+
+import matplotlib.pyplot as plt
+
+import common
+import hat_multigrid
+import table1
+
+
+def make(results, out_dir, reference, written):
+    """Write hat_scaling.png and hat_scaling.md."""
+    cells = common.first_repetition(results)
+    by_solver = common.group_by(cells, hat_multigrid.solver_name)
+    fig, ax = plt.subplots(figsize=(6.0, 4.2))
+    rows = []
+    for i, name in enumerate(sorted(by_solver)):
+        pts = sorted((common.get(r, "mesh.faces"), table1.mean_step(r, "total"), table1.mean_step(r, "solve"))
+                     for r in by_solver[name] if common.finite(common.get(r, "mesh.faces")))
+        pts = [p for p in pts if common.finite(p[1])]
+        if pts:
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color="C%d" % i, label=name)
+        rows += [[name, "%d" % p[0], common.fmt(p[1]), common.fmt(p[2])] for p in pts]
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("faces")
+    ax.set_ylabel("seconds per step (steps 2 on)")
+    ax.legend()
+    title = "Hat basis: time per step against mesh size"
+    ax.set_title(title, fontsize=9)
+    fig.text(0.01, -0.03, common.sources_line(cells), fontsize=6, wrap=True)
+    common.save_figure(fig, out_dir, "hat_scaling", cells, title, written)
+    common.save_markdown(common.markdown_table(["solver", "faces", "s / step", "solve s"], rows), out_dir,
+                         "hat_scaling", cells, title, written)
