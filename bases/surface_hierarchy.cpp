@@ -101,7 +101,8 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
     for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
       const int w = fine.neighbour[std::size_t(k)];
       const double nd = d + (fine.points.row(v) - fine.points.row(w)).norm();
-      if (nd < dist[std::size_t(w)] || (nd == dist[std::size_t(w)] && lab < label[std::size_t(w)])) {
+      if (nd < dist[std::size_t(w)] ||
+          (nd == dist[std::size_t(w)] && lab < label[std::size_t(w)])) {
         dist[std::size_t(w)] = nd;
         label[std::size_t(w)] = lab;
         queue.emplace(nd, lab, w);
@@ -112,7 +113,8 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
   LevelMesh coarse;
   coarse.points.resize(nc, 3);
   for (int v = 0; v < n; ++v)
-    if (coarse_index[std::size_t(v)] >= 0) coarse.points.row(coarse_index[std::size_t(v)]) = fine.points.row(v);
+    if (coarse_index[std::size_t(v)] >= 0)
+      coarse.points.row(coarse_index[std::size_t(v)]) = fine.points.row(v);
   std::vector<std::pair<int, int>> edges;
   for (int v = 0; v < n; ++v)
     for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
@@ -192,7 +194,8 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
     for (double& w : best_w) sum += (w = std::max(w, 0.0));
     const auto& t = coarse.triangles[std::size_t(best_t)];
     for (int c = 0; c < 3; ++c)
-      if (best_w[std::size_t(c)] > 0) entries.emplace_back(v, t[std::size_t(c)], best_w[std::size_t(c)] / sum);
+      if (best_w[std::size_t(c)] > 0)
+        entries.emplace_back(v, t[std::size_t(c)], best_w[std::size_t(c)] / sum);
   }
   SparseMatrix P(n, nc);
   P.setFromTriplets(entries.begin(), entries.end());
@@ -293,7 +296,8 @@ SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triang
     colours[k + 1] = solver_colours(pattern);
   }
   SurfaceHierarchy h;
-  for (auto it = levels.rbegin(); it != levels.rend(); ++it) h.points.push_back(std::move(it->points));
+  for (auto it = levels.rbegin(); it != levels.rend(); ++it)
+    h.points.push_back(std::move(it->points));
   for (auto it = P.rbegin(); it != P.rend(); ++it) h.prolongations.push_back(std::move(*it));
   h.colours.assign(colours.rbegin(), colours.rend());
   return h;
