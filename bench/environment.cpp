@@ -37,11 +37,18 @@ std::string hostname() {
 
 }  // namespace
 
-nlohmann::json environment_json(int threads) {
+nlohmann::json environment_json(int threads, const nlohmann::json& result) {
+  const nlohmann::json* system =
+      result.is_object() && result.contains("system") ? &result["system"] : nullptr;
+  return environment_json(threads,
+                          system && system->is_object() ? system->value("blas_threads", 0) : 0);
+}
+
+nlohmann::json environment_json(int threads, int blas_threads) {
   const int cores = int(std::thread::hardware_concurrency());
   // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the config
-  // asked for (that request is in "config.threads"); the flow caps OpenBLAS, under CHOLMOD, at
-  // the same count (solvers/blas_threads.h).
+  // asked for (that request is in "config.threads"); OpenBLAS, under CHOLMOD, ran with the count
+  // the flow chose (solvers/blas_threads.h).
   const int ran = runnable_threads(threads);
   const auto v = [](int a, int b, int c) {
     return std::to_string(a) + "." + std::to_string(b) + "." + std::to_string(c);
@@ -51,7 +58,7 @@ nlohmann::json environment_json(int threads) {
           {"cpu", cpu_model()},
           {"cores", cores},
           {"threads", ran},
-          {"blas_threads", ran},
+          {"blas_threads", blas_threads > 0 ? blas_threads : ran},
           {"hostname", hostname()},
           {"build", {{"type", MCFBENCH_BUILD_TYPE}, {"compiler", MCFBENCH_CXX_COMPILER}}},
           {"libraries",

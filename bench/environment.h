@@ -8,9 +8,13 @@
 
 namespace mcf {
 
-/// {"commit", "cpu", "cores", "threads", "hostname", "libraries": {...}, "build": {...}}
-/// "threads" is the parallelism the flow had: the request (0 = all) capped at the cores TBB uses.
-nlohmann::json environment_json(int threads);
+/// {"commit", "cpu", "cores", "threads", "blas_threads", "hostname", "libraries": {...},
+/// "build": {...}}. "threads" is the parallelism the flow had: the request (0 = all) capped at the
+/// cores TBB uses; "blas_threads" the OpenBLAS threads it ran CHOLMOD with (result
+/// "system.blas_threads"), the same as "threads" where not given.
+nlohmann::json environment_json(int threads, int blas_threads = 0);
+/// environment_json for a result that may hold "system.blas_threads".
+nlohmann::json environment_json(int threads, const nlohmann::json& result);
 /// Peak resident set size of this process (getrusage), in bytes.
 long long peak_memory_bytes();
 

@@ -116,7 +116,7 @@ void run_flow_into_folder(const FlowRequest& request) {
   // disk) leaves OUT as it was, whatever it held.
   try {
     outcome = run_staged(config, mesh, staging, line_seconds, frames);
-    outcome.result["environment"] = environment_json(config.threads);
+    outcome.result["environment"] = environment_json(config.threads, outcome.result);
     outcome.result["peak_memory_bytes"] = peak_memory_bytes();
     outcome.result["memory_estimate"] = memory.to_json();
     outcome.result["memory_budget"] = budget.to_json();

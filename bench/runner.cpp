@@ -169,7 +169,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
               {"config", p.cell.config},
               {"steps", json::array()}};
   }
-  result["environment"] = environment_json(config.threads);
+  result["environment"] = environment_json(config.threads, result);
   result["peak_memory_bytes"] = peak_per_cell ? cell_peak_memory_bytes() : peak_memory_bytes();
   result["peak_memory_scope"] = peak_per_cell ? "cell" : "process";
   if (!memory.is_null()) result["memory_estimate"] = std::move(memory);

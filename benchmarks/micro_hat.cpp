@@ -8,6 +8,7 @@
 #include "bases/surface_hierarchy.h"
 #include "bases/vertex_ordering.h"
 #include "datasets/mesh_spec.h"
+#include "solvers/blas_threads.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"
 #include "solvers/pcg_solver.h"
@@ -16,7 +17,10 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
+#include <map>
 #include <memory>
+#include <string>
+#include <thread>
 
 namespace mcf {
 namespace {
@@ -167,6 +171,53 @@ void BM_HatMultigridCycle(benchmark::State& state) {
   label(state, HatFixture::get());
 }
 BENCHMARK(BM_HatMultigridCycle)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace mcf
+
+namespace mcf {
+namespace {
+
+/// CHOLMOD's refactorization and solve of the hat system against OpenBLAS's thread count, at two
+/// sizes (Arg 0: the armadillo at 52k faces, 1: at 832k), so that a machine's own rule for
+/// `--blas-threads` can be read off (docs/benchmarks.md, "BLAS threads").
+void BM_CholmodBlasThreads(benchmark::State& state) {
+  static std::map<int, std::pair<SparseMatrix, Eigen::MatrixXd>> systems;
+  const int size = int(state.range(0));
+  auto it = systems.find(size);
+  if (it == systems.end()) {
+    const MeshSource m =
+        load_mesh_spec(size == 0 ? "cgal:armadillo" : "cgal:armadillo@faces=832000");
+    const HatBasis basis(m.mesh);
+    SparseMatrix A = basis.mass() + 1e-3 * basis.stiffness();
+    Eigen::MatrixXd B;
+    symmetric_multiply(basis.mass(), m.mesh.vertices, B);
+    it = systems.emplace(size, std::make_pair(std::move(A), std::move(B))).first;
+  }
+  const ScopedBlasThreads blas(int(state.range(1)));
+  CholmodSolver solver;
+  solver.set_matrix(it->second.first);  // symbolic analysis outside the timed loop
+  Eigen::MatrixXd X;
+  for (auto _ : state) {
+    solver.set_matrix(it->second.first);
+    solver.solve(it->second.second, X);
+  }
+  state.counters["unknowns"] = double(it->second.first.rows());
+  state.counters["blas_threads"] = double(blas_threads());
+  state.counters["auto"] =
+      double(auto_blas_threads(int(std::thread::hardware_concurrency()), it->second.first.rows()));
+}
+
+void blas_thread_args(benchmark::internal::Benchmark* b) {
+  const int cores = int(std::thread::hardware_concurrency());
+  for (int size : {0, 1})
+    for (int t = 1; t <= cores; t *= 2) b->Args({size, t});
+}
+BENCHMARK(BM_CholmodBlasThreads)
+    ->Apply(blas_thread_args)
+    ->ArgNames({"size", "blas"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace mcf

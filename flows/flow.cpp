@@ -216,6 +216,7 @@ class FlowRun {
   FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::json& result);
 
   const Positions& vertices() const { return V_; }
+  Eigen::Index dimension() const { return basis_->dimension(); }
   /// Makes step `step`; false when a stop rule ends the flow there (result["stop"] says why).
   bool advance(int step);
   /// result["stop"] (if no rule stopped the flow) and result["steps"]; the final mesh.
@@ -471,8 +472,10 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
   tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
                                   std::size_t(threads));
-  // CHOLMOD's BLAS has its own pool: capped alike, at what TBB can run (environment.blas_threads).
-  const ScopedBlasThreads blas(runnable_threads(config.threads));
+  // CHOLMOD's BLAS has its own pool: capped at what TBB can run while the flow is set up, then at
+  // the count for this system (blas_threads or auto_blas_threads; environment.blas_threads).
+  const int runnable = runnable_threads(config.threads);
+  const ScopedBlasThreads setup_blas(runnable);
 
   validate_flow_mesh(config, source.report, source.spec);
   FlowOutcome out;
@@ -481,6 +484,10 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   out.result["config"] = to_json(config);
   out.result["mesh"] = mesh_json(source);
   FlowRun flow(config, source, out.result);
+  const int blas_threads = config.blas_threads > 0 ? std::min(config.blas_threads, runnable)
+                                                   : auto_blas_threads(runnable, flow.dimension());
+  const ScopedBlasThreads blas(blas_threads);
+  out.result["system"]["blas_threads"] = blas_threads;
   if (observer.on_step) observer.on_step(0, 0.0, flow.vertices());
   for (int step = 1; step <= config.steps; ++step) {
     if (!flow.advance(step)) break;

@@ -49,6 +49,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   c.steps = int(r.get_integer("steps", c.steps, 0, 100000000));
   c.normalize_area = r.get_bool("normalize_area", c.normalize_area);
   c.threads = int(r.get_integer("threads", c.threads, 0, 4096));
+  c.blas_threads = int(r.get_integer("blas_threads", c.blas_threads, 0, 4096));
   c.save_every = int(r.get_integer("save_every", c.save_every, 0, 100000000));
   r.finish();
   if (c.solver.tolerance < 0) c.solver.tolerance = c.solver.name == "multigrid" ? 0.0 : 1e-10;
@@ -83,6 +84,7 @@ nlohmann::json to_json(const FlowConfig& c) {
           {"steps", c.steps},
           {"normalize_area", c.normalize_area},
           {"threads", c.threads},
+          {"blas_threads", c.blas_threads},
           {"save_every", c.save_every}};
 }
 

@@ -49,7 +49,10 @@ struct FlowConfig {
   int steps = 10;
   bool normalize_area = false;  ///< unit area, centroid at origin, before and after every step
   int threads = 0;              ///< 0 = all cores
-  int save_every = 0;           ///< write frame_NNNN.ply every K steps (0 = never)
+  /// OpenBLAS threads under CHOLMOD: 0 = auto (auto_blas_threads, solvers/blas_threads.h), else
+  /// this many, at most `threads`.
+  int blas_threads = 0;
+  int save_every = 0;  ///< write frame_NNNN.ply every K steps (0 = never)
 };
 
 /// Reads a flow config strictly (unknown keys, wrong types, out-of-range values are errors that

@@ -20,4 +20,9 @@ int blas_threads() {
   return openblas_get_num_threads();
 }
 
+int auto_blas_threads(int threads, long long dimension) {
+  if (dimension < kBlasThreadsFromDimension) return 1;
+  return threads < 1 ? 1 : (threads < kMaxAutoBlasThreads ? threads : kMaxAutoBlasThreads);
+}
+
 }  // namespace mcf

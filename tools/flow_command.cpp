@@ -11,7 +11,7 @@ namespace mcf {
 namespace {
 
 struct FlowArgs {
-  std::string config_file, out, max_memory;
+  std::string config_file, out, max_memory, blas_threads;
   // Every flag maps to one key of the flow config; only flags given on the command line are
   // set, so --config FILE supplies the rest.
   std::string mesh, flow, basis, mass, tracking, cube, stabilization, solver, preconditioner, cycle,
@@ -68,6 +68,9 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
   cmd.add_flag("--normalize-area", args.normalize_area,
                "Unit total area, centroid at the origin, before and after every step");
   cmd.add_option("--threads", args.threads, "Worker threads (0 = all cores, default)");
+  cmd.add_option("--blas-threads", args.blas_threads,
+                 "OpenBLAS threads under CHOLMOD: auto (default: one below 20000 unknowns, else "
+                 "up to 4) | N (at most --threads)");
   cmd.add_option("--save-every", args.save_every,
                  "Write OUT/frame_NNNNN.ply every K steps (0 = never)");
   cmd.add_option("--max-memory", args.max_memory,
@@ -110,6 +113,21 @@ FlowRequest flow_request(const CLI::App& cmd, const FlowArgs& args) {
   set("--steps", "steps", args.steps);
   set("--normalize-area", "normalize_area", args.normalize_area);
   set("--threads", "threads", args.threads);
+  if (cmd.count("--blas-threads") > 0) {
+    int n = 0;
+    if (args.blas_threads != "auto") {
+      std::size_t used = 0;
+      try {
+        n = std::stoi(args.blas_threads, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != args.blas_threads.size() || n < 1 || n > 4096)
+        throw CLI::ValidationError("--blas-threads", "expected auto or a count 1..4096, got \"" +
+                                                         args.blas_threads + "\"");
+    }
+    r.settings.emplace_back("blas_threads", n);
+  }
   set("--save-every", "save_every", args.save_every);
   return r;
 }

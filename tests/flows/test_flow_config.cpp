@@ -1,3 +1,4 @@
+#include "core/parallel.h"
 #include "datasets/mesh_spec.h"
 #include "flows/config_reader.h"
 #include "flows/flow.h"
@@ -127,6 +128,40 @@ TEST(FlowConfig, ThreadsCapTheBlasUnderCholmodForTheFlow) {
     const ScopedBlasThreads none(0);  // 0: leave the cap alone
     EXPECT_EQ(blas_threads(), before);
   }
+}
+
+TEST(FlowConfig, BlasThreadsAutoFollowsTheSizeAndAGivenCountIsCappedAtThreads) {
+  // The rule: one thread for a small system, up to four for a large one, never more than TBB's.
+  EXPECT_EQ(auto_blas_threads(16, kBlasThreadsFromDimension - 1), 1);
+  EXPECT_EQ(auto_blas_threads(16, kBlasThreadsFromDimension), kMaxAutoBlasThreads);
+  EXPECT_EQ(auto_blas_threads(2, 1000000), 2);
+  EXPECT_EQ(auto_blas_threads(0, 1000000), 1);
+  const ScopedBlasThreads two(2);
+  if (blas_threads() < 2 || runnable_threads(2) < 2)
+    GTEST_SKIP() << "one thread runs on this machine";
+  auto ran = [](const json& j) {
+    const FlowConfig c = flow_config_from_json(j, "cfg.json");
+    std::vector<int> seen;
+    FlowObserver observer;
+    observer.on_step = [&](int step, double, const Positions&) {
+      if (step > 0) seen.push_back(blas_threads());
+    };
+    const FlowOutcome o = run_flow(c, load_mesh_spec(c.mesh), observer);
+    EXPECT_EQ(o.result["system"]["blas_threads"], seen.at(0));
+    return seen.at(0);
+  };
+  // 642 unknowns: auto gives one thread, however many may run.
+  EXPECT_EQ(ran(json{{"mesh", "icosphere:level=3"}, {"steps", 1}, {"threads", 2}}), 1);
+  EXPECT_EQ(
+      ran(json{{"mesh", "icosphere:level=3"}, {"steps", 1}, {"threads", 2}, {"blas_threads", 2}}),
+      2);
+  EXPECT_EQ(
+      ran(json{{"mesh", "icosphere:level=3"}, {"steps", 1}, {"threads", 1}, {"blas_threads", 2}}),
+      1);
+  // 40962 unknowns: both threads.
+  EXPECT_EQ(ran(json{{"mesh", "icosphere:level=6"}, {"steps", 1}, {"threads", 2}}), 2);
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"blas_threads", -1}}).find("blas_threads"),
+            std::string::npos);
 }
 
 }  // namespace
