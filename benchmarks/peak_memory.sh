@@ -31,6 +31,7 @@ for mesh in cgal:armadillo cgal:armadillo@faces=200000 cgal:armadillo@faces=8320
   echo "peak_memory.sh: $mesh" >&2
   flow --mesh "$mesh" --basis hat --solver cholmod
   flow --mesh "$mesh" --basis hat --solver pcg
+  flow --mesh "$mesh" --basis hat --solver multigrid
   for depth in 6 7 8; do
     flow --mesh "$mesh" --basis octree --depth $depth --solver multigrid
     flow --mesh "$mesh" --basis octree --depth $depth --solver cholmod

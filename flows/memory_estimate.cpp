@@ -23,6 +23,9 @@ constexpr double kRebuiltPerVertex = 697;           // mesh, clipped pieces of t
 constexpr double kRebuiltPerFunction = 1821;        // as tracked, plus the pattern built each step
 constexpr double kOctreeCholmodPerFunction = 1154;  // the factor of the band's 27-point graph
 constexpr double kDensePerUnknown2 = 16;            // the dense matrix and its LLT, 8 bytes each
+// The hat basis's surface hierarchy with the multigrid's levels and buffers (the armadillo at 832k
+// faces: 627-664 MiB against 449 MiB with PCG).
+constexpr double kHatMultigridPerVertex = 480;
 
 /// About this many finest functions per (h^2 of surface): measured 2.84-3.02 on the armadillo,
 /// the elephant and spheres at depths 6 to 9.
@@ -103,7 +106,12 @@ MemoryEstimate estimate_flow_memory(const FlowConfig& config, const FlowSizes& s
     e.dimension = sizes.vertices;
     e.mesh_bytes = kHatPerVertex * sizes.vertices;
   }
-  if (cholmod)
+  const SolverConfig& solver = config.solver;
+  const bool multigrid =
+      solver.name == "multigrid" || (solver.name == "pcg" && solver.preconditioner == "multigrid");
+  if (config.basis != "octree" && multigrid)
+    e.solver_bytes = kHatMultigridPerVertex * e.dimension;
+  else if (cholmod)
     e.solver_bytes =
         (config.basis == "octree" ? kOctreeCholmodPerFunction : kHatCholmodPerVertex) * e.dimension;
   else if (config.solver.name == "dense")

@@ -320,6 +320,7 @@ TEST(Cli, AFlowTooLargeForTheMemoryIsRefusedWithItsEstimate) {
 TEST(Cli, MemoryEstimateIsWithinTwiceTheMeasuredPeak) {
   for (const std::string args :
        {"--mesh sphere:vertices=60000 --basis hat --solver cholmod",
+        "--mesh sphere:vertices=60000 --basis hat --solver multigrid",
         "--mesh sphere:vertices=20000 --basis octree --depth 7 --solver multigrid",
         "--mesh sphere:vertices=20000 --basis octree --depth 7 --tracking rebuilt --solver "
         "multigrid"}) {
