@@ -14,6 +14,9 @@
 //                              pattern) + W-cycle + evaluate
 //   BM_Step_HatCholmod/threads:2  hat update + M+δK + CHOLMOD refactorize + solve
 //                              (symbolic analysis outside the loop)
+//   BM_Step_HatMultigrid/threads:2/cycle:C  the hat basis with its surface hierarchy: update +
+//                              set_matrix_sum (Galerkin values) + predicted start + one
+//                              W(5,5)-cycle (C = 0) or two V(2,2)-cycles (C = 1) + evaluate
 // Ratios: reports/summarize_micro.py turns the JSON into the tables of docs/benchmarks.md.
 //
 // Fixtures are large (several GB at depth 9 on 832k faces), so only one lives at a time: taking
@@ -686,6 +689,69 @@ void BM_Step_HatCholmod(benchmark::State& state) {
 BENCHMARK(BM_Step_HatCholmod)
     ->ArgName("threads")
     ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
+
+void BM_Step_HatMultigrid(benchmark::State& state) {
+  const Case c = arm_case();
+  auto& f = acquire<HatStepFixture>("hat-multigrid-step:" + c.spec, [c] {
+    auto h = std::make_unique<HatStepFixture>();
+    h->source = &mesh(c.spec);
+    h->basis = std::make_unique<HatBasis>(h->source->mesh, MassKind::consistent,
+                                          SurfaceHierarchyOptions{});
+    return h;
+  });
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              std::size_t(state.range(0)));
+  HatBasis& basis = *f.basis;
+  MultigridOptions o;
+  const bool v = state.range(1) == 1;
+  o.cycle = v ? MultigridCycle::V : MultigridCycle::W;
+  o.cycles = v ? 2 : 1;
+  o.pre_smooth = o.post_smooth = v ? 2 : 5;
+  MultigridSolver solver(o);
+  HierarchyView keyed{basis.prolongations(), basis.colours(), new_pattern_key()};
+  const Coefficients x = basis.initial_coefficients();
+  // The Galerkin pattern outside the loop, as the flow builds it once.
+  solver.set_matrix_sum(MatrixSum(1.0, basis.mass(), c.dt, basis.stiffness()), keyed);
+  Eigen::MatrixXd B, X;
+  double t_update = 0, t_galerkin = 0, t_solve = 0;
+  const auto step = [&](bool timed) {
+    auto t0 = Clock::now();
+    basis.update(x, true, true);
+    auto t1 = Clock::now();
+    const MatrixSum sum(1.0, basis.mass(), c.dt, basis.stiffness());
+    solver.set_matrix_sum(sum, keyed);
+    auto t2 = Clock::now();
+    symmetric_multiply(basis.mass(), x, B);
+    const PredictedStart start = predicted_start(sum, B, x, x);
+    X = x + start.increment;
+    solver.solve(B, X);
+    Positions vtx = basis.evaluate_vertices(X);
+    benchmark::DoNotOptimize(vtx.data());
+    auto t3 = Clock::now();
+    if (!timed) return;
+    t_update += std::chrono::duration<double>(t1 - t0).count();
+    t_galerkin += std::chrono::duration<double>(t2 - t1).count();
+    t_solve += std::chrono::duration<double>(t3 - t2).count();
+  };
+  step(false);  // warm-up (see "Warm-up" at the top)
+  timed_steps(state, step);
+  const double n = double(state.iterations());
+  state.counters["update_ms"] = 1e3 * t_update / n;
+  state.counters["set_matrix_ms"] = 1e3 * t_galerkin / n;
+  state.counters["solve_ms"] = 1e3 * t_solve / n;
+  state.counters["threads"] = double(state.range(0));
+  state.counters["mg_levels"] = double(solver.levels());
+  state.counters["vertices"] = double(f.source->mesh.num_vertices());
+  state.counters["faces"] = double(f.source->mesh.num_faces());
+  state.SetLabel(c.spec);
+}
+BENCHMARK(BM_Step_HatMultigrid)
+    ->ArgNames({"threads", "cycle"})
+    ->Args({2, 0})
+    ->Args({2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);
