@@ -48,7 +48,7 @@ std::vector<fs::path> json_files(const fs::path& dir) {
   return paths;
 }
 
-/// A plan's temporary file (`NAME.json.tmp.PID`, see write_file_atomic) in `plans`, if any.
+/// A plan's temporary file (`NAME.json.tmp.HOST.PID`, see write_file_atomic) in `plans`, if any.
 std::optional<fs::path> temporary_plan(const fs::path& plans) {
   if (!fs::is_directory(plans)) return std::nullopt;
   for (const auto& entry : fs::directory_iterator(plans))
