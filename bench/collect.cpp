@@ -218,8 +218,8 @@ void note_lacking_distances(const std::string& name, const StudyResults& g,
   if (lacking.empty()) return;
   s["without_reference_distance"] = lacking;
   std::printf(
-      "%s: %zu cells lack their reference distance (rerun `mcfbench run` without --shard "
-      "to add them)\n",
+      "%s: %zu cells lack their reference distance (`mcfbench run CONFIG --distances-only` "
+      "adds them)\n",
       name.c_str(), lacking.size());
 }
 

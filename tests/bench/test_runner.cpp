@@ -10,8 +10,10 @@
 
 #include "bench_test_util.h"
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <iterator>
 #include <map>
 #include <set>
 #include <thread>
@@ -140,6 +142,51 @@ TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
   for (int i : {1, 2})
     EXPECT_EQ(read_json(plans[size_t(i)].file)["reference_distance"].size(), 1u) << i;
   EXPECT_EQ(run_experiment(e, o).distances, 0);  // nothing stale any more
+}
+
+TEST(Runner, DistancesOnlyRunsNoCellAndWritesNoPlan) {
+  // After an array that lost a task: shard 0 finished (cells 0 and 2), shard 1's cell 1 is
+  // missing. A distances-only pass adds cell 2's distance to cell 0 and leaves cell 1 missing.
+  const fs::path out = fresh_dir("distances_only");
+  const json j = {
+      {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
+      {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
+      {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  o.shard_count = 2;
+  o.shard_index = 0;
+  ASSERT_EQ(run_experiment(e, o).ran, 2);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  // As if cell 2 had finished before its reference cell: its distance is not there yet.
+  json cell2 = read_json(plans[2].file);
+  cell2.erase("reference_distance");
+  cell2.erase("reference_cell");
+  write_text(plans[2].file, cell2.dump());
+  const auto plans_before = fs::directory_iterator(out / kPlanFolder);
+  const size_t plan_files = size_t(std::distance(plans_before, fs::directory_iterator{}));
+
+  RunOptions d;
+  d.out_dir = out.string();
+  d.distances_only = true;
+  const RunSummary s = run_experiment(e, d);
+  EXPECT_EQ(s.ran, 0);
+  EXPECT_EQ(s.skipped, 2);
+  EXPECT_EQ(s.not_run, 1);
+  EXPECT_EQ(s.distances, 1);
+  EXPECT_FALSE(fs::exists(plans[1].file)) << "a distances-only pass ran a cell";
+  EXPECT_EQ(read_json(plans[2].file)["reference_distance"].size(), 1u);
+  EXPECT_EQ(
+      size_t(std::distance(fs::directory_iterator(out / kPlanFolder), fs::directory_iterator{})),
+      plan_files)
+      << "a distances-only pass wrote a plan";
+  EXPECT_EQ(run_experiment(e, d).distances, 0);  // nothing left to add
+  // Into a folder that does not exist: nothing to add, nothing created.
+  d.out_dir = (out / "none").string();
+  EXPECT_EQ(run_experiment(e, d).not_run, 3);
+  EXPECT_FALSE(fs::exists(out / "none"));
 }
 
 TEST(Runner, ACellErrorIsRecordedAndTheRunGoesOn) {
