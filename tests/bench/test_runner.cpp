@@ -722,6 +722,60 @@ TEST(RunnerCli, ShardsThenCollect) {
   EXPECT_EQ(read_json(dir / "dup.json")["duplicates"].size(), 1u);
 }
 
+TEST(RunnerCli, ConcurrentShardsIntoOneFolderKeepEveryCellAndPlan) {
+  // The tasks of a job array write into one folder at once, each its own cells and plan; a shard
+  // run twice at once (an array submitted again while the first still ran) writes the same files
+  // twice. Neither may lose or damage a cell or a plan: every file is published by a rename of a
+  // temporary file named by its machine and process.
+  const fs::path dir = fresh_dir("concurrent_shards");
+  write_text(dir / "c.json", R"({
+    "name": "concurrent",
+    "defaults": {"mesh": "icosphere:level=3", "steps": 15, "threads": 1},
+    "axes": {"dt": [0.001, 0.002, 0.003, 0.004, 0.005, 0.006]},
+    "metrics": {"frames": [15], "reference": {"dt": 0.001}, "distance_samples": 200}})");
+  std::string all;
+  int n = 0;
+  for (const char* shard : {"0/3", "1/3", "2/3", "1/3"}) {
+    const std::string name = "process" + std::to_string(n++);
+    all += "(" + std::string(MCFBENCH_BINARY) + " run c.json --out out --shard " + shard + " >" +
+           name + ".out 2>&1; echo $? >" + name + ".rc) & ";
+  }
+  const std::string cmd = "cd '" + dir.string() + "' && { " + all + "wait; }";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() != ".rc") continue;
+    EXPECT_EQ(slurp(entry.path()), "0\n")
+        << entry.path() << ": " << slurp(fs::path(entry.path()).replace_extension(".out"));
+  }
+  // The distances to a reference cell another shard ran, then the check.
+  Command c = mcfbench("run c.json --out out --distances-only", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  c = mcfbench("collect out", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("6 cells found of 6, 0 missing, 0 duplicated, 0 errored"), std::string::npos)
+      << c.out;
+  EXPECT_EQ(c.out.find("lack their reference distance"), std::string::npos) << c.out;
+  const auto results = result_files(dir / "out");
+  ASSERT_EQ(results.size(), 6u);
+  for (const fs::path& r : results) EXPECT_EQ(read_json(r)["status"], "ok") << r;
+  std::set<std::string> plans;
+  for (const auto& entry : fs::directory_iterator(dir / "out" / kPlanFolder)) {
+    plans.insert(entry.path().filename().string());
+    EXPECT_EQ(read_json(entry.path())["cells"].size(), 6u) << entry.path();
+  }
+  ASSERT_EQ(plans.size(), 3u);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(std::count_if(plans.begin(), plans.end(),
+                            [&](const std::string& p) {
+                              return p.find(".shard-" + std::to_string(i) + "-of-3.json") !=
+                                     std::string::npos;
+                            }),
+              1)
+        << i;
+  for (const auto& entry : fs::recursive_directory_iterator(dir / "out"))
+    EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
+}
+
 TEST(RunnerCli, ConfigErrorsNameFileAndKeyAndWriteNothing) {
   const fs::path dir = fresh_dir("cfgerr");
   const std::vector<std::pair<std::string, std::string>> cases = {
