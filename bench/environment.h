@@ -11,6 +11,8 @@ namespace mcf {
 /// {"commit", "cpu", "cores", "threads", "hostname", "libraries": {...}, "build": {...}}
 /// "threads" is the parallelism the flow had: the request (0 = all) capped at the cores TBB uses.
 nlohmann::json environment_json(int threads);
+/// The source tree the binary was built from (its reports/ and bench/configs/), as CMake saw it.
+std::string source_dir();
 /// Peak resident set size of this process (getrusage), in bytes.
 long long peak_memory_bytes();
 
