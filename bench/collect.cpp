@@ -48,7 +48,7 @@ std::vector<fs::path> json_files(const fs::path& dir) {
   return paths;
 }
 
-/// A plan's temporary file (`NAME.json.tmp.PID`, see write_file_atomic) in `plans`, if any.
+/// A plan's temporary file (`NAME.json.tmp.HOST.PID`, see write_file_atomic) in `plans`, if any.
 std::optional<fs::path> temporary_plan(const fs::path& plans) {
   if (!fs::is_directory(plans)) return std::nullopt;
   for (const auto& entry : fs::directory_iterator(plans))
@@ -218,8 +218,8 @@ void note_lacking_distances(const std::string& name, const StudyResults& g,
   if (lacking.empty()) return;
   s["without_reference_distance"] = lacking;
   std::printf(
-      "%s: %zu cells lack their reference distance (rerun `mcfbench run` without --shard "
-      "to add them)\n",
+      "%s: %zu cells lack their reference distance (`mcfbench run CONFIG --distances-only` "
+      "adds them)\n",
       name.c_str(), lacking.size());
 }
 

@@ -74,6 +74,10 @@ nlohmann::json environment_json(int threads, int blas_threads) {
             {"blas", "openblas"}}}};
 }
 
+std::string source_dir() {
+  return MCFBENCH_SOURCE_DIR;
+}
+
 long long peak_memory_bytes() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);

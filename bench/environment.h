@@ -15,6 +15,8 @@ namespace mcf {
 nlohmann::json environment_json(int threads, int blas_threads = 0);
 /// environment_json for a result that may hold "system.blas_threads".
 nlohmann::json environment_json(int threads, const nlohmann::json& result);
+/// The source tree the binary was built from (its reports/ and bench/configs/), as CMake saw it.
+std::string source_dir();
 /// Peak resident set size of this process (getrusage), in bytes.
 long long peak_memory_bytes();
 

@@ -71,6 +71,7 @@ int run_experiment_with_progress(const RunRequest& request) {
   o.out_dir =
       !request.out.empty() ? request.out : "results/" + e.name + (request.quick ? "-quick" : "");
   o.force = request.force;
+  o.distances_only = request.distances_only;
   o.threads = request.threads;
   o.max_memory = request.max_memory;
   RunProgress progress(line_seconds);
@@ -91,6 +92,14 @@ int run_experiment_with_progress(const RunRequest& request) {
                  signal_name(stop.signal).c_str(), stop.done, stop.summary.in_shard,
                  stop.summary.ran, stop.summary.skipped, plan.c_str());
     return 128 + stop.signal;  // as a shell reports a process the signal ended
+  }
+  if (request.distances_only) {
+    std::printf(
+        "%s: %d cells, %d in shard %d/%d: %d with a result, %d without (not run: "
+        "--distances-only), %d reference distances added; results in %s\n",
+        e.name.c_str(), s.total, s.in_shard, o.shard_index, o.shard_count, s.skipped, s.not_run,
+        s.distances, o.out_dir.c_str());
+    return 0;
   }
   std::printf(
       "%s: %d cells, %d in shard %d/%d: %d ran%s, %d skipped, %d errors, %d reference "

@@ -11,11 +11,12 @@ namespace mcf {
 struct RunRequest {
   std::string config;  ///< the experiment config (JSON)
   std::string out;     ///< results folder; empty: results/NAME (results/NAME-quick with quick)
-  std::string shard = "0/1";  ///< "i/n": only cells with index % n == i
-  bool force = false;         ///< rerun cells whose result file exists
-  bool quick = false;         ///< the config's "quick" variant
-  int threads = -1;           ///< >= 0 overrides every cell's thread count
-  std::string max_memory;     ///< memory budget: "" = what is available, "none", or a size
+  std::string shard = "0/1";    ///< "i/n": only cells with index % n == i
+  bool force = false;           ///< rerun cells whose result file exists
+  bool quick = false;           ///< the config's "quick" variant
+  int threads = -1;             ///< >= 0 overrides every cell's thread count
+  bool distances_only = false;  ///< run no cell, only add missing reference distances
+  std::string max_memory;       ///< memory budget: "" = what is available, "none", or a size
 };
 
 /// Runs the request's cells; returns 1 when a cell errored, else 0. A config error (or a bad

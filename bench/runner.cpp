@@ -71,16 +71,6 @@ json read_json_file(const std::string& path) {
   }
 }
 
-/// A cell counts as done on a rerun when its file holds a result that did not error: an
-/// errored cell (a mesh that was missing, an exception) is retried, and so is a file that does
-/// not parse (written by something else than the atomic writer), which is replaced.
-bool finished(const std::string& file) {
-  if (!fs::exists(file)) return false;
-  std::ifstream in(file);
-  const json r = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return r.is_object() && r.contains("status") && r["status"].is_string() && r["status"] != "error";
-}
-
 json cell_json(const ExperimentConfig& e, const CellPlan& p) {
   return {{"index", p.cell.index},
           {"key", p.key},
@@ -205,6 +195,38 @@ json reference_distances(const ExperimentConfig& e, const fs::path& out, const C
   return list;
 }
 
+/// Adds the reference distances the shard's finished cells lack, or whose cell or reference ran
+/// again now (`ran_now`, by hash). A stop request between two cells throws Interrupt. Returns how
+/// many cells got their distances.
+int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
+                            const std::vector<CellPlan>& plans,
+                            const std::set<std::string>& ran_now,
+                            const std::function<int()>& stop_requested) {
+  const fs::path out(o.out_dir);
+  int added = 0;
+  for (const CellPlan& p : plans) {
+    if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
+    if (const int signal = stop_requested()) throw Interrupt{signal};
+    const CellPlan* ref = reference_for(e, plans, p);
+    if (!ref || !fs::exists(p.file) || !fs::exists(ref->file)) continue;
+    json result = read_json_file(p.file);
+    const bool stale =
+        ran_now.count(p.hash) || ran_now.count(ref->hash) || !result.contains("reference_distance");
+    if (!stale || result.value("status", "") == "error") continue;
+    const json ref_result = read_json_file(ref->file);
+    if (ref_result.value("status", "") == "error") continue;
+    result["reference_distance"] = reference_distances(e, out, p, *ref);
+    result["reference_cell"] = {{"index", ref->cell.index},
+                                {"hash", ref->hash},
+                                {"key", ref->key},
+                                {"assignment", ref->cell.assignment},
+                                {"repetition", ref->cell.repetition}};
+    write_file_atomic(p.file, result.dump(1) + "\n");
+    ++added;
+  }
+  return added;
+}
+
 }  // namespace
 
 RunStopped::RunStopped(int signal_number, const RunSummary& run_summary, int cells_done)
@@ -223,6 +245,13 @@ const MeshSource& MeshCache::get(const std::string& spec) {
 std::string code_version() {
   static const std::string v = environment_json(1).value("commit", "unknown");
   return v;
+}
+
+bool cell_finished(const std::string& file) {
+  if (!fs::exists(file)) return false;
+  std::ifstream in(file);
+  const json r = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return r.is_object() && r.contains("status") && r["status"].is_string() && r["status"] != "error";
 }
 
 bool in_shard(int index, int shard_index, int shard_count) {
@@ -347,8 +376,9 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   };
   // A cell too large for the memory is refused from its spec's sizes before any mesh is built.
   // A spec that does not parse is left to plan_cells, which names the config and the cell.
+  // With distances_only no cell runs, so none is checked.
   for (const Cell& c : e.cells) {
-    if (!in_shard(c.index, o.shard_index, o.shard_count)) continue;
+    if (o.distances_only || !in_shard(c.index, o.shard_index, o.shard_count)) continue;
     MeshSpecRequest request;
     try {
       request = parse_mesh_spec(c.flow.mesh);
@@ -368,7 +398,8 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
 
   // And from its mesh's sizes once the meshes are loaded: the cells still to run.
   for (const CellPlan& p : plans)
-    if (in_shard(p.cell.index, o.shard_index, o.shard_count) && (o.force || !finished(p.file))) {
+    if (!o.distances_only && in_shard(p.cell.index, o.shard_index, o.shard_count) &&
+        (o.force || !cell_finished(p.file))) {
       const MeshSource& source = meshes.get(p.cell.flow.mesh);
       checked_memory_estimate(p.cell.flow, mesh_sizes(p.cell.flow, source.mesh, source.analytic),
                               budget, cell_name(p.cell) + ", mesh " + p.cell.flow.mesh);
@@ -378,6 +409,18 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   s.total = int(plans.size());
   for (const auto& p : plans) s.in_shard += in_shard(p.cell.index, o.shard_index, o.shard_count);
   const fs::path out(o.out_dir);
+  auto stop_requested = [&] { return o.stop_requested ? o.stop_requested() : 0; };
+  if (o.distances_only) {
+    for (const CellPlan& p : plans)
+      if (in_shard(p.cell.index, o.shard_index, o.shard_count))
+        ++(cell_finished(p.file) ? s.skipped : s.not_run);
+    try {
+      if (with_reference) s.distances = add_reference_distances(e, o, plans, {}, stop_requested);
+    } catch (const Interrupt& stop) {
+      throw RunStopped(stop.signal, s, s.skipped);
+    }
+    return s;
+  }
   fs::create_directories(out);
   // Before the first cell: a run killed at any point leaves the list of cells it owed, which
   // `collect` checks the results against (without it an empty folder looked complete).
@@ -385,14 +428,13 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
                     run_plan(e, plans, o.shard_index, o.shard_count).dump(1) + "\n");
   std::set<std::string> ran_now;
   int done = 0;
-  auto stop_requested = [&] { return o.stop_requested ? o.stop_requested() : 0; };
   for (const CellPlan& p : plans) {
     if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
     if (const int signal = stop_requested()) throw RunStopped(signal, s, done);
     CellReport report;
     report.plan = &p;
     report.total = s.in_shard;
-    if (!o.force && finished(p.file)) {
+    if (!o.force && cell_finished(p.file)) {
       ++s.skipped;
       report.skipped = true;
       report.status = "skipped";
@@ -438,28 +480,12 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   // Distances to the reference flow once the cells are there. Only this shard's cells: a cell
   // file then has exactly one writer even when shards run at once on a shared file system.
   // A cell whose reference belongs to a shard that had not finished gets its distances on
-  // the next run that includes it (e.g. one unsharded `mcfbench run` after a Slurm array:
-  // every cell is skipped, the missing distances are filled in).
+  // the next run that includes it (e.g. `mcfbench run --distances-only` after a Slurm array).
   if (with_reference) {
-    for (const CellPlan& p : plans) {
-      if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
-      if (const int signal = stop_requested()) throw RunStopped(signal, s, done);
-      const CellPlan* ref = reference_for(e, plans, p);
-      if (!ref || !fs::exists(p.file) || !fs::exists(ref->file)) continue;
-      json result = read_json_file(p.file);
-      const bool stale = ran_now.count(p.hash) || ran_now.count(ref->hash) ||
-                         !result.contains("reference_distance");
-      if (!stale || result.value("status", "") == "error") continue;
-      const json ref_result = read_json_file(ref->file);
-      if (ref_result.value("status", "") == "error") continue;
-      result["reference_distance"] = reference_distances(e, out, p, *ref);
-      result["reference_cell"] = {{"index", ref->cell.index},
-                                  {"hash", ref->hash},
-                                  {"key", ref->key},
-                                  {"assignment", ref->cell.assignment},
-                                  {"repetition", ref->cell.repetition}};
-      write_file_atomic(p.file, result.dump(1) + "\n");
-      ++s.distances;
+    try {
+      s.distances = add_reference_distances(e, o, plans, ran_now, stop_requested);
+    } catch (const Interrupt& stop) {
+      throw RunStopped(stop.signal, s, done);
     }
   }
   return s;

@@ -57,6 +57,10 @@ struct RunOptions {
   int shard_index = 0, shard_count = 1;
   bool force = false;
   int threads = -1;  ///< >= 0 overrides every cell's "threads" (part of the config, so of the key)
+  /// Runs no cell and writes no plan: only adds the reference distances (metrics.reference) that
+  /// the finished cells of the shard lack, as after a job array whose tasks could not see each
+  /// other's cells. Cells without a finished result are counted in RunSummary::not_run.
+  bool distances_only = false;
   /// The memory budget (bench/memory_budget.h): "" = what is available, "none", or a size. A cell
   /// this shard would run whose estimated peak exceeds it stops the run before anything is written.
   std::string max_memory;
@@ -70,11 +74,16 @@ struct RunOptions {
 
 struct RunSummary {
   int total = 0, in_shard = 0, ran = 0, skipped = 0, errors = 0, distances = 0;
+  int not_run = 0;  ///< with distances_only: cells of the shard without a finished result
   int retried = 0;  ///< of `ran`: cells whose file held an error (or did not parse), run again
 };
 
 /// The code version stored in hashes: the git commit the binary was built from.
 std::string code_version();
+/// Whether a cell's result file counts as done on a rerun: it holds a result that did not error.
+/// A missing file, an errored cell and a file that does not parse (written by something else than
+/// the atomic writer) are not done: a rerun runs them.
+bool cell_finished(const std::string& file);
 /// Shard membership: cell index % n == i.
 bool in_shard(int index, int shard_index, int shard_count);
 /// Parses "i/n" (0 <= i < n); throws std::invalid_argument with a message otherwise.

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <unistd.h>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -13,6 +14,18 @@ namespace mcf {
 
 namespace fs = std::filesystem;
 
+std::string temporary_host_name() {
+  static const std::string name = [] {
+    char buffer[256] = {};
+    std::string host = ::gethostname(buffer, sizeof buffer - 1) == 0 ? buffer : "";
+    if (host.empty()) host = "localhost";
+    for (char& ch : host)
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_') ch = '_';
+    return host;
+  }();
+  return name;
+}
+
 int remove_stale_temporaries(const std::string& path) {
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -23,12 +36,19 @@ int remove_stale_temporaries(const std::string& path) {
   for (; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
-    const std::string digits = name.substr(prefix.size());
-    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    // HOST.PID, or PID alone (written before temporary files named their machine: this one's).
+    std::string digits = name.substr(prefix.size());
+    if (const auto dot = digits.rfind('.'); dot != std::string::npos) {
+      if (digits.substr(0, dot) != temporary_host_name()) continue;
+      digits = digits.substr(dot + 1);
+    }
+    if (digits.empty() || digits.size() > 9 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      continue;
     const pid_t pid = pid_t(std::stol(digits));
     // Only a process that is certainly gone (ESRCH): a live one (EPERM included) may be writing.
-    // The check is local, so on a shared file system a writer on another machine looks dead;
-    // that needs two writers of one file at once, which results never have (one per cell).
+    // The check is local, hence only this machine's files: on a shared file system a writer on
+    // another machine would look dead.
     if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
     std::error_code rm;
     if (fs::remove(it->path(), rm)) ++removed;
@@ -77,7 +97,8 @@ void write_file_atomic(const std::string& path, const std::string& content) {
                                target.parent_path().string() + ": " + ec.message());
   }
   remove_stale_temporaries(path);
-  const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
+  const fs::path tmp =
+      target.string() + ".tmp." + temporary_host_name() + "." + std::to_string(::getpid());
   // POSIX calls rather than a stream: the message names the cause the system gave (no space left
   // on device, read-only file system, quota exceeded), which a stream does not keep.
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);

@@ -13,6 +13,7 @@ namespace mcf {
 void add_flow_command(CLI::App& app, std::function<int()>& run);
 void add_mesh_info_command(CLI::App& app, std::function<int()>& run);
 void add_run_command(CLI::App& app, std::function<int()>& run);
+void add_submit_command(CLI::App& app, std::function<int()>& run);
 void add_expand_command(CLI::App& app, std::function<int()>& run);
 void add_collect_command(CLI::App& app, std::function<int()>& run);
 void add_compare_command(CLI::App& app, std::function<int()>& run);

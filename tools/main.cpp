@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   mcf::add_flow_command(app, run);
   mcf::add_mesh_info_command(app, run);
   mcf::add_run_command(app, run);
+  mcf::add_submit_command(app, run);
   mcf::add_expand_command(app, run);
   mcf::add_collect_command(app, run);
   mcf::add_compare_command(app, run);

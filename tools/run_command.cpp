@@ -19,19 +19,25 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
       "leaves no partial file. SIGINT or SIGTERM stops the run after the running step (exit 130 or "
       "143),\n"
       "dropping the running cell: rerun the same command to resume.\n"
-      "Slurm: sbatch --array=0-15 --wrap 'mcfbench run cfg.json --shard $SLURM_ARRAY_TASK_ID/16'\n"
-      "then `mcfbench collect results/NAME` checks that every cell is there (with "
-      "metrics.reference, first\n"
-      "run `mcfbench run cfg.json` once without --shard: every cell is skipped and the distances "
-      "to the\n"
-      "reference cells that other shards computed are added).\n"
+      "Slurm: `mcfbench submit` writes and submits the job array and a job that collects and "
+      "reports;\n"
+      "by hand: sbatch --array=0-15 --wrap 'mcfbench run cfg.json --shard "
+      "$SLURM_ARRAY_TASK_ID/16', then\n"
+      "(with metrics.reference) `mcfbench run cfg.json --distances-only` adds the distances to "
+      "reference\n"
+      "cells that other shards computed, and `mcfbench collect results/NAME` checks that every "
+      "cell is there.\n"
       "Config format: see bench/experiment_config.h and bench/configs/.");
   cmd->add_option("config", a->config, "Experiment config (JSON)")->required();
   cmd->add_option("--out", a->out,
                   "Results folder (default results/NAME, or results/NAME-quick with --quick)");
   cmd->add_option("--shard", a->shard,
                   "Run only cells with index % n == i (i/n, 0-based; default 0/1)");
-  cmd->add_flag("--force", a->force, "Rerun cells whose result file exists");
+  CLI::Option* force = cmd->add_flag("--force", a->force, "Rerun cells whose result file exists");
+  cmd->add_flag("--distances-only", a->distances_only,
+                "Run no cell: only add the reference distances the finished cells lack (after a "
+                "sharded run)")
+      ->excludes(force);
   cmd->add_flag("--quick", a->quick,
                 "Use the config's \"quick\" variant (small, minutes on 2 cores)");
   cmd->add_option("--threads", a->threads,

@@ -10,8 +10,10 @@
 
 #include "bench_test_util.h"
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <iterator>
 #include <map>
 #include <set>
 #include <thread>
@@ -140,6 +142,51 @@ TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
   for (int i : {1, 2})
     EXPECT_EQ(read_json(plans[size_t(i)].file)["reference_distance"].size(), 1u) << i;
   EXPECT_EQ(run_experiment(e, o).distances, 0);  // nothing stale any more
+}
+
+TEST(Runner, DistancesOnlyRunsNoCellAndWritesNoPlan) {
+  // After an array that lost a task: shard 0 finished (cells 0 and 2), shard 1's cell 1 is
+  // missing. A distances-only pass adds cell 2's distance to cell 0 and leaves cell 1 missing.
+  const fs::path out = fresh_dir("distances_only");
+  const json j = {
+      {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
+      {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
+      {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  o.shard_count = 2;
+  o.shard_index = 0;
+  ASSERT_EQ(run_experiment(e, o).ran, 2);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  // As if cell 2 had finished before its reference cell: its distance is not there yet.
+  json cell2 = read_json(plans[2].file);
+  cell2.erase("reference_distance");
+  cell2.erase("reference_cell");
+  write_text(plans[2].file, cell2.dump());
+  const auto plans_before = fs::directory_iterator(out / kPlanFolder);
+  const size_t plan_files = size_t(std::distance(plans_before, fs::directory_iterator{}));
+
+  RunOptions d;
+  d.out_dir = out.string();
+  d.distances_only = true;
+  const RunSummary s = run_experiment(e, d);
+  EXPECT_EQ(s.ran, 0);
+  EXPECT_EQ(s.skipped, 2);
+  EXPECT_EQ(s.not_run, 1);
+  EXPECT_EQ(s.distances, 1);
+  EXPECT_FALSE(fs::exists(plans[1].file)) << "a distances-only pass ran a cell";
+  EXPECT_EQ(read_json(plans[2].file)["reference_distance"].size(), 1u);
+  EXPECT_EQ(
+      size_t(std::distance(fs::directory_iterator(out / kPlanFolder), fs::directory_iterator{})),
+      plan_files)
+      << "a distances-only pass wrote a plan";
+  EXPECT_EQ(run_experiment(e, d).distances, 0);  // nothing left to add
+  // Into a folder that does not exist: nothing to add, nothing created.
+  d.out_dir = (out / "none").string();
+  EXPECT_EQ(run_experiment(e, d).not_run, 3);
+  EXPECT_FALSE(fs::exists(out / "none"));
 }
 
 TEST(Runner, ACellErrorIsRecordedAndTheRunGoesOn) {
@@ -673,6 +720,60 @@ TEST(RunnerCli, ShardsThenCollect) {
   c = mcfbench("collect s0 s1 s2 --out dup.json", dir);
   EXPECT_NE(c.status, 0);
   EXPECT_EQ(read_json(dir / "dup.json")["duplicates"].size(), 1u);
+}
+
+TEST(RunnerCli, ConcurrentShardsIntoOneFolderKeepEveryCellAndPlan) {
+  // The tasks of a job array write into one folder at once, each its own cells and plan; a shard
+  // run twice at once (an array submitted again while the first still ran) writes the same files
+  // twice. Neither may lose or damage a cell or a plan: every file is published by a rename of a
+  // temporary file named by its machine and process.
+  const fs::path dir = fresh_dir("concurrent_shards");
+  write_text(dir / "c.json", R"({
+    "name": "concurrent",
+    "defaults": {"mesh": "icosphere:level=3", "steps": 15, "threads": 1},
+    "axes": {"dt": [0.001, 0.002, 0.003, 0.004, 0.005, 0.006]},
+    "metrics": {"frames": [15], "reference": {"dt": 0.001}, "distance_samples": 200}})");
+  std::string all;
+  int n = 0;
+  for (const char* shard : {"0/3", "1/3", "2/3", "1/3"}) {
+    const std::string name = "process" + std::to_string(n++);
+    all += "(" + std::string(MCFBENCH_BINARY) + " run c.json --out out --shard " + shard + " >" +
+           name + ".out 2>&1; echo $? >" + name + ".rc) & ";
+  }
+  const std::string cmd = "cd '" + dir.string() + "' && { " + all + "wait; }";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() != ".rc") continue;
+    EXPECT_EQ(slurp(entry.path()), "0\n")
+        << entry.path() << ": " << slurp(fs::path(entry.path()).replace_extension(".out"));
+  }
+  // The distances to a reference cell another shard ran, then the check.
+  Command c = mcfbench("run c.json --out out --distances-only", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  c = mcfbench("collect out", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("6 cells found of 6, 0 missing, 0 duplicated, 0 errored"), std::string::npos)
+      << c.out;
+  EXPECT_EQ(c.out.find("lack their reference distance"), std::string::npos) << c.out;
+  const auto results = result_files(dir / "out");
+  ASSERT_EQ(results.size(), 6u);
+  for (const fs::path& r : results) EXPECT_EQ(read_json(r)["status"], "ok") << r;
+  std::set<std::string> plans;
+  for (const auto& entry : fs::directory_iterator(dir / "out" / kPlanFolder)) {
+    plans.insert(entry.path().filename().string());
+    EXPECT_EQ(read_json(entry.path())["cells"].size(), 6u) << entry.path();
+  }
+  ASSERT_EQ(plans.size(), 3u);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(std::count_if(plans.begin(), plans.end(),
+                            [&](const std::string& p) {
+                              return p.find(".shard-" + std::to_string(i) + "-of-3.json") !=
+                                     std::string::npos;
+                            }),
+              1)
+        << i;
+  for (const auto& entry : fs::recursive_directory_iterator(dir / "out"))
+    EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
 }
 
 TEST(RunnerCli, ConfigErrorsNameFileAndKeyAndWriteNothing) {
