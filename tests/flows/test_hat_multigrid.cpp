@@ -107,25 +107,28 @@ TEST(HatMultigrid, OneAndTwoThreadsGiveTheSameBits) {
 }
 
 TEST(HatMultigrid, FlowsWithMultigridFollowCholmod) {
-  const json base = {
-      {"mesh", "cgal:armadillo"}, {"basis", "hat"}, {"flow", "cmcf"}, {"dt", 1e-3}, {"steps", 5}};
-  json cholmod = base, cycles = base, pcg = base;
-  cholmod["solver"] = {{"name", "cholmod"}};
-  cycles["solver"] = {{"name", "multigrid"}, {"cycles", 4}};
-  pcg["solver"] = {{"name", "pcg"}, {"preconditioner", "multigrid"}, {"tolerance", 1e-10}};
-  const FlowOutcome exact = testing::run(cholmod);
-  const double size = (exact.final_mesh.vertices.colwise().maxCoeff() -
-                       exact.final_mesh.vertices.colwise().minCoeff())
-                          .norm();
-  for (const json* j : {&cycles, &pcg}) {
-    const FlowOutcome o = testing::run(*j);
-    ASSERT_EQ(o.result["status"], "ok") << (*j)["solver"];
-    EXPECT_GT(o.result["system"]["levels"].get<int>(), 2);
-    EXPECT_GT(o.result["system"]["setup_seconds"]["hierarchy"].get<double>(), 0.0);
-    const double rms = std::sqrt(
-        (o.final_mesh.vertices - exact.final_mesh.vertices).rowwise().squaredNorm().mean());
-    EXPECT_LT(rms / size, 1e-7) << (*j)["solver"];
-    EXPECT_EQ(o.result["steps"].back()["solver"]["status"], "converged") << (*j)["solver"];
+  for (const char* flow : {"cmcf", "heat"}) {
+    const json base = {
+        {"mesh", "cgal:armadillo"}, {"basis", "hat"}, {"flow", flow}, {"dt", 1e-3}, {"steps", 5}};
+    json cholmod = base, cycles = base, pcg = base;
+    cholmod["solver"] = {{"name", "cholmod"}};
+    cycles["solver"] = {{"name", "multigrid"}, {"cycles", 4}};
+    pcg["solver"] = {{"name", "pcg"}, {"preconditioner", "multigrid"}, {"tolerance", 1e-10}};
+    const FlowOutcome exact = testing::run(cholmod);
+    const double size = (exact.final_mesh.vertices.colwise().maxCoeff() -
+                         exact.final_mesh.vertices.colwise().minCoeff())
+                            .norm();
+    for (const json* j : {&cycles, &pcg}) {
+      const FlowOutcome o = testing::run(*j);
+      ASSERT_EQ(o.result["status"], "ok") << flow << " " << (*j)["solver"];
+      EXPECT_GT(o.result["system"]["levels"].get<int>(), 2);
+      EXPECT_GT(o.result["system"]["setup_seconds"]["hierarchy"].get<double>(), 0.0);
+      const double rms = std::sqrt(
+          (o.final_mesh.vertices - exact.final_mesh.vertices).rowwise().squaredNorm().mean());
+      EXPECT_LT(rms / size, 1e-7) << flow << " " << (*j)["solver"];
+      EXPECT_EQ(o.result["steps"].back()["solver"]["status"], "converged")
+          << flow << " " << (*j)["solver"];
+    }
   }
 }
 
