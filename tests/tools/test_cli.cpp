@@ -318,6 +318,11 @@ TEST(Cli, AFlowTooLargeForTheMemoryIsRefusedWithItsEstimate) {
 }
 
 TEST(Cli, MemoryEstimateIsWithinTwiceTheMeasuredPeak) {
+#if defined(__SANITIZE_ADDRESS__)
+  // The estimate models the process as built for use; AddressSanitizer's shadow memory and
+  // redzones about double an instrumented process's peak.
+  GTEST_SKIP() << "peak memory under AddressSanitizer is not the process's own";
+#endif
   for (const std::string args :
        {"--mesh sphere:vertices=60000 --basis hat --solver cholmod",
         "--mesh sphere:vertices=60000 --basis hat --solver multigrid",
