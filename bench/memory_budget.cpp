@@ -60,12 +60,6 @@ double cgroup_room(std::string& source) {
   return room;
 }
 
-std::string gib(double bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.2f GiB", bytes / double(1ull << 30));
-  return text;
-}
-
 }  // namespace
 
 nlohmann::json MemoryBudget::to_json() const {
@@ -156,10 +150,10 @@ void check_memory(const MemoryEstimate& estimate, const MemoryBudget& budget,
   std::string message =
       what + ": the flow needs an estimated " + estimate.describe(config) + ", more than ";
   if (budget.total)
-    message += budget.source + " allows (" + gib(budget.bytes) + ")";
+    message += budget.source + " allows (" + format_gib(budget.bytes) + ")";
   else
-    message += "the " + gib(budget.bytes) + " available (" + budget.source + "; " +
-               gib(estimate.resident_bytes) + " already held by this process)";
+    message += "the " + format_gib(budget.bytes) + " available (" + budget.source + "; " +
+               format_gib(estimate.resident_bytes) + " already held by this process)";
   message +=
       "; use a smaller mesh or depth, or --max-memory SIZE (none: no check) if the estimate is "
       "wrong for this machine";

@@ -31,13 +31,13 @@ constexpr double kHatMultigridPerVertex = 480;
 /// the elephant and spheres at depths 6 to 9.
 constexpr double kFunctionsPerArea = 3.0;
 
-std::string gib(double bytes) {
+}  // namespace
+
+std::string format_gib(double bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.2f GiB", bytes / double(1ull << 30));
   return text;
 }
-
-}  // namespace
 
 nlohmann::json MemoryEstimate::to_json() const {
   return {
@@ -53,7 +53,7 @@ std::string MemoryEstimate::describe(const FlowConfig& config) const {
   else
     std::snprintf(sizes, sizeof sizes, "%.3g unknowns", dimension);
   std::string what =
-      gib(total()) + (lower_bound ? " at least" : "") + " (" + config.basis + " basis";
+      format_gib(total()) + (lower_bound ? " at least" : "") + " (" + config.basis + " basis";
   if (config.basis == "octree") what += " depth " + std::to_string(config.octree.depth);
   return what + ", " + config.solver.name + ": " + sizes + ")";
 }

@@ -44,6 +44,9 @@ struct MemoryEstimate {
   std::string describe(const FlowConfig& config) const;
 };
 
+/// "12.40 GiB": bytes for messages.
+std::string format_gib(double bytes);
+
 /// Sizes from a spec that has not been read or built: a generator's own estimate of its faces or
 /// the "@faces=N" it is subdivided to (at least N faces). A closed surface has about half as many
 /// vertices as faces. Zero for a file or model without "@faces" (its size is its own).

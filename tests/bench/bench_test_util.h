@@ -41,11 +41,12 @@ struct Command {
   std::string out, err;
 };
 
-/// Runs `mcfbench ARGS` in `cwd`, capturing stdout and stderr.
-inline Command mcfbench(const std::string& args, const fs::path& cwd) {
+/// Runs `mcfbench ARGS` in `cwd`, capturing stdout and stderr; `env` ("NAME=value ", shell-quoted)
+/// is set for it.
+inline Command mcfbench(const std::string& args, const fs::path& cwd, const std::string& env = "") {
   const fs::path out = cwd / ".stdout.txt", err = cwd / ".stderr.txt";
-  const std::string cmd = "cd '" + cwd.string() + "' && " + MCFBENCH_BINARY + " " + args + " >" +
-                          out.string() + " 2>" + err.string();
+  const std::string cmd = "cd '" + cwd.string() + "' && " + env + MCFBENCH_BINARY + " " + args +
+                          " >" + out.string() + " 2>" + err.string();
   const int raw = std::system(cmd.c_str());
   Command c;
   c.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

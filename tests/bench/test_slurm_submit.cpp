@@ -67,16 +67,7 @@ echo $((4240 + n)))sh");
 
 /// `mcfbench submit ARGS` in `cwd` with the fakes first on PATH.
 Command submit(const std::string& args, const fs::path& cwd, const FakeSlurm& fake) {
-  const fs::path out = cwd / ".stdout.txt", err = cwd / ".stderr.txt";
-  const std::string cmd = "cd '" + cwd.string() + "' && PATH='" + fake.bin.string() +
-                          "':\"$PATH\" " + MCFBENCH_BINARY + " submit " + args + " >" +
-                          out.string() + " 2>" + err.string();
-  const int raw = std::system(cmd.c_str());
-  Command c;
-  c.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  c.out = slurp(out);
-  c.err = slurp(err);
-  return c;
+  return mcfbench("submit " + args, cwd, "PATH='" + fake.bin.string() + "':\"$PATH\" ");
 }
 
 bool contains(const std::string& text, const std::string& part) {
