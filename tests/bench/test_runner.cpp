@@ -119,13 +119,19 @@ TEST(Runner, AFlowThatStopsEarlyHasMetricsAtItsLastCompletedStep) {
   EXPECT_FALSE(all["steps"][5].contains("metrics"));  // the stopping step's positions are dropped
 }
 
-TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
-  const fs::path out = fresh_dir("sharded_ref");
+/// Three cells (dt 1e-3, 2e-3, 4e-3) of a two-step flow whose frame 2 is compared with the dt =
+/// 1e-3 cell's: what the sharded-distance tests run.
+ExperimentConfig three_dts_with_reference() {
   const json j = {
       {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
       {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
       {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
-  const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
+  return parse_experiment_config(j, "r.json", false);
+}
+
+TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
+  const fs::path out = fresh_dir("sharded_ref");
+  const ExperimentConfig e = three_dts_with_reference();
   RunOptions o;
   o.out_dir = out.string();
   o.shard_count = 2;
@@ -148,11 +154,7 @@ TEST(Runner, DistancesOnlyRunsNoCellAndWritesNoPlan) {
   // After an array that lost a task: shard 0 finished (cells 0 and 2), shard 1's cell 1 is
   // missing. A distances-only pass adds cell 2's distance to cell 0 and leaves cell 1 missing.
   const fs::path out = fresh_dir("distances_only");
-  const json j = {
-      {"defaults", {{"mesh", "icosphere:level=1"}, {"steps", 2}}},
-      {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
-      {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
-  const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
+  const ExperimentConfig e = three_dts_with_reference();
   RunOptions o;
   o.out_dir = out.string();
   o.shard_count = 2;
