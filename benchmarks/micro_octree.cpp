@@ -486,6 +486,7 @@ void BM_Step_TrackedStabilized(benchmark::State& state) {
   TrackedOctreeBasis& basis = *f.basis;
   MultigridOptions o = mg_options(state.range(1) == 0 ? MultigridCycle::W : MultigridCycle::V);
   o.pre_smooth = o.post_smooth = int(state.range(2));
+  o.cycles = int(state.range(3));
   MultigridSolver solver(o);
   const HierarchyView h{basis.prolongations(), basis.colours(), new_pattern_key()};
   const double c = 0.5, dt = f.c.dt;
@@ -536,17 +537,22 @@ void BM_Step_TrackedStabilized(benchmark::State& state) {
   timed_steps(state, step);
   phases.report(state, residual);
   state.counters["smooth"] = double(state.range(2));
+  state.counters["cycles"] = double(o.cycles);
   step_counters(state, f.c, *f.source, basis.stats());
-  state.SetLabel(std::string(state.range(1) == 0 ? "W(" : "V(") + std::to_string(state.range(2)) +
-                 "," + std::to_string(state.range(2)) + ") " + f.c.spec);
+  state.SetLabel(std::to_string(o.cycles) + "x " + (state.range(1) == 0 ? "W(" : "V(") +
+                 std::to_string(state.range(2)) + "," + std::to_string(state.range(2)) + ") " +
+                 f.c.spec);
 }
 BENCHMARK(BM_Step_TrackedStabilized)
-    ->ArgNames({"threads", "vcycle", "smooth"})
-    ->Args({2, 0, 5})
-    ->Args({2, 1, 5})
-    ->Args({2, 1, 3})
-    ->Args({2, 1, 2})
-    ->Args({1, 1, 3})
+    ->ArgNames({"threads", "vcycle", "smooth", "cycles"})
+    ->Args({2, 0, 5, 1})
+    ->Args({2, 1, 5, 1})
+    ->Args({2, 1, 3, 1})
+    ->Args({2, 1, 2, 1})
+    ->Args({2, 1, 2, 2})
+    ->Args({2, 0, 3, 1})
+    ->Args({2, 0, 2, 1})
+    ->Args({1, 1, 3, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);

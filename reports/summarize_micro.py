@@ -158,9 +158,14 @@ def main():
     t2, t1 = get("BM_Step_Tracked/threads:2"), get("BM_Step_Tracked/threads:1")
     rb, hat = get("BM_Step_Rebuilt/threads:2"), get("BM_Step_HatCholmod/threads:2")
     # The stabilized tracked steps (docs/octree-multigrid.md "Stabilization"), by cycle and sweeps.
-    stab = [((x.get("label") or "?").split()[0], x) for x in
-            (get(f"BM_Step_TrackedStabilized/threads:2/vcycle:{v}/smooth:{k}")
-             for v, k in ((0, 5), (1, 5), (1, 3), (1, 2))) if x]
+    # Names carry the cycles per step (".../cycles:N"); files written before that argument existed
+    # name one cycle without it. Labels read "Nx W(5,5) mesh" (older: "W(5,5) mesh").
+    def stabilized(v, k, n):
+        base = f"BM_Step_TrackedStabilized/threads:2/vcycle:{v}/smooth:{k}"
+        return get(f"{base}/cycles:{n}") or (get(base) if n == 1 else None)
+    stab = [(" ".join((x.get("label") or "?").split()[:-1]) or "?", x) for x in
+            (stabilized(v, k, n) for v, k, n in ((0, 5, 1), (1, 5, 1), (1, 3, 1), (1, 2, 1),
+                                                 (1, 2, 2), (0, 3, 1), (0, 2, 1))) if x]
     def steal(x):
         # CPU time the hypervisor took per step (all vCPUs); absent from older benchmark files.
         v = x.get("steal_ms")

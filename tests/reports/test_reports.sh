@@ -28,12 +28,17 @@ cat >"$sw/micro.json" <<'JSON'
    "real_time": 2000, "update_ms": 800, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
   {"name": "BM_Step_Tracked/threads:1/iterations:5/real_time", "run_type": "iteration", "time_unit": "ms",
    "real_time": 9000, "update_ms": 900, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "bytes_per_cubature_point": 24},
+  {"name": "BM_Step_TrackedStabilized/threads:2/vcycle:1/smooth:2/cycles:2/iterations:5/real_time", "run_type": "iteration",
+   "time_unit": "ms", "real_time": 700, "update_ms": 1, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "label": "2x V(2,2) m"},
+  {"name": "BM_Step_TrackedStabilized/threads:2/vcycle:0/smooth:5/iterations:5/real_time", "run_type": "iteration",
+   "time_unit": "ms", "real_time": 900, "update_ms": 1, "set_matrix_ms": 1, "solve_ms": 1, "evaluate_ms": 1, "label": "W(5,5) m"},
   {"name": "BM_Step_Tracked/threads:1_mean", "run_type": "aggregate", "time_unit": "ms", "real_time": 4267}]}
 JSON
 "$py" "$root/reports/summarize_micro.py" "$sw/micro.json" >"$sw/out.md" 2>&1 || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py"; exit 1; }
 for want in '| 1 | 2 | 100 | 25% |' '| outside the cycle (copies, final residual) |  | 40 | 10% |' \
             '| rebuilt / tracked per step | 4× |' '| tracked, 1 thread | 2000 | update 800,' \
-            '| tracked 1 thread / 2 threads | 2× |' 'medians of 1–3 repetitions' 'evaluate 1, steal 250 |'; do
+            '| tracked 1 thread / 2 threads | 2× |' 'medians of 1–3 repetitions' 'evaluate 1, steal 250 |' \
+            '| tracked, stabilized, 2x V(2,2), 2 threads | 700 |' '| tracked, stabilized, W(5,5), 2 threads | 900 |'; do
   grep -qF "$want" "$sw/out.md" || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py lacks: $want"; exit 1; }
 done
 rm -rf "$sw"
