@@ -158,14 +158,10 @@ def main():
     t2, t1 = get("BM_Step_Tracked/threads:2"), get("BM_Step_Tracked/threads:1")
     rb, hat = get("BM_Step_Rebuilt/threads:2"), get("BM_Step_HatCholmod/threads:2")
     # The stabilized tracked steps (docs/octree-multigrid.md "Stabilization"), by cycle and sweeps.
-    # Names carry the cycles per step (".../cycles:N"); files written before that argument existed
-    # name one cycle without it. Labels read "Nx W(5,5) mesh" (older: "W(5,5) mesh").
-    def stabilized(v, k, n):
-        base = f"BM_Step_TrackedStabilized/threads:2/vcycle:{v}/smooth:{k}"
-        return get(f"{base}/cycles:{n}") or (get(base) if n == 1 else None)
-    stab = [(" ".join((x.get("label") or "?").split()[:-1]) or "?", x) for x in
-            (stabilized(v, k, n) for v, k, n in ((0, 5, 1), (1, 5, 1), (1, 3, 1), (1, 2, 1),
-                                                 (1, 2, 2), (0, 3, 1), (0, 2, 1))) if x]
+    # Every 2-thread variant the file holds, in its order; labels read "Nx W(5,5) mesh" (files
+    # written before the cycles argument: "W(5,5) mesh"), the mesh dropped here.
+    stab = [(" ".join((x.get("label") or "?").split()[:-1]) or "?", x) for n, x in b.items()
+            if n.startswith("BM_Step_TrackedStabilized/threads:2/")]
     def steal(x):
         # CPU time the hypervisor took per step (all vCPUs); absent from older benchmark files.
         v = x.get("steal_ms")
