@@ -2,6 +2,7 @@
 // against P^T A P formed directly, cycles converging to CHOLMOD's solution, the same bits for one
 // and two threads, and flows with multigrid and multigrid-preconditioned CG against CHOLMOD's.
 
+#include "../residual_floor.h"
 #include "flow_test_util.h"
 
 #include "bases/hat_basis.h"
@@ -16,6 +17,7 @@ namespace mcf {
 namespace {
 
 using nlohmann::json;
+using testing::falls_above_rounding_floor;
 
 struct HatSystem {
   TriangleMesh mesh;
@@ -80,9 +82,10 @@ TEST(HatMultigrid, CyclesConvergeToTheCholmodSolution) {
       const SolveReport r = mg.solve(s.B, x);
       EXPECT_EQ(r.status, SolveStatus::converged) << dt;
       EXPECT_LT((x - exact).norm() / exact.norm(), 1e-10) << "dt " << dt << " " << to_string(cycle);
-      // Each cycle reduces the residual: the smoother and the coarse correction work together.
-      for (std::size_t c = 1; c < r.residuals.size(); ++c)
-        ASSERT_LT(r.residuals[c], r.residuals[c - 1]) << "dt " << dt << " cycle " << c;
+      // Each cycle reduces the residual (above the rounding floor): the smoother and the coarse
+      // correction work together.
+      EXPECT_TRUE(falls_above_rounding_floor(r.residuals))
+          << "dt " << dt << " " << to_string(cycle);
     }
   }
 }

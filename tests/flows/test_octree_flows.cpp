@@ -2,6 +2,7 @@
 // W-cycle's residual reduction, tracked vs rebuilt vs the analytic sphere, thread independence,
 // pinches.
 
+#include "../residual_floor.h"
 #include "flow_test_util.h"
 
 #include "bases/octree_basis.h"
@@ -20,6 +21,7 @@ namespace mcf {
 namespace {
 
 using nlohmann::json;
+using testing::falls_above_rounding_floor;
 using testing::last;
 using testing::run;
 
@@ -74,15 +76,16 @@ TEST(OctreeFlows, PlainCyclesConvergeToCholmod) {
 }
 
 TEST(OctreeFlows, MultigridCyclesReduceTheResidual) {
-  // Plain W-cycles: the residual falls with every cycle. (On the restricted surface system the
-  // convergence factor degrades after the first cycles — near-null modes of the restricted
-  // B-splines; see docs/octree-multigrid.md — so this checks monotone decrease, not a rate.)
+  // Plain W-cycles: the residual falls with every cycle above the rounding floor. (On the
+  // restricted surface system the convergence factor degrades after the first cycles — near-null
+  // modes of the restricted B-splines; see docs/octree-multigrid.md — so this checks monotone
+  // decrease, not a rate.)
   json j = octree("icosphere:level=4", "tracked", 6, {{"name", "multigrid"}, {"cycles", 8}});
   j["steps"] = 1;
   const auto o = run(j);
   const auto& r = o.result["steps"][0]["solver"]["residuals"];
   ASSERT_EQ(r.size(), 8u);
-  for (std::size_t i = 1; i < r.size(); ++i) EXPECT_LT(r[i].get<double>(), r[i - 1].get<double>());
+  EXPECT_TRUE(falls_above_rounding_floor(r.get<std::vector<double>>()));
   EXPECT_LT(r.back().get<double>(), 1e-4);
 }
 
