@@ -255,14 +255,14 @@ namespace {
 
 /// The top level's keys, name and description.
 void read_header(const json& j, const std::string& source, ExperimentConfig& e) {
-  static const std::set<std::string> top = {"name",        "description", "paper", "comment",
-                                            "defaults",    "axes",        "zip",   "exclude",
-                                            "repetitions", "metrics",     "quick"};
+  static const std::set<std::string> top = {
+      "name",    "description", "paper",      "comment",    "defaults", "axes", "zip",
+      "exclude", "repetitions", "interleave", "order_seed", "metrics",  "quick"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!top.count(it.key()))
       fail(source, it.key(),
            "unknown key (known: name, description, paper, comment, defaults, axes, zip, exclude, "
-           "repetitions, metrics, quick)");
+           "repetitions, interleave, order_seed, metrics, quick)");
   if (j.contains("name")) {
     if (!j["name"].is_string() || j["name"].get<std::string>().empty())
       fail(source, "name", "expected a non-empty string, got " + j["name"].dump());
@@ -274,6 +274,17 @@ void read_header(const json& j, const std::string& source, ExperimentConfig& e) 
     if (!j["description"].is_string())
       fail(source, "description", "expected a string, got " + j["description"].dump());
     e.description = j["description"].get<std::string>();
+  }
+  if (j.contains("interleave")) {
+    if (!j["interleave"].is_boolean())
+      fail(source, "interleave", "expected true or false, got " + j["interleave"].dump());
+    e.interleave = j["interleave"].get<bool>();
+  }
+  if (j.contains("order_seed")) {
+    const json& s = j["order_seed"];
+    if (!s.is_number_integer() || s.get<long long>() < 0)
+      fail(source, "order_seed", "expected an integer >= 0, got " + s.dump());
+    e.order_seed = s.get<long long>();
   }
 }
 

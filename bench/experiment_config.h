@@ -6,7 +6,7 @@
 //     "axes": {"solver.cycles": [1, 2], "mesh": ["a", "b"]},      // cartesian product
 //     "zip": [ {"basis": ["hat", "octree"], "solver.name": ["cholmod", "multigrid"]} ],
 //     "exclude": [ {"basis": "hat", "octree.depth": 9} ],
-//     "repetitions": 1,
+//     "repetitions": 1, "interleave": true, "order_seed": 1,
 //     "metrics": {"quasi_conformal": true, "sphericity": true, "every": 10,
 //                 "frames": [1, 10, 100], "reference": {"basis": "hat"}, "distance_samples":
 //                 20000},
@@ -51,6 +51,12 @@ struct ExperimentConfig {
   std::string name, description;
   bool quick = false;  ///< the quick variant was expanded
   int repetitions = 1;
+  /// With repetitions > 1, run every cell once in a shuffled order, then every cell again in
+  /// another, instead of a cell's repetitions back to back: slow drift of the machine (thermal
+  /// state, other tenants) then spreads over all cells instead of biasing some. The order is fixed
+  /// by `order_seed` (and the round), so a rerun or a resumed run walks the same order.
+  bool interleave = true;
+  long long order_seed = 1;
   MetricsConfig metrics;
   nlohmann::json study_config;  ///< the whole file as read (stored in every result)
   std::vector<Cell> cells;

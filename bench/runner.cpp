@@ -1,9 +1,11 @@
 #include "bench/runner.h"
 
 #include "bench/cell_hash.h"
+#include "bench/contention.h"
 #include "bench/environment.h"
 #include "bench/memory_budget.h"
 #include "bench/metrics.h"
+#include "bench/timing_summary.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "flows/config_reader.h"
@@ -14,6 +16,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -95,6 +99,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   const bool per_step = m.quasi_conformal || m.sphericity;
   const bool peak_per_cell = reset_peak_memory();
   const double steal_before = cpu_steal_seconds();
+  const CpuCounters counters_before = read_cpu_counters();
 
   json result;
   json memory;
@@ -170,6 +175,9 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
     result["steal_seconds"] = steal;
+  result["contention"] = contention_json(counters_before, read_cpu_counters(),
+                                         result["environment"].value("cores", 0));
+  if (json t = timing_summary(result); !t.empty()) result["timing"] = std::move(t);
   return result;
 }
 
@@ -366,6 +374,33 @@ const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellP
   return best;
 }
 
+std::vector<std::size_t> execution_order(const ExperimentConfig& e,
+                                         const std::vector<CellPlan>& plans, int shard_index,
+                                         int shard_count) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < plans.size(); ++i)
+    if (in_shard(plans[i].cell.index, shard_index, shard_count)) order.push_back(i);
+  if (!e.interleave || e.repetitions <= 1) return order;
+  std::map<int, std::vector<std::size_t>> rounds;
+  for (std::size_t i : order) rounds[plans[i].cell.repetition].push_back(i);
+  order.clear();
+  for (auto& [round, cells] : rounds) {
+    // std::shuffle's and the distributions' algorithms are the library's own; the engine's
+    // output is fixed by the standard, so the draw below is the same everywhere.
+    std::mt19937_64 engine(std::uint64_t(e.order_seed) * 1000003u + std::uint64_t(round));
+    for (std::size_t i = cells.size(); i > 1; --i) {
+      const std::uint64_t limit =
+          std::numeric_limits<std::uint64_t>::max() - std::numeric_limits<std::uint64_t>::max() % i;
+      std::uint64_t r;
+      do r = engine();
+      while (r >= limit);
+      std::swap(cells[i - 1], cells[std::size_t(r % i)]);
+    }
+    order.insert(order.end(), cells.begin(), cells.end());
+  }
+  return order;
+}
+
 RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
     throw std::invalid_argument("--shard: expected i/n with 0 <= i < n");
@@ -428,8 +463,8 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
                     run_plan(e, plans, o.shard_index, o.shard_count).dump(1) + "\n");
   std::set<std::string> ran_now;
   int done = 0;
-  for (const CellPlan& p : plans) {
-    if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
+  for (const std::size_t i : execution_order(e, plans, o.shard_index, o.shard_count)) {
+    const CellPlan& p = plans[i];
     if (const int signal = stop_requested()) throw RunStopped(signal, s, done);
     CellReport report;
     report.plan = &p;

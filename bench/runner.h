@@ -118,6 +118,15 @@ struct RunStopped : std::runtime_error {
   int done;            ///< cells of the shard with a result from this run or an earlier one
 };
 
+/// The order in which `run` walks the shard's cells, as indices into `plans`: expansion order, or
+/// with ExperimentConfig::interleave and repetitions > 1 one round per repetition, each round the
+/// cells of that repetition in a shuffled order (Fisher-Yates on a 64-bit Mersenne Twister seeded
+/// by order_seed and the round: the same on every platform). Cell indices and hashes do not
+/// change, so shards and resumed runs mean the same cells.
+std::vector<std::size_t> execution_order(const ExperimentConfig& e,
+                                         const std::vector<CellPlan>& plans, int shard_index = 0,
+                                         int shard_count = 1);
+
 /// Runs the shard. Config problems throw before anything is written; an exception inside one
 /// cell's flow becomes that cell's result {"status": "error", "error": ...} and the run goes on.
 /// A file that cannot be written (the plan, a cell's result or frames: a full disk, a read-only

@@ -1,0 +1,69 @@
+// Contention from fabricated counters, /proc/stat parsing, and the timing summary of a result.
+#include "bench/contention.h"
+#include "bench/timing_summary.h"
+
+#include <gtest/gtest.h>
+
+namespace mcf {
+namespace {
+
+using nlohmann::json;
+
+CpuCounters at(double wall, double busy, double own, double steal) {
+  CpuCounters c;
+  c.wall = wall;
+  c.busy = busy;
+  c.own = own;
+  c.steal = steal;
+  c.load1 = 1.0;
+  return c;
+}
+
+TEST(Contention, OtherProcessesTimeMarksACell) {
+  // 10 s: the machine was busy 20 CPU-seconds, 19.5 of them this process's: quiet.
+  json quiet = contention_json(at(0, 100, 10, 5), at(10, 120, 29.5, 5.1), 2);
+  EXPECT_FALSE(quiet["contended"].get<bool>());
+  EXPECT_NEAR(quiet["other_cores"].get<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(quiet["steal_cores"].get<double>(), 0.01, 1e-12);
+  EXPECT_FALSE(quiet.contains("reason"));
+  // A build beside it: 9 CPU-seconds of others in 10 s.
+  json busy = contention_json(at(0, 100, 10, 5), at(10, 129, 30, 5), 2);
+  EXPECT_TRUE(busy["contended"].get<bool>());
+  EXPECT_NE(busy["reason"].get<std::string>().find("0.90 cores"), std::string::npos);
+  // The hypervisor took a tenth of a core.
+  EXPECT_TRUE(contention_json(at(0, 0, 0, 0), at(10, 10, 10, 1), 2)["contended"].get<bool>());
+  // Unknown counters never mark a cell.
+  EXPECT_FALSE(contention_json(at(0, -1, -1, -1), at(10, -1, -1, -1), 2)["contended"].get<bool>());
+}
+
+TEST(Contention, ProcStatLine) {
+  double busy = 0, steal = 0;
+  ASSERT_TRUE(parse_proc_stat_cpu("cpu  100 10 50 1000 7 3 2 40 0 0", 100, busy, steal));
+  EXPECT_DOUBLE_EQ(busy, 1.65);  // user + nice + system + irq + softirq
+  EXPECT_DOUBLE_EQ(steal, 0.4);
+  EXPECT_FALSE(parse_proc_stat_cpu("cpu0 1 2 3 4 5 6 7 8", 100, busy, steal));
+  EXPECT_FALSE(parse_proc_stat_cpu("cpu 1 2 3", 100, busy, steal));
+  const CpuCounters now = read_cpu_counters();
+  EXPECT_GE(now.own, 0.0);
+}
+
+TEST(TimingSummary, MedianOfTheStepsAfterTheFirst) {
+  json r = {{"system", {{"setup_seconds", {{"total", 2.0}}}}},
+            {"steps",
+             {{{"seconds", {{"total", 9.0}}}},
+              {{"seconds", {{"total", 1.0}}}},
+              {{"seconds", {{"total", 3.0}}}},
+              {{"seconds", {{"total", 2.0}}}},
+              {{"seconds", {{"total", 100.0}}}}}}};
+  const json t = timing_summary(r);
+  EXPECT_DOUBLE_EQ(t["step_median_seconds"].get<double>(), 2.5);  // of 1, 3, 2, 100
+  EXPECT_EQ(t["steps_timed"], 4);
+  EXPECT_DOUBLE_EQ(t["first_step_seconds"].get<double>(), 9.0);
+  EXPECT_DOUBLE_EQ(t["flow_seconds"].get<double>(), 117.0);
+  r["steps"] = json::array({{{"seconds", {{"total", 4.0}}}}});
+  EXPECT_DOUBLE_EQ(timing_summary(r)["step_median_seconds"].get<double>(), 4.0);
+  EXPECT_TRUE(timing_summary(json{{"steps", json::array()}}).empty());
+}
+
+}  // namespace
+}  // namespace mcf
