@@ -28,8 +28,8 @@ bool parse_proc_stat_cpu(const std::string& text, long ticks_per_second, double&
 
 CpuCounters read_cpu_counters() {
   CpuCounters c;
-  c.wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-               .count();
+  c.wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   {
     std::ifstream in("/proc/stat");
     std::string line;

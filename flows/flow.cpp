@@ -99,6 +99,11 @@ class FlowStepContext final : public StepContext {
     ++solves_;
     iterations_ += r.iterations;
     residuals_per_solve_.push_back(r.residuals);
+    contraction_ = std::max(contraction_, r.contraction);
+    if (r.fallback_iterations > 0) {
+      ++fallbacks_;
+      fallback_iterations_ += r.fallback_iterations;
+    }
     if (severity(r.status) >= severity(worst_.status)) worst_ = r;
     return Y;
   }
@@ -108,7 +113,8 @@ class FlowStepContext final : public StepContext {
     x_ = &x;
     x_prev_ = prev;
     update_seconds_ = solve_seconds_ = 0;
-    solves_ = iterations_ = 0;
+    solves_ = iterations_ = fallbacks_ = fallback_iterations_ = 0;
+    contraction_ = -1;
     residuals_per_solve_.clear();
     worst_ = SolveReport{};
   }
@@ -123,6 +129,8 @@ class FlowStepContext final : public StepContext {
 
   double update_seconds_ = 0, solve_seconds_ = 0;
   int solves_ = 0, iterations_ = 0;
+  double contraction_ = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
+  int fallbacks_ = 0, fallback_iterations_ = 0;  ///< solves whose stalled cycles CG took over
   SolveReport worst_;
   // Every solve's residuals, in order (Taylor-2 and Neumann-2 solve twice a step).
   std::vector<std::vector<double>> residuals_per_solve_;
@@ -323,6 +331,10 @@ nlohmann::json FlowRun::solver_record(int step, double t) const {
       {"relative_residual", worst.relative_residual},
       {"status", to_string(worst.status)}};
   if (ctx.solves_ > 1) record["solver"]["residuals_per_solve"] = ctx.residuals_per_solve_;
+  if (ctx.contraction_ >= 0) record["solver"]["contraction"] = ctx.contraction_;
+  if (ctx.fallbacks_ > 0)
+    record["solver"]["fallback"] = {{"solves", ctx.fallbacks_},
+                                    {"iterations", ctx.fallback_iterations_}};
   // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
   // Gauss-Seidel on a level), or why it failed.
   if (!worst.message.empty()) record["solver"]["message"] = worst.message;

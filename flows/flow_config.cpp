@@ -40,6 +40,9 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
     c.solver.cycle = s.get_string("cycle", c.solver.cycle, {"V", "W"});
     c.solver.cycles = int(s.get_integer("cycles", c.solver.cycles, 1, 10000));
     c.solver.smooth = int(s.get_integer("smooth", c.solver.smooth, 0, 1000));
+    c.solver.stall_ratio = s.get_number("stall_ratio", c.solver.stall_ratio, 0, 1);
+    c.solver.fallback_tolerance =
+        s.get_number("fallback_tolerance", c.solver.fallback_tolerance, 1e-300, 1);
     s.finish();
   }
   c.integrator = r.get_string("integrator", c.integrator, integrator_names());
@@ -77,7 +80,9 @@ nlohmann::json to_json(const FlowConfig& c) {
             {"preconditioner", c.solver.preconditioner},
             {"cycle", c.solver.cycle},
             {"cycles", c.solver.cycles},
-            {"smooth", c.solver.smooth}}},
+            {"smooth", c.solver.smooth},
+            {"stall_ratio", c.solver.stall_ratio},
+            {"fallback_tolerance", c.solver.fallback_tolerance}}},
           {"integrator", c.integrator},
           {"extrapolate", c.extrapolate},
           {"dt", c.dt},

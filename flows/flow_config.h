@@ -34,6 +34,11 @@ struct SolverConfig {
   std::string cycle = "W";                ///< multigrid: V | W
   int cycles = 1;                         ///< multigrid cycles per solve
   int smooth = 5;                         ///< Gauss–Seidel sweeps before and after (each)
+  /// multigrid: when a solve's cycles reduce the residual by less than this per cycle (mean over
+  /// the solve), CG preconditioned by the cycle takes over to `fallback_tolerance`
+  /// (solvers/multigrid_fallback.h); 0 = never.
+  double stall_ratio = 0.5;
+  double fallback_tolerance = 1e-10;
 };
 
 struct FlowConfig {

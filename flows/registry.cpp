@@ -6,6 +6,7 @@
 #include "solvers/cholmod_solver.h"
 #include "solvers/dense_reference.h"
 #include "solvers/multigrid.h"
+#include "solvers/multigrid_fallback.h"
 #include "solvers/multigrid_pcg.h"
 #include "solvers/pcg_solver.h"
 
@@ -64,8 +65,15 @@ std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& 
 std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config) {
   if (config.name == "cholmod") return std::make_unique<CholmodSolver>();
   if (config.name == "dense") return std::make_unique<DenseLltSolver>();
-  if (config.name == "multigrid")
-    return std::make_unique<MultigridSolver>(multigrid_options(config));
+  if (config.name == "multigrid") {
+    if (config.stall_ratio <= 0)
+      return std::make_unique<MultigridSolver>(multigrid_options(config));
+    StallFallbackOptions f;
+    f.stall_ratio = config.stall_ratio;
+    f.tolerance = config.fallback_tolerance;
+    f.max_iterations = config.max_iterations;
+    return std::make_unique<FallbackMultigridSolver>(multigrid_options(config), f);
+  }
   if (config.name == "pcg") {
     PcgOptions o;
     o.relative_tolerance = config.tolerance;

@@ -31,6 +31,11 @@ struct SolveReport {
   int iterations = 0;              ///< cycles (multigrid), CG iterations (PCG), 1 (direct)
   double relative_residual = 0.0;  ///< max over right-hand sides of ||b - A x|| / ||b||
   std::vector<double> residuals;   ///< relative residual after each iteration / cycle
+  /// Multigrid: the mean reduction of the relative residual per cycle over the solve,
+  /// (r_k / r_0)^(1/k) from the warm start's r_0, where the solver measured r_0; -1 otherwise.
+  double contraction = -1;
+  /// Iterations of a fallback solver that took over after this one stalled (0: none ran).
+  int fallback_iterations = 0;
   std::string message;
   bool ok() const {
     return status == SolveStatus::converged || status == SolveStatus::max_iterations;

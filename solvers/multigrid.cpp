@@ -632,7 +632,9 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
   const int top = int(m.levels.size()) - 1;
   const double tol = options_.tolerance;
 
-  double rel = tol > 0.0 ? m.relative_residual(bnorm) : std::numeric_limits<double>::infinity();
+  const bool measure_start = tol > 0.0 || options_.measure_contraction;
+  double rel = measure_start ? m.relative_residual(bnorm) : std::numeric_limits<double>::infinity();
+  const double start = rel;
   if (tol > 0.0 && rel < tol) {
     rep.relative_residual = rel;
     return rep;
@@ -660,6 +662,9 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
     rep.status = std::isfinite(rel) ? SolveStatus::converged : SolveStatus::numerical_issue;
   }
   rep.relative_residual = rel;
+  if (measure_start && rep.iterations > 0 && std::isfinite(rel) && std::isfinite(start) &&
+      start > 0.0)
+    rep.contraction = std::pow(rel / start, 1.0 / rep.iterations);
   m.store(fine, fine.x, X);
   return rep;
 }

@@ -78,6 +78,9 @@ struct MultigridOptions {
   int post_smooth = 5;  ///< Gauss-Seidel sweeps after the coarse correction, per level
   /// 0: run exactly `cycles` cycles; > 0: stop early once the relative residual is below.
   double tolerance = 0.0;
+  /// Measure the warm start's residual (one residual pass) so that the report's contraction is
+  /// known even when `tolerance` is 0; with a tolerance it is measured anyway.
+  bool measure_contraction = false;
 };
 
 const char* to_string(MultigridCycle c);

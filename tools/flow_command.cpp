@@ -18,7 +18,7 @@ struct FlowArgs {
       integrator;
   int depth = 0, cubature = 0, max_iterations = 0, cycles = 0, smooth = 0, steps = 0, threads = 0,
       save_every = 0;
-  double dt = 0, tolerance = 0, stabilization_weight = 0;
+  double dt = 0, tolerance = 0, stabilization_weight = 0, stall_ratio = 0, fallback_tolerance = 0;
   bool refine_input = false, normalize_area = false, frozen = false;
 };
 
@@ -58,6 +58,11 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
   cmd.add_option("--cycles", args.cycles, "Multigrid cycles per solve (default 1)");
   cmd.add_option("--smooth", args.smooth,
                  "Gauss-Seidel sweeps before and after each coarse correction (default 5)");
+  cmd.add_option("--stall-ratio", args.stall_ratio,
+                 "Multigrid: CG preconditioned by the cycle takes over when the cycles reduce the "
+                 "residual by less than this per cycle (default 0.5; 0 = never)");
+  cmd.add_option("--fallback-tolerance", args.fallback_tolerance,
+                 "Multigrid: relative residual the fallback CG stops at (default 1e-10)");
   cmd.add_option(
       "--integrator", args.integrator,
       "explicit-euler | semi-implicit (default) | crank-nicolson | bdf2 | taylor2 | neumann2");
@@ -107,6 +112,8 @@ FlowRequest flow_request(const CLI::App& cmd, const FlowArgs& args) {
   set("--cycle", "solver.cycle", args.cycle);
   set("--cycles", "solver.cycles", args.cycles);
   set("--smooth", "solver.smooth", args.smooth);
+  set("--stall-ratio", "solver.stall_ratio", args.stall_ratio);
+  set("--fallback-tolerance", "solver.fallback_tolerance", args.fallback_tolerance);
   set("--integrator", "integrator", args.integrator);
   set("--frozen", "extrapolate", !args.frozen);
   set("--dt", "dt", args.dt);

@@ -7,6 +7,7 @@
 #include "solvers/cholmod_solver.h"
 #include "solvers/dense_reference.h"
 #include "solvers/multigrid.h"
+#include "solvers/multigrid_fallback.h"
 #include "solvers/multigrid_pcg.h"
 #include "solvers/pcg_solver.h"
 
@@ -1043,6 +1044,84 @@ TEST(LinearSolverInterface, AnyColumnMajorBlockSolvesInPlaceBitwise) {
     ASSERT_TRUE(solver->solve(B, resized).ok());
     EXPECT_TRUE(bitwise(resized, zero));
   }
+}
+
+}  // namespace
+
+// --- FallbackMultigridSolver (solvers/multigrid_fallback.h) ---
+
+namespace {
+
+TEST(MultigridFallback, ContractionIsTheMeanReductionFromTheWarmStart) {
+  Problem pr = make_problem(4, 1, 0.05);
+  MultigridOptions o;
+  o.cycles = 3;
+  o.measure_contraction = true;
+  MultigridSolver mg(o);
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 5);
+  Eigen::MatrixXd X = 0.5 * random_matrix(pr.A.rows(), 3, 6);
+  const double r0 =
+      ((B - pr.A * X).colwise().norm().array() / B.colwise().norm().array()).maxCoeff();
+  const auto rep = mg.solve(B, X);
+  ASSERT_EQ(rep.iterations, 3);
+  EXPECT_NEAR(rep.contraction, std::pow(rep.relative_residual / r0, 1.0 / 3), 1e-9);
+  EXPECT_GT(rep.contraction, 0.0);
+  EXPECT_LT(rep.contraction, 0.5);
+  // Not measured unless asked (or a tolerance needs it).
+  MultigridSolver plain;
+  ASSERT_TRUE(plain.set_matrix(pr.A, pr.view()).ok());
+  Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  EXPECT_EQ(plain.solve(B, Y).contraction, -1);
+}
+
+TEST(MultigridFallback, ContractingCyclesAreTheMultigridsOwnBits) {
+  Problem pr = make_problem(4, 1, 0.05);
+  MultigridOptions o;
+  o.cycles = 2;
+  MultigridSolver mg(o);
+  mcf::FallbackMultigridSolver guarded(o, {});
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  ASSERT_TRUE(guarded.set_matrix(pr.A, pr.view()).ok());
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 8);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3), Y = X;
+  const auto a = mg.solve(B, X), b = guarded.solve(B, Y);
+  EXPECT_EQ(X, Y);
+  EXPECT_EQ(a.residuals, b.residuals);
+  EXPECT_EQ(b.fallback_iterations, 0);
+  EXPECT_EQ(guarded.fallbacks(), 0);
+}
+
+TEST(MultigridFallback, StalledCyclesHandOverToCgThatReachesTheTolerance) {
+  Problem pr = make_problem(4, 1, 0.05);
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt(pr.A);
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 9);
+  const Eigen::MatrixXd exact = ldlt.solve(B);
+  MultigridOptions o;  // one W-cycle: contracts by ~0.05, "stalled" for a bound of 1e-6
+  mcf::StallFallbackOptions f;
+  f.stall_ratio = 1e-6;
+  f.tolerance = 1e-11;
+  mcf::FallbackMultigridSolver guarded(o, f);
+  for (int round = 0; round < 2; ++round) {  // the second solve reuses CG's matrix
+    ASSERT_TRUE(guarded.set_matrix(pr.A, pr.view()).ok());
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+    const auto rep = guarded.solve(B, X);
+    EXPECT_EQ(rep.status, SolveStatus::converged);
+    EXPECT_GT(rep.fallback_iterations, 0);
+    EXPECT_EQ(rep.iterations, 1 + rep.fallback_iterations);
+    EXPECT_EQ(int(rep.residuals.size()), rep.iterations);
+    EXPECT_LE(rep.relative_residual, 1e-11);
+    EXPECT_LT(rel_diff(X, exact), 1e-8);
+    EXPECT_NE(rep.message.find("stalled"), std::string::npos);
+    EXPECT_EQ(guarded.fallbacks(), round + 1);
+  }
+  // CG that runs out of iterations says so: not converged, not silently exact.
+  f.max_iterations = 1;
+  f.tolerance = 1e-15;
+  mcf::FallbackMultigridSolver capped(o, f);
+  ASSERT_TRUE(capped.set_matrix(pr.A, pr.view()).ok());
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  EXPECT_EQ(capped.solve(B, X).status, SolveStatus::max_iterations);
 }
 
 }  // namespace
