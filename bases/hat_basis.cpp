@@ -22,8 +22,12 @@ Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3
 }
 
 HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
-                   std::optional<SurfaceHierarchyOptions> hierarchy)
-    : vertices0_(mesh.vertices), faces_(mesh.faces), mass_kind_(mass_kind) {
+                   std::optional<SurfaceHierarchyOptions> hierarchy, Eigen::Index output_vertices)
+    : vertices0_(mesh.vertices),
+      faces_(mesh.faces),
+      output_vertices_(output_vertices < 0 ? mesh.num_vertices()
+                                           : std::min(output_vertices, mesh.num_vertices())),
+      mass_kind_(mass_kind) {
   const auto t0 = std::chrono::steady_clock::now();
   if (hierarchy) {
     // Functions numbered so that neighbours are close (bases/vertex_ordering.h), which the
@@ -70,9 +74,11 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
 }
 
 Positions HatBasis::evaluate_vertices(const Coefficients& x) const {
-  if (order_.empty()) return x;
-  Positions V(x.rows(), 3);
-  for (std::size_t k = 0; k < order_.size(); ++k) V.row(order_[k]) = x.row(Eigen::Index(k));
+  if (order_.empty())
+    return output_vertices_ == x.rows() ? Positions(x) : x.topRows(output_vertices_);
+  Positions V(output_vertices_, 3);
+  for (std::size_t k = 0; k < order_.size(); ++k)
+    if (order_[k] < output_vertices_) V.row(order_[k]) = x.row(Eigen::Index(k));
   return V;
 }
 

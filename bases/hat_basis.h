@@ -20,8 +20,13 @@ class HatBasis final : public Basis {
   /// (bases/surface_hierarchy.h) once; it is kept through the flow, as the mesh's connectivity is.
   /// The functions are then numbered in a bandwidth-reducing order (bases/vertex_ordering.h), not
   /// the vertices': coefficients are in that order, evaluate_vertices returns the mesh's.
+  ///
+  /// `output_vertices` < the mesh's vertex count: evaluate_vertices returns only the mesh's first
+  /// `output_vertices` vertices (with a 1-to-4 split input, subdivide_midpoint, those are the
+  /// original mesh's: the midpoints flow as functions of their own but are not output). -1: all.
   HatBasis(const TriangleMesh& mesh, MassKind mass_kind = MassKind::consistent,
-           std::optional<SurfaceHierarchyOptions> hierarchy = std::nullopt);
+           std::optional<SurfaceHierarchyOptions> hierarchy = std::nullopt,
+           Eigen::Index output_vertices = -1);
 
   std::string name() const override { return "hat"; }
   Eigen::Index dimension() const override { return faces_.rows() ? vertices0_.rows() : 0; }
@@ -41,9 +46,10 @@ class HatBasis final : public Basis {
   }
 
  private:
-  Positions vertices0_;     // in the functions' order
-  Triangles faces_;         // on the functions' numbers
-  std::vector<int> order_;  // function k is vertex order_[k]; empty: the mesh's own order
+  Positions vertices0_;           // in the functions' order
+  Triangles faces_;               // on the functions' numbers
+  std::vector<int> order_;        // function k is vertex order_[k]; empty: the mesh's own order
+  Eigen::Index output_vertices_;  // evaluate_vertices returns the mesh's first this many
   MassKind mass_kind_;
   FixedPattern pattern_;                              // 9 slots per face, gathered per nonzero
   std::vector<double> mass_, stiffness_;              // values on pattern_

@@ -68,7 +68,7 @@ FlowSizes spec_sizes(const MeshSpecRequest& request) {
 FlowSizes mesh_sizes(const FlowConfig& config, const TriangleMesh& mesh, bool analytic) {
   FlowSizes s;
   s.exact = true;
-  const double split = config.basis == "octree" && config.octree.refine_input ? 4.0 : 1.0;
+  const double split = config.octree.refine_input ? 4.0 : 1.0;
   s.faces = double(mesh.faces.rows()) * split;
   // A 1-to-4 split adds one vertex per edge: about 3/2 per face.
   s.vertices = double(mesh.vertices.rows()) + (split - 1.0) / 2.0 * double(mesh.faces.rows());

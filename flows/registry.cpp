@@ -3,6 +3,7 @@
 #include "bases/hat_basis.h"
 #include "bases/octree_basis.h"
 #include "bases/tracked_octree_basis.h"
+#include "datasets/subdivide.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/dense_reference.h"
 #include "solvers/multigrid.h"
@@ -51,8 +52,11 @@ std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& 
     std::optional<SurfaceHierarchyOptions> hierarchy;
     if (s.name == "multigrid" || (s.name == "pcg" && s.preconditioner == "multigrid"))
       hierarchy = SurfaceHierarchyOptions{};
-    return std::make_unique<HatBasis>(
-        mesh, config.mass == "lumped" ? MassKind::lumped : MassKind::consistent, hierarchy);
+    const MassKind mass = config.mass == "lumped" ? MassKind::lumped : MassKind::consistent;
+    if (config.octree.refine_input)  // the 1-to-4 split flows; the input's vertices are output
+      return std::make_unique<HatBasis>(subdivide_midpoint(mesh), mass, hierarchy,
+                                        mesh.num_vertices());
+    return std::make_unique<HatBasis>(mesh, mass, hierarchy);
   }
   if (config.basis == "octree") {
     const OctreeOptions o = octree_options(config.octree, analytic);

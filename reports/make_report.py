@@ -37,7 +37,7 @@ import index  # noqa: E402
 STAGING_FOLDER = ".report-staging"
 
 STUDIES = ["table1", "sphere_error", "model_error", "depth_cycles", "cubature", "cmcf", "time_order",
-           "hat_multigrid", "hat_scaling"]
+           "hat_multigrid", "hat_scaling", "work_precision"]
 
 
 def parse_args(argv):

@@ -18,7 +18,7 @@ while [ $# -gt 0 ]; do
 done
 [ -n "$out" ] || out="$root/out/studies${quick:+-quick}"
 if [ ${#studies[@]} -eq 0 ]; then
-  studies=(table1 sphere_error model_error depth_cycles cubature cmcf time_order)
+  studies=(table1 sphere_error model_error depth_cycles cubature cmcf time_order work_precision)
 fi
 status=0
 dirs=()

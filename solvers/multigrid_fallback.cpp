@@ -17,8 +17,7 @@ SolveReport FallbackMultigridSolver::set_matrix(const SparseMatrix& A, Hierarchy
   return multigrid_.set_matrix(A, hierarchy);
 }
 
-SolveReport FallbackMultigridSolver::set_matrix_sum(const MatrixSum& sum,
-                                                    HierarchyView hierarchy) {
+SolveReport FallbackMultigridSolver::set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy) {
   pcg_current_ = false;
   return multigrid_.set_matrix_sum(sum, hierarchy);
 }
@@ -53,9 +52,10 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   out.residuals = cycles.residuals;
   out.residuals.insert(out.residuals.end(), cg.residuals.begin(), cg.residuals.end());
   char note[128];
-  std::snprintf(note, sizeof note,
-                "cycles stalled (contraction %.3g > %.3g): CG preconditioned by the cycle took over",
-                cycles.contraction, fallback_.stall_ratio);
+  std::snprintf(
+      note, sizeof note,
+      "cycles stalled (contraction %.3g > %.3g): CG preconditioned by the cycle took over",
+      cycles.contraction, fallback_.stall_ratio);
   out.message = cycles.message.empty() ? note : cycles.message + "; " + note;
   if (!cg.message.empty()) out.message += "; " + cg.message;
   return out;

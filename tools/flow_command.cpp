@@ -39,7 +39,8 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
   cmd.add_option("--cube", args.cube,
                  "Octree bounding cube: auto (default: unit cube if the mesh fits) | unit | tight");
   cmd.add_flag("--refine-input", args.refine_input,
-               "Octree: split the input mesh 1-to-4 once first");
+               "Split the input mesh 1-to-4 once first (octree and hat basis); only its vertices "
+               "are output");
   cmd.add_option("--stabilization", args.stabilization,
                  "Octree: none (the paper's system) | normal-gradient (solve each step's "
                  "increment with the band's normal-gradient term added)");

@@ -1,0 +1,106 @@
+#!/usr/bin/python3
+"""reports/work_precision.py on fabricated result files: the marked Pareto front is exactly the
+non-dominated set (against a brute-force check over random points), contended cells are neither on
+it nor dominate anything, the table names the fastest setting within each error level, and the
+report writes its files. Exit 77 (skip) without matplotlib."""
+
+import json
+import os
+import random
+import sys
+import tempfile
+
+try:
+    import matplotlib  # noqa: F401
+except ImportError:
+    print("SKIP: /usr/bin/python3 has no matplotlib")
+    sys.exit(77)
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "reports"))
+import common  # noqa: E402
+import work_precision as wp  # noqa: E402
+
+failures = []
+
+
+def check(cond, what):
+    if not cond:
+        failures.append(what)
+
+
+def fake(index, basis, solver, time, error, repetition=0, contended=False, mesh="sphere:vertices=1000",
+         octree=None, status="ok"):
+    """A result file as `mcfbench run` writes it, with the fields the report reads."""
+    steps = [{"step": s, "seconds": {"total": time}, "radial_error": {"rms": error, "rms_continuous": 10 * error}}
+             for s in (1, 2, 3)]
+    return {"status": status, "stop": {"step": 3, "reason": "completed"},
+            "config": {"mesh": mesh, "flow": "mcf", "dt": 1e-3, "basis": basis, "solver": solver,
+                       "octree": octree or {"tracking": "tracked", "stabilization": "normal-gradient",
+                                            "stabilization_weight": 0.5, "refine_input": False}},
+            "steps": steps, "mesh": {"vertices": 1000},
+            "timing": {"step_median_seconds": time, "setup_seconds": 0.1, "flow_seconds": 3 * time + 0.1},
+            "contention": {"contended": contended},
+            "environment": {"commit": "fake"},
+            "cell": {"index": index, "repetition": repetition, "config_key": "k%d" % index, "study": "work_precision",
+                     "quick": False, "assignment": {}},
+            "_stem": "c%d-%d" % (index, repetition), "_path": "/fake/c%d-%d.json" % (index, repetition),
+            "_mtime": 0}
+
+
+# 1. The front against brute force, on random points, some contended.
+rng = random.Random(3)
+for trial in range(200):
+    pts = [{"time": rng.choice([rng.uniform(0.1, 10), 1.0]), "errors": {"e": rng.choice([rng.uniform(1e-6, 1e-3), 1e-4])},
+            "contended": rng.random() < 0.2} for _ in range(rng.randint(1, 25))]
+    front = wp.pareto_front(pts, "e")
+    usable = [p for p in pts if not p["contended"]]
+    expected = [p for p in usable
+                if not any(q["time"] <= p["time"] and q["errors"]["e"] <= p["errors"]["e"]
+                           and (q["time"] < p["time"] or q["errors"]["e"] < p["errors"]["e"]) for q in usable)]
+    check(sorted(map(id, front)) == sorted(map(id, expected)), "trial %d: front differs from the non-dominated set" % trial)
+    check(not any(p["contended"] for p in front), "trial %d: a contended point on the front" % trial)
+
+# 2. A contended point that would dominate everything is left out; the table skips it too.
+cg = {"name": "cholmod"}
+mg = lambda k: {"name": "multigrid", "cycle": "V", "smooth": 2, "cycles": k}  # noqa: E731
+results = [fake(0, "hat", cg, 1.0, 1e-5),
+           fake(1, "hat", mg(1), 0.2, 5e-5), fake(2, "hat", mg(2), 0.3, 1.05e-5), fake(3, "hat", mg(4), 0.5, 0.9e-5),
+           fake(4, "hat", mg(8), 0.01, 1e-9, contended=True)]
+# A second repetition of cell 1: contended, slower; the point's time is the quiet repetition's.
+results.append(fake(1, "hat", mg(1), 5.0, 5e-5, repetition=1, contended=True))
+points = wp.points_of(results)
+by_knob = {(p["family"], p["knob"]): p for p in points}
+check(by_knob[("hat MG V(2,2)", "x1")]["time"] == 0.2, "the contended repetition's time was used")
+check(by_knob[("hat MG V(2,2)", "x8")]["contended"], "an all-contended point is not marked contended")
+front = wp.pareto_front(points, "radial error, semi-implicit")
+check([p["knob"] for p in front] == ["x1", "x2", "x4"], "front: %s" % [p["knob"] for p in front])
+levels = wp.epsilons(points, "radial error, semi-implicit")
+check([round(e / 1e-5, 6) for e in levels] == [1.1, 2.0, 10.0], "error levels %s" % levels)
+check(wp.fastest_within(points, "radial error, semi-implicit", levels[0])["knob"] == "x2", "fastest within 1.1x")
+check(wp.fastest_within(points, "radial error, semi-implicit", levels[2])["knob"] == "x1", "fastest within 10x")
+check(wp.fastest_within(points, "radial error, semi-implicit", 1e-7) is None, "nothing reaches 1e-7 uncontended")
+
+# 3. Families and knobs from the config alone.
+check(wp.family_and_knob(fake(9, "octree", {"name": "pcg", "preconditioner": "multigrid", "cycle": "W", "smooth": 5,
+                                             "max_iterations": 3}, 1.0, 1e-5,
+                              octree={"stabilization": "none", "tracking": "tracked"}))[:2]
+      == ("octree (paper's system) CG by its W(5,5)", "3 its"), "octree CG family")
+check(wp.family_and_knob(fake(9, "hat", {"name": "cholmod"}, 1.0, 1e-5, octree={"refine_input": True}))[0].startswith("reference"),
+      "the refined reference")
+
+# 4. The report end to end, with a stopped cell listed and not plotted.
+results.append(fake(5, "octree", mg(1), 0.4, 1e-4, status="singular"))
+with tempfile.TemporaryDirectory() as out:
+    written = []
+    wp.make(results, out, None, written)
+    for name in ("work_precision.md", "work_precision.png", "work_precision_scaling.png"):
+        check(os.path.getsize(os.path.join(out, name)) > 0, "missing " + name)
+    text = open(os.path.join(out, "work_precision.md")).read()
+    check("hat MG V(2,2) x2" in text, "the table names the fastest setting within 1.1x")
+    check("Stopped before the last step" in text, "the stopped cell is not listed")
+    check("1 contended point(s) left out" in text, "contended points are not counted")
+
+if failures:
+    print("FAIL:\n  " + "\n  ".join(failures))
+    sys.exit(1)
+print("work_precision report: front, contention, table and files checked")
