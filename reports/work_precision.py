@@ -268,6 +268,7 @@ def make(results, out_dir, reference, written):
                 + ("; ".join("%s (%s s, %s)" % (describe(p), common.fmt(p["time"]), common.fmt(p["errors"][error]))
                              for p in front) or "none")
                 + (".\n\n%d contended point(s) left out." % busy if busy else "."))
+    sections += degenerating_sections(points)
     text = ("Error of the final step against the time per step (the median over repetitions of each "
             "repetition's median step over steps 2..N; repetitions interleaved). Error levels are "
             "multiples of the exact point's error (hat + CHOLMOD on the same mesh). Set-up (hierarchy, "
@@ -293,6 +294,42 @@ def make(results, out_dir, reference, written):
     fig.tight_layout()
     common.save_figure(fig, out_dir, "work_precision", cells, "Work-precision diagrams", written)
     draw_scaling(points, colours, out_dir, cells, written)
+
+
+def fallback_steps(result):
+    """(steps whose solves fell back to CG, CG iterations in all) of a result."""
+    steps = [s for s in result.get("steps") or [] if common.get(s, "solver.fallback")]
+    return len(steps), sum(common.get(s, "solver.fallback.iterations", 0) or 0 for s in steps)
+
+
+def degenerating_sections(points):
+    """Per degenerating case: each fast setting with its fallback against CHOLMOD on the same
+    system (same basis and octree system): the ratio of their errors, the steps each completed,
+    and how often the fallback ran."""
+    out = []
+    for case, pts in common.group_by([p for p in points if p["case"][0] == "degenerating"],
+                                     lambda p: (p["case"], p["vertices"])).items():
+        rows = []
+        for p in pts:
+            if not p["family"].endswith(" + fallback"):
+                continue
+            system = p["family"].split(" V(")[0].split(" W(")[0].replace("hat MG", "hat")
+            exact = next((q for q in pts if q["family"] == system + " + CHOLMOD"), None)
+            name = "distance to the reference flow"
+            e, x = p["errors"].get("RMS distance to the reference flow"), (exact or {}).get("errors", {}).get(
+                "RMS distance to the reference flow")
+            n, its = fallback_steps(p["result"])
+            rows.append([describe(p), common.fmt(e), exact["family"] if exact else "—", common.fmt(x),
+                         common.fmt(e / x, "%.2f") if common.finite(e) and common.finite(x) else "—",
+                         "%s / %s" % (common.get(p["result"], "stop.step", "?"),
+                                      common.get(exact["result"], "stop.step", "?") if exact else "—"),
+                         "%d steps, %d CG iterations" % (n, its)])
+        if rows:
+            out.append("### Degenerating: %s, %s vertices — the fast settings with their fallback\n\n" % (
+                case[0][1], case[1]) + common.markdown_table(
+                    ["setting", name, "CHOLMOD on the same system", "its distance", "ratio", "steps (ours / CHOLMOD)",
+                     "fallback"], rows))
+    return out
 
 
 def draw_scaling(points, colours, out_dir, cells, written):
