@@ -21,7 +21,8 @@ TEST(RefineInput, HatFlowOfTheSplitMeshAtTheInputsVertices) {
               {"solver", {{"name", solver}, {"cycles", 30}, {"tolerance", 1e-13}}}};
     json refined = j;
     refined["octree"]["refine_input"] = true;
-    const FlowConfig a = flow_config_from_json(refined, "test"), b = flow_config_from_json(j, "test");
+    const FlowConfig a = flow_config_from_json(refined, "test"),
+                     b = flow_config_from_json(j, "test");
     const MeshSource source = load_mesh_spec(a.mesh);
     MeshSource split = source;
     split.mesh = subdivide_midpoint(source.mesh);
