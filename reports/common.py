@@ -317,6 +317,23 @@ def commits_note(study, info):
                 "; its figures and tables mix commits" if sum(1 for _, _, kept, _ in info["commits"] if kept) > 1 else ""))
 
 
+def contended(result):
+    """Whether the cell shared its cores with other work while it ran (`contention.contended`,
+    bench/contention.h): its times are not a measurement of its method."""
+    return bool(get(result, "contention.contended", False))
+
+
+def quiet_or_all(results):
+    """The repetitions that ran uncontended, or all of them where none did."""
+    quiet = [r for r in results if not contended(r)]
+    return quiet or list(results)
+
+
+def time_text(result, seconds, spec="%.3g"):
+    """A formatted time, marked where its cell was contended."""
+    return fmt(seconds, spec) + (" (contended)" if contended(result) and finite(seconds) else "")
+
+
 def first_repetition(results):
     """One result per configuration (config_identity) and commit, its lowest repetition: curves
     are drawn once per variant. Of cells run by several commits only the newest commit's results

@@ -67,10 +67,10 @@ def make(results, out_dir, reference, written):
             step = table1.mean_step(r, "total")
             dist, at = last_distance(r)
             ratio = step / base_step if common.finite(step) and common.finite(base_step) else None
-            rows.append([solver_name(r), r.get("status", "?"), common.fmt(step), common.fmt(ratio, "%.2f"),
+            rows.append([solver_name(r), r.get("status", "?"), common.time_text(r, step), common.fmt(ratio, "%.2f"),
                          common.fmt(table1.mean_step(r, "solve")), common.fmt(contraction(r), "%.2f"),
                          common.fmt(dist), at if at is not None else "—"])
-            if common.finite(step) and common.finite(dist) and dist > 0:
+            if common.finite(step) and common.finite(dist) and dist > 0 and not common.contended(r):
                 points.append((solver_name(r), step, dist))
         title = "%s, %s, dt = %s" % key
         sections.append("### " + title + "\n\n" + common.markdown_table(

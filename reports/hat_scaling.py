@@ -16,12 +16,19 @@ def make(results, out_dir, reference, written):
     fig, ax = plt.subplots(figsize=(6.0, 4.2))
     rows = []
     for i, name in enumerate(sorted(by_solver)):
-        pts = sorted((common.get(r, "mesh.faces"), table1.mean_step(r, "total"), table1.mean_step(r, "solve"))
+        pts = sorted((common.get(r, "mesh.faces"), table1.mean_step(r, "total"), table1.mean_step(r, "solve"),
+                      common.contended(r))
                      for r in by_solver[name] if common.finite(common.get(r, "mesh.faces")))
         pts = [p for p in pts if common.finite(p[1])]
-        if pts:
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color="C%d" % i, label=name)
-        rows += [[name, "%d" % p[0], common.fmt(p[1]), common.fmt(p[2])] for p in pts]
+        quiet = [p for p in pts if not p[3]]
+        if quiet:
+            ax.plot([p[0] for p in quiet], [p[1] for p in quiet], "o-", color="C%d" % i, label=name)
+        busy = [p for p in pts if p[3]]
+        if busy:  # shared its cores with other work: drawn, but not as a measurement
+            ax.plot([p[0] for p in busy], [p[1] for p in busy], "o", mfc="none", color="0.6",
+                    label="contended (not measured)")
+        rows += [[name, "%d" % p[0], common.fmt(p[1]) + (" (contended)" if p[3] else ""), common.fmt(p[2])]
+                 for p in pts]
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("faces")

@@ -36,8 +36,9 @@ def system_seconds(result):
 
 
 def median_over(results, fn):
-    """Median over repetitions of fn(result), ignoring missing values."""
-    vals = [v for v in (fn(r) for r in results) if common.finite(v)]
+    """Median over repetitions of fn(result), ignoring missing values and, where any repetition
+    ran uncontended, the contended ones (common.quiet_or_all)."""
+    vals = [v for v in (fn(r) for r in common.quiet_or_all(results)) if common.finite(v)]
     return statistics.median(vals) if vals else None
 
 
