@@ -34,10 +34,10 @@ struct SolverConfig {
   std::string cycle = "W";                ///< multigrid: V | W
   int cycles = 1;                         ///< multigrid cycles per solve
   int smooth = 5;                         ///< Gauss–Seidel sweeps before and after (each)
-  /// multigrid: when a solve's cycles reduce the residual by less than this per cycle (mean over
-  /// the solve), CG preconditioned by the cycle takes over to `fallback_tolerance`
-  /// (solvers/multigrid_fallback.h); 0 = never.
-  double stall_ratio = 0.5;
+  /// multigrid: k cycles promise to reduce the step's initial residual by stall_ratio^k; where they
+  /// reduce it by less per cycle, CG preconditioned by the cycle takes over until they have
+  /// (never below `fallback_tolerance`; solvers/multigrid_fallback.h). 0 = never.
+  double stall_ratio = 0.2;
   double fallback_tolerance = 1e-10;
 };
 

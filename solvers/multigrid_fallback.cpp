@@ -1,5 +1,8 @@
 #include "solvers/multigrid_fallback.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace mcf {
@@ -27,17 +30,23 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   const bool stalled = cycles.ok() && cycles.contraction > fallback_.stall_ratio &&
                        cycles.relative_residual > fallback_.tolerance;
   if (!stalled) return cycles;
+  // r_k = r_0 · contraction^k, so healthy cycles would have reached r_k · (bound / contraction)^k.
+  const double target =
+      std::max(fallback_.tolerance,
+               cycles.relative_residual *
+                   std::pow(fallback_.stall_ratio / cycles.contraction, cycles.iterations));
+  PcgOptions o;
+  o.relative_tolerance = target;
+  o.max_iterations = fallback_.max_iterations;
+  o.preconditioner = PcgPreconditioner::external;
   if (!pcg_) {
-    PcgOptions o;
-    o.relative_tolerance = fallback_.tolerance;
-    o.max_iterations = fallback_.max_iterations;
-    o.preconditioner = PcgPreconditioner::external;
     pcg_ = std::make_unique<PcgSolver>(o);
     // One cycle from zero with equal sweeps before and after: a symmetric operator
     // (MultigridSolver::precondition), as CG needs.
     pcg_->set_preconditioner(
         [this](const Eigen::MatrixXd& r, Eigen::MatrixXd& z) { multigrid_.precondition(r, z); });
   }
+  pcg_->set_options(o);
   if (!pcg_current_) {
     const SolveReport m = pcg_->set_matrix(multigrid_.level_matrix(multigrid_.levels() - 1));
     if (!m.ok()) return m;
@@ -51,11 +60,11 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   out.contraction = cycles.contraction;
   out.residuals = cycles.residuals;
   out.residuals.insert(out.residuals.end(), cg.residuals.begin(), cg.residuals.end());
-  char note[128];
+  char note[192];
   std::snprintf(
       note, sizeof note,
-      "cycles stalled (contraction %.3g > %.3g): CG preconditioned by the cycle took over",
-      cycles.contraction, fallback_.stall_ratio);
+      "cycles stalled (contraction %.3g > %.3g): CG preconditioned by the cycle took over to %.3g",
+      cycles.contraction, fallback_.stall_ratio, target);
   out.message = cycles.message.empty() ? note : cycles.message + "; " + note;
   if (!cg.message.empty()) out.message += "; " + cg.message;
   return out;

@@ -60,10 +60,12 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
   cmd.add_option("--smooth", args.smooth,
                  "Gauss-Seidel sweeps before and after each coarse correction (default 5)");
   cmd.add_option("--stall-ratio", args.stall_ratio,
-                 "Multigrid: CG preconditioned by the cycle takes over when the cycles reduce the "
-                 "residual by less than this per cycle (default 0.5; 0 = never)");
-  cmd.add_option("--fallback-tolerance", args.fallback_tolerance,
-                 "Multigrid: relative residual the fallback CG stops at (default 1e-10)");
+                 "Multigrid: where the cycles reduce the residual by less than this per cycle, CG "
+                 "preconditioned by the cycle takes over until they have reached what this ratio "
+                 "promises (default 0.2; 0 = never)");
+  cmd.add_option(
+      "--fallback-tolerance", args.fallback_tolerance,
+      "Multigrid: the fallback CG never stops below this relative residual (default 1e-10)");
   cmd.add_option(
       "--integrator", args.integrator,
       "explicit-euler | semi-implicit (default) | crank-nicolson | bdf2 | taylor2 | neumann2");

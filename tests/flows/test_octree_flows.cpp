@@ -41,10 +41,11 @@ json paper(const std::string& mesh, const std::string& tracking, int depth, cons
   return j;
 }
 
-TEST(OctreeFlows, StalledCyclesFallBackToCgAndMatchTheExactSolve) {
+TEST(OctreeFlows, StalledCyclesFallBackToCgAndComeCloserToTheExactSolve) {
   // One W-cycle a step on the paper's system contracts by 0.2-0.8 (its near-null modes,
-  // docs/octree-multigrid.md): with the default bound of 0.5, CG preconditioned by the cycle
-  // takes over on such steps and solves to 1e-10, so the flow follows the exact solve.
+  // docs/octree-multigrid.md): with the default bound of 0.2, CG preconditioned by the cycle
+  // takes over on such steps until the step's initial residual is reduced 5x, as a contracting
+  // cycle would have, so the flow stays closer to the exact solve than the plain cycles.
   json mg = octree("icosphere:level=3", "tracked", 5, {{"name", "multigrid"}});
   mg["octree"]["stabilization"] = "none";
   json plain = paper("icosphere:level=3", "tracked", 5, {{"name", "multigrid"}});
@@ -54,19 +55,23 @@ TEST(OctreeFlows, StalledCyclesFallBackToCgAndMatchTheExactSolve) {
   const Positions exact = run(ch).final_mesh.vertices;
   int fell_back = 0;
   for (const auto& s : fallback.result["steps"]) {
-    EXPECT_TRUE(s["solver"].contains("contraction"));
-    if (s["solver"].contains("fallback")) {
-      ++fell_back;
-      EXPECT_GT(s["solver"]["contraction"].get<double>(), 0.5);
-      EXPECT_GT(s["solver"]["fallback"]["iterations"].get<int>(), 0);
-      EXPECT_LE(s["solver"]["relative_residual"].get<double>(), 1e-10);
-    }
+    const auto& solver = s["solver"];
+    ASSERT_TRUE(solver.contains("contraction"));
+    if (!solver.contains("fallback")) continue;
+    ++fell_back;
+    // The cycle's residual over its contraction is the step's initial residual r_0.
+    const double c = solver["contraction"].get<double>();
+    const double r0 = solver["residuals"][0].get<double>() / c;
+    EXPECT_GT(c, 0.2);
+    EXPECT_GT(solver["fallback"]["iterations"].get<int>(), 0);
+    EXPECT_LE(solver["relative_residual"].get<double>(), 0.2 * r0 * (1 + 1e-9));
+    EXPECT_EQ(solver["status"], "converged");
   }
   EXPECT_GT(fell_back, 0);
   for (const auto& s : cycles.result["steps"]) EXPECT_FALSE(s["solver"].contains("fallback"));
   const double off_fallback = (fallback.final_mesh.vertices - exact).norm() / exact.norm();
   const double off_cycles = (cycles.final_mesh.vertices - exact).norm() / exact.norm();
-  EXPECT_LT(off_fallback, 0.5 * off_cycles);
+  EXPECT_LT(off_fallback, off_cycles);
 }
 
 TEST(OctreeFlows, MultigridConvergesToCholmod) {

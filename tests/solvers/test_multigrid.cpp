@@ -1097,9 +1097,9 @@ TEST(MultigridFallback, StalledCyclesHandOverToCgThatReachesTheTolerance) {
   Eigen::SimplicialLDLT<SparseMatrix> ldlt(pr.A);
   const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 9);
   const Eigen::MatrixXd exact = ldlt.solve(B);
-  MultigridOptions o;  // one W-cycle: contracts by ~0.05, "stalled" for a bound of 1e-6
+  MultigridOptions o;  // one W-cycle: contracts by ~0.05, "stalled" for a bound of 1e-12
   mcf::StallFallbackOptions f;
-  f.stall_ratio = 1e-6;
+  f.stall_ratio = 1e-12;
   f.tolerance = 1e-11;
   mcf::FallbackMultigridSolver guarded(o, f);
   for (int round = 0; round < 2; ++round) {  // the second solve reuses CG's matrix
@@ -1115,7 +1115,28 @@ TEST(MultigridFallback, StalledCyclesHandOverToCgThatReachesTheTolerance) {
     EXPECT_NE(rep.message.find("stalled"), std::string::npos);
     EXPECT_EQ(guarded.fallbacks(), round + 1);
   }
+  // A bound above the floor: CG stops where healthy cycles would have been, r_0 · bound^k (r_0 = 1
+  // from a zero start), not at the floor.
+  // The bound is a tenth of what the cycle achieves, so it counts as stalled.
+  MultigridOptions measured = o;
+  measured.measure_contraction = true;
+  MultigridSolver plain(measured);
+  ASSERT_TRUE(plain.set_matrix(pr.A, pr.view()).ok());
+  Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  const double bound = 0.1 * plain.solve(B, Z).contraction;
+  ASSERT_GT(bound, 1e-6);
+  f.stall_ratio = bound;
+  mcf::FallbackMultigridSolver to_bound(o, f);
+  ASSERT_TRUE(to_bound.set_matrix(pr.A, pr.view()).ok());
+  {
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+    const auto rep = to_bound.solve(B, X);
+    EXPECT_GT(rep.fallback_iterations, 0);
+    EXPECT_LE(rep.relative_residual, bound * (1 + 1e-9));
+    EXPECT_GT(rep.relative_residual, 1e-3 * bound);  // stopped near the bound, not at the floor
+  }
   // CG that runs out of iterations says so: not converged, not silently exact.
+  f.stall_ratio = 1e-12;
   f.max_iterations = 1;
   f.tolerance = 1e-15;
   mcf::FallbackMultigridSolver capped(o, f);
