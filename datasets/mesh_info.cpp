@@ -25,7 +25,7 @@ nlohmann::json mesh_info(const std::string& spec, const std::string& write_to,
                       {"bbox_min", {lo.x(), lo.y(), lo.z()}},
                       {"bbox_max", {hi.x(), hi.y(), hi.z()}},
                       {"reoriented_faces", r.reoriented_faces},
-                      {"collapsed_faces", r.collapsed_faces},
+                      {"repaired_faces", r.repaired_faces},
                       {"degenerate_faces", r.degenerate_faces}};
   if (!m.notes.empty()) j["notes"] = m.notes;
   if (m.sphere_radius) j["sphere_radius"] = *m.sphere_radius;

@@ -11,7 +11,7 @@ namespace mcf {
 
 /// {spec, kind, analytic, vertices, faces, unreferenced_vertices, boundary_loops,
 /// connected_components, euler_characteristic, genus, area, bbox_min, bbox_max,
-/// reoriented_faces, collapsed_faces, degenerate_faces[, notes][, sphere_radius][,
+/// reoriented_faces, repaired_faces, degenerate_faces[, notes][, sphere_radius][,
 /// cylinder_radius]} of the mesh `spec` gives, loaded with `options`. When `write_to` is not
 /// empty the (generated / scaled / repaired / subdivided) mesh is also written there, before the
 /// description is returned: a write that fails throws.

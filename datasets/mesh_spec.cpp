@@ -397,23 +397,26 @@ MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& option
                         count_of(faces_read, "face") +
                         " so that every face agrees with its neighbours (the file lists them "
                         "with mixed orientation)");
-  CollapseReport collapsed;
-  if (options.degenerate == DegenerateFaces::collapse) {
+  DegenerateRepair repaired;
+  if (options.degenerate == DegenerateFaces::repair) {
     // Before subdivision, which would make four zero-area faces of each.
-    collapsed = collapse_degenerate_faces(src.mesh);
-    if (collapsed.degenerate_faces > 0) {
+    repaired = repair_degenerate_faces(src.mesh);
+    if (repaired.degenerate_faces > 0) {
       try {
         check_half_edge_faces(src.mesh, validate_name);
       } catch (const MeshError& e) {
-        fail(spec, std::string("collapsing its zero-area faces left a mesh a half-edge mesh "
+        fail(spec, std::string("removing its zero-area faces left a mesh a half-edge mesh "
                                "cannot hold: ") +
                        e.what());
       }
+      const long long collapsed = repaired.degenerate_faces - repaired.flipped_faces;
       src.notes.push_back(
-          "collapsed " + count_of(collapsed.degenerate_faces, "zero-area face") +
-          " (repair_degenerate): " + count_of(collapsed.removed_faces, "face") + " of " +
-          std::to_string(faces_read) + " removed, " + std::to_string(collapsed.merged_vertices) +
-          (collapsed.merged_vertices == 1 ? " vertex" : " vertices") + " merged into a neighbour");
+          "removed " + count_of(repaired.degenerate_faces, "zero-area face") +
+          " (repair_degenerate): " + std::to_string(repaired.flipped_faces) +
+          " flipped away across their longest edge, " + std::to_string(collapsed) + " collapsed (" +
+          std::to_string(repaired.removed_faces) + " of " + count_of(faces_read, "face") +
+          " gone, " + std::to_string(repaired.merged_vertices) +
+          (repaired.merged_vertices == 1 ? " vertex" : " vertices") + " merged into a neighbour)");
     }
   }
   if (target_faces > 0) subdivide_source(src, target_faces);
@@ -422,7 +425,7 @@ MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& option
   validate.degenerate_hint = options.degenerate_hint;
   src.report = validate_mesh(src.mesh, validate_name, validate);
   src.report.reoriented_faces = read.reoriented_faces;
-  src.report.collapsed_faces = collapsed.degenerate_faces;
+  src.report.repaired_faces = repaired.degenerate_faces;
   if (src.report.degenerate_faces > 0)
     src.notes.push_back("kept " + count_of(src.report.degenerate_faces, "zero-area face") +
                         " as they are");

@@ -28,15 +28,15 @@ struct MeshSource {
   std::optional<double> cylinder_radius;  ///< set for open_cylinder (axis z through the origin)
   MeshReport report;                      ///< validation report (validate_mesh has passed)
   /// What loading changed or let through, one sentence each (faces reoriented, zero-area faces
-  /// collapsed or kept), for the user to see on stderr; the counts are in `report`.
+  /// removed or kept), for the user to see on stderr; the counts are in `report`.
   std::vector<std::string> notes;
 };
 
 /// What to do with zero-area faces (validate.h's degenerate_faces).
 enum class DegenerateFaces {
-  refuse,    ///< a MeshError naming the first one (the default)
-  keep,      ///< counted in MeshReport::degenerate_faces (a basis that needs no cotangents)
-  collapse,  ///< collapse_degenerate_faces (datasets/repair.h), counted in collapsed_faces
+  refuse,  ///< a MeshError naming the first one (the default)
+  keep,    ///< counted in MeshReport::degenerate_faces (a basis that needs no cotangents)
+  repair,  ///< repair_degenerate_faces (datasets/repair.h), counted in repaired_faces
 };
 
 struct MeshLoadOptions {

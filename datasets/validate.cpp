@@ -214,8 +214,12 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name,
   return report;
 }
 
+double degenerate_area(const TriangleMesh& mesh) {
+  return min_face_area(mesh, referenced_vertices(mesh.num_vertices(), mesh.faces));
+}
+
 std::vector<Eigen::Index> degenerate_faces(const TriangleMesh& mesh) {
-  const double min_area = min_face_area(mesh, referenced_vertices(mesh.num_vertices(), mesh.faces));
+  const double min_area = degenerate_area(mesh);
   std::vector<Eigen::Index> out;
   for (Eigen::Index f = 0; f < mesh.num_faces(); ++f)
     if (is_degenerate(face_area(mesh, f), min_area)) out.push_back(f);

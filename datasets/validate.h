@@ -27,8 +27,8 @@ struct MeshReport {
   long long degenerate_faces = 0;
   /// Faces the reader reversed to orient the surface consistently (read_mesh's ReadReport).
   long long reoriented_faces = 0;
-  /// Zero-area faces collapsed by the opt-in repair (collapse_degenerate_faces).
-  long long collapsed_faces = 0;
+  /// Zero-area faces removed by the opt-in repair (repair_degenerate_faces).
+  long long repaired_faces = 0;
   bool closed() const { return boundary_loops == 0; }
 };
 
@@ -51,6 +51,9 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name,
 /// diagonal of the surface's bounding box (relative, since the studies mix unit-cube models and
 /// large analytic shapes). Face indices must be valid.
 std::vector<Eigen::Index> degenerate_faces(const TriangleMesh& mesh);
+
+/// The area at or below which a face of this mesh is degenerate (degenerate_faces).
+double degenerate_area(const TriangleMesh& mesh);
 
 /// Unreferenced vertices do not count in χ or components. Boundary loops are the connected
 /// components of the boundary-edge graph (two holes touching at one vertex count as one).

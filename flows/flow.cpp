@@ -201,7 +201,7 @@ nlohmann::json mesh_json(const MeshSource& source) {
           {"area", rep.area},
           {"analytic", source.analytic},
           {"reoriented_faces", rep.reoriented_faces},
-          {"collapsed_faces", rep.collapsed_faces},
+          {"repaired_faces", rep.repaired_faces},
           {"degenerate_faces", rep.degenerate_faces}};
 }
 

@@ -135,7 +135,7 @@ void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::
 MeshLoadOptions mesh_load_options(const FlowConfig& c) {
   MeshLoadOptions o;
   if (c.repair_degenerate) {
-    o.degenerate = DegenerateFaces::collapse;
+    o.degenerate = DegenerateFaces::repair;
   } else if (c.basis == "octree") {
     // The octree basis integrates over the surface by cubature on clipped pieces, and a
     // zero-area face leaves no piece: it changes nothing there.
@@ -143,7 +143,7 @@ MeshLoadOptions mesh_load_options(const FlowConfig& c) {
   } else {
     o.degenerate_hint =
         ": the hat basis needs every face's cotangents, which a zero-area face lacks; "
-        "--repair-degenerate (config key repair_degenerate) collapses zero-area faces, or "
+        "--repair-degenerate (config key repair_degenerate) removes zero-area faces, or "
         "--basis octree takes them as they are";
   }
   return o;

@@ -66,7 +66,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
 nlohmann::json to_json(const FlowConfig& c);
 /// Cross-option checks (e.g. multigrid needs the octree, cMCF needs a fixed basis).
 void validate_flow_config(const FlowConfig& c, const std::string& source);
-/// How the flow's mesh is loaded: zero-area faces collapsed (repair_degenerate), kept (the octree
+/// How the flow's mesh is loaded: zero-area faces removed (repair_degenerate), kept (the octree
 /// basis, which integrates over the surface and needs no face's cotangents) or refused with a
 /// message naming the option that goes on (the hat basis).
 MeshLoadOptions mesh_load_options(const FlowConfig& c);

@@ -42,10 +42,10 @@ void add_mesh_info_command(CLI::App& app, std::function<int()>& run) {
     run = [a]() -> int {
       const std::string& spec = a->spec.empty() ? a->mesh : a->spec;
       MeshLoadOptions options;
-      if (a->repair_degenerate) options.degenerate = DegenerateFaces::collapse;
+      if (a->repair_degenerate) options.degenerate = DegenerateFaces::repair;
       if (a->keep_degenerate) options.degenerate = DegenerateFaces::keep;
       options.degenerate_hint =
-          ": --repair-degenerate collapses zero-area faces, --keep-degenerate counts them";
+          ": --repair-degenerate removes zero-area faces, --keep-degenerate counts them";
       const nlohmann::json info = mesh_info(spec, a->out, options);
       for (const auto& note : info.value("notes", nlohmann::json::array()))
         std::fprintf(stderr, "mcfbench mesh-info: %s: %s\n", spec.c_str(),

@@ -1,7 +1,7 @@
 // Flows on meshes as they come: a mesh whose every vertex lies on its held boundary has nothing
 // free to move, and every solver completes its flow with the mesh unchanged (none is asked to
 // factorize or cycle on an empty system, which each used to report as a singular flow); the
-// octree basis flows a mesh with zero-area faces; repair_degenerate collapses them for the hat
+// octree basis flows a mesh with zero-area faces; repair_degenerate removes them for the hat
 // basis; unit-area normalisation of an open surface is refused saying what to run instead.
 
 #include "../core/temp_dir.h"
@@ -90,12 +90,13 @@ TEST(Flow, ZeroAreaFacesAreKeptByTheOctreeRefusedByTheHatBasisOrCollapsedOnReque
   EXPECT_EQ(octree.result["mesh"]["degenerate_faces"], 1);
   EXPECT_EQ(octree.result["mesh"]["faces"], 6);
   EXPECT_EQ(octree.result["mesh"]["notes"].size(), 1u);
-  // repair_degenerate collapses the cap for the hat basis, and says so in the config and mesh.
+  // repair_degenerate removes the cap for the hat basis (its longest edge is on the boundary, so
+  // it is collapsed), and says so in the config and mesh.
   const FlowOutcome hat =
       flow({{"mesh", tent}, {"basis", "hat"}, {"repair_degenerate", true}, {"steps", 2}});
   EXPECT_EQ(hat.result["status"], "ok") << hat.result["stop"].dump();
   EXPECT_EQ(hat.result["config"]["repair_degenerate"], true);
-  EXPECT_EQ(hat.result["mesh"]["collapsed_faces"], 1);
+  EXPECT_EQ(hat.result["mesh"]["repaired_faces"], 1);
   EXPECT_EQ(hat.result["mesh"]["faces"], 4);
   EXPECT_EQ(hat.final_mesh.num_faces(), 4);
   // Left unset, the key stays out of the config (so cell keys of earlier runs still match).

@@ -511,10 +511,10 @@ TEST(Cli, ZeroAreaFacesAreRefusedNamingTheWaysOnOrRepairedOnRequest) {
   const Output r = mcfbench_output("flow --mesh " + tent.string() +
                                    " --repair-degenerate --steps 1 --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("collapsed 1 zero-area face"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("removed 1 zero-area face"), std::string::npos) << r.err;
   std::ifstream in(out / "result.json");
   const nlohmann::json j = nlohmann::json::parse(in);
-  EXPECT_EQ(j["mesh"]["collapsed_faces"], 1);
+  EXPECT_EQ(j["mesh"]["repaired_faces"], 1);
   EXPECT_EQ(j["config"]["repair_degenerate"], true);
   const Output octree = mcfbench_output("flow --mesh " + tent.string() +
                                         " --basis octree --depth 5 --steps 1 --out " +
@@ -527,7 +527,7 @@ TEST(Cli, ZeroAreaFacesAreRefusedNamingTheWaysOnOrRepairedOnRequest) {
   EXPECT_NE(info.err.find("--repair-degenerate"), std::string::npos) << info.err;
   EXPECT_EQ(
       nlohmann::json::parse(
-          mcfbench_output("mesh-info --repair-degenerate " + tent.string()).out)["collapsed_faces"],
+          mcfbench_output("mesh-info --repair-degenerate " + tent.string()).out)["repaired_faces"],
       1);
   EXPECT_EQ(
       nlohmann::json::parse(
