@@ -69,6 +69,7 @@ OrientationResult orient_faces(Triangles& faces) {
     i = j;
   }
   if (result.problem != OrientationResult::Problem::none) return result;
+  std::vector<EdgeUse>().swap(uses);  // a 1M-face mesh's uses and links are ~100 MB each
   std::vector<Eigen::Index> start(static_cast<std::size_t>(m + 1), 0);
   for (const auto& l : links) ++start[static_cast<std::size_t>(l.first + 1)];
   for (Eigen::Index f = 0; f < m; ++f)
@@ -78,6 +79,7 @@ OrientationResult orient_faces(Triangles& faces) {
     std::vector<Eigen::Index> next(start.begin(), start.end() - 1);
     for (const auto& l : links) adjacent[static_cast<std::size_t>(next[l.first]++)] = l.second;
   }
+  std::vector<std::pair<Eigen::Index, Link>>().swap(links);
 
   // flip[f]: 0 unvisited, 1 keep, 2 reverse.
   std::vector<char> flip(static_cast<std::size_t>(m), 0);
