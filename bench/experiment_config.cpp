@@ -212,7 +212,10 @@ bool excluded(const json& raw, const json& exclude, std::vector<bool>& used) {
 const std::vector<std::string>& flow_config_keys() {
   static const std::vector<std::string> keys = [] {
     std::vector<std::string> k;
-    flatten_keys(to_json(FlowConfig{}), "", k);
+    // With every key that to_json writes only when it is set.
+    FlowConfig every;
+    every.repair_degenerate = true;
+    flatten_keys(to_json(every), "", k);
     return k;
   }();
   return keys;

@@ -4,6 +4,7 @@
 #include "bench/experiment_config.h"
 #include "bench/memory_budget.h"
 #include "bench/progress.h"
+#include "bench/stop_signals.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "datasets/mesh_spec.h"
@@ -42,13 +43,24 @@ FlowConfig flow_config_of(const FlowRequest& request) {
   return flow_config_from_json(j, source);
 }
 
+/// A stop request (SIGINT, SIGTERM) seen after step `step`.
+struct FlowInterrupted {
+  int signal;
+  int step;
+};
+
 /// Runs the flow with its progress on stderr and its frames (every config.save_every steps)
-/// written into `staging`, listed in `frames`.
+/// written into `staging`, listed in `frames`. After every step (and before the first) a stop
+/// request throws FlowInterrupted, before that step's frame is written.
 FlowOutcome run_staged(const FlowConfig& config, const MeshSource& mesh, const fs::path& staging,
                        double line_seconds, std::set<std::string>& frames) {
   Progress progress("step", config.steps, line_seconds);
   FlowObserver observer;
   observer.on_step = [&](int step, double, const Positions& V) {
+    if (const int signal = StopSignals::received()) {
+      progress.clear();
+      throw FlowInterrupted{signal, step};
+    }
     progress.update(step);
     if (config.save_every > 0 && step % config.save_every == 0) {
       char name[32];
@@ -83,13 +95,16 @@ void publish(const fs::path& out, const fs::path& staging, const std::set<std::s
 
 }  // namespace
 
-void run_flow_into_folder(const FlowRequest& request) {
+int run_flow_into_folder(const FlowRequest& request) {
   const FlowConfig config = flow_config_of(request);
   const MemoryBudget budget = memory_budget(request.max_memory);
   // Before the mesh is generated or read (a generator's size is known from its spec), then with
   // the mesh's own sizes before the basis is built.
   checked_memory_estimate(config, spec_sizes(parse_mesh_spec(config.mesh)), budget, config.mesh);
-  const MeshSource mesh = load_mesh_spec(config.mesh);  // throws naming the file: nothing written
+  // Throws naming the file: nothing written.
+  const MeshSource mesh = load_mesh_spec(config.mesh, mesh_load_options(config));
+  for (const std::string& note : mesh.notes)
+    std::fprintf(stderr, "mcfbench flow: %s: %s\n", config.mesh.c_str(), note.c_str());
   const MemoryEstimate memory = checked_memory_estimate(
       config, mesh_sizes(config, mesh.mesh, mesh.analytic), budget, config.mesh);
   const double line_seconds = progress_line_seconds();  // a bad MCFBENCH_PROGRESS_SECONDS too
@@ -112,6 +127,9 @@ void run_flow_into_folder(const FlowRequest& request) {
   std::set<std::string> frames;
   FlowOutcome outcome;
   const double steal_before = cpu_steal_seconds();
+  // SIGINT and SIGTERM stop the flow after the running step, as they stop `run`: the staging
+  // folder goes as on any failure, and OUT keeps what it held.
+  const StopSignals signals;
   // Every file of the run is written into the staging folder first: a write that fails (a full
   // disk) leaves OUT as it was, whatever it held.
   try {
@@ -124,15 +142,25 @@ void run_flow_into_folder(const FlowRequest& request) {
       outcome.result["steal_seconds"] = steal;
     write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
     write_file_atomic((staging / "result.json").string(), outcome.result.dump(1) + "\n");
+  } catch (const FlowInterrupted& stop) {
+    fs::remove_all(created ? out : staging, ec);
+    std::fprintf(stderr, "mcfbench flow: stopped by %s after step %d of %d; %s\n",
+                 signal_name(stop.signal).c_str(), stop.step, config.steps,
+                 created ? ("nothing written (" + out.string() + " removed)").c_str()
+                         : (out.string() + " holds what it held before").c_str());
+    return 128 + stop.signal;  // as a shell reports a process the signal ended
   } catch (...) {
     fs::remove_all(created ? out : staging, ec);
     throw;
   }
   publish(out, staging, frames);
+  for (const auto& note : outcome.result.value("notes", nlohmann::json::array()))
+    std::fprintf(stderr, "mcfbench flow: %s\n", note.get<std::string>().c_str());
   const auto& stop = outcome.result["stop"];
   std::fprintf(stderr, "mcfbench flow: %s after %d steps (%s); wrote %s\n",
                outcome.result["status"].get<std::string>().c_str(), stop["step"].get<int>(),
                stop["reason"].get<std::string>().c_str(), (out / "result.json").c_str());
+  return 0;
 }
 
 }  // namespace mcf

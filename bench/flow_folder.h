@@ -26,8 +26,12 @@ struct FlowRequest {
 /// (flow_config_from_json, so the command line and experiment configs agree), loads the mesh,
 /// refuses a flow whose estimated peak memory exceeds the budget (before the mesh is generated,
 /// from the spec's sizes, and again once it is loaded), runs the flow with its progress on stderr
-/// and publishes its files into `out`; one line on stderr says how the flow ended. Throws on a
+/// and publishes its files into `out`; one line on stderr says how the flow ended, and one per
+/// note of the mesh's loading (faces reoriented, zero-area faces collapsed or kept). Throws on a
 /// configuration or set-up error, before anything is written or removing what this run created.
-void run_flow_into_folder(const FlowRequest& request);
+/// SIGINT or SIGTERM stops the flow after the running step (bench/stop_signals.h): its staged
+/// files are removed, `out` keeps what it held (or is removed when this run created it), a line
+/// on stderr says so, and 128 + the signal is returned; else 0.
+int run_flow_into_folder(const FlowRequest& request);
 
 }  // namespace mcf

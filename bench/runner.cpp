@@ -104,7 +104,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   json result;
   json memory;
   try {
-    const MeshSource& source = meshes.get(config.mesh);
+    const MeshSource& source = meshes.get(config);
     memory = estimate_flow_memory(config, mesh_sizes(config, source.mesh, source.analytic),
                                   resident_memory_bytes())
                  .to_json();
@@ -243,10 +243,12 @@ RunStopped::RunStopped(int signal_number, const RunSummary& run_summary, int cel
       summary(run_summary),
       done(cells_done) {}
 
-const MeshSource& MeshCache::get(const std::string& spec) {
-  auto it = meshes_.find(spec);
+const MeshSource& MeshCache::get(const std::string& spec, const MeshLoadOptions& options) {
+  // The hint only words the refusal: the treatment of zero-area faces makes the mesh.
+  const std::string key = spec + "\n" + std::to_string(static_cast<int>(options.degenerate));
+  auto it = meshes_.find(key);
   if (it == meshes_.end())
-    it = meshes_.emplace(spec, std::make_shared<MeshSource>(load_mesh_spec(spec))).first;
+    it = meshes_.emplace(key, std::make_shared<MeshSource>(load_mesh_spec(spec, options))).first;
   return *it->second;
 }
 
@@ -297,14 +299,14 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
     }
     if (!wanted || wanted(c)) {
       try {
-        p.mesh_fingerprint = mesh_fingerprint(meshes.get(c.flow.mesh).mesh);
+        p.mesh_fingerprint = mesh_fingerprint(meshes.get(c.flow).mesh);
       } catch (const std::exception& ex) {
         throw ConfigError(e.source + " (cell " + std::to_string(c.index) + " " +
                           c.assignment.dump() + "): mesh: " + ex.what());
       }
       // Before any cell runs: a cell that cannot run on its mesh stops the whole plan.
       validate_flow_mesh(
-          c.flow, meshes.get(c.flow.mesh).report,
+          c.flow, meshes.get(c.flow).report,
           e.source + " (cell " + std::to_string(c.index) + " " + c.assignment.dump() + ")");
       p.key = cell_key(p.cell.config, c.repetition, p.mesh_fingerprint);
       p.config_key = cell_key(p.cell.config, -1, p.mesh_fingerprint);
@@ -435,7 +437,7 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   for (const CellPlan& p : plans)
     if (!o.distances_only && in_shard(p.cell.index, o.shard_index, o.shard_count) &&
         (o.force || !cell_finished(p.file))) {
-      const MeshSource& source = meshes.get(p.cell.flow.mesh);
+      const MeshSource& source = meshes.get(p.cell.flow);
       checked_memory_estimate(p.cell.flow, mesh_sizes(p.cell.flow, source.mesh, source.analytic),
                               budget, cell_name(p.cell) + ", mesh " + p.cell.flow.mesh);
     }

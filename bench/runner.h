@@ -26,10 +26,13 @@ struct CellPlan {
   std::string file;        ///< OUT/<hash>.json
 };
 
-/// Meshes are loaded once per spec per process (hashing needs the loaded mesh's bytes).
+/// Meshes are loaded once per spec (and treatment of zero-area faces) per process (hashing needs
+/// the loaded mesh's bytes).
 class MeshCache {
  public:
-  const MeshSource& get(const std::string& spec);
+  const MeshSource& get(const std::string& spec, const MeshLoadOptions& options = {});
+  /// The mesh of a flow, loaded as that flow loads it (mesh_load_options).
+  const MeshSource& get(const FlowConfig& flow) { return get(flow.mesh, mesh_load_options(flow)); }
 
  private:
   std::map<std::string, std::shared_ptr<MeshSource>> meshes_;

@@ -5,8 +5,9 @@
 
 namespace mcf {
 
-nlohmann::json mesh_info(const std::string& spec, const std::string& write_to) {
-  const MeshSource m = load_mesh_spec(spec);
+nlohmann::json mesh_info(const std::string& spec, const std::string& write_to,
+                         const MeshLoadOptions& options) {
+  const MeshSource m = load_mesh_spec(spec, options);
   const MeshReport& r = m.report;
   const Eigen::Vector3d lo = m.mesh.vertices.colwise().minCoeff(),
                         hi = m.mesh.vertices.colwise().maxCoeff();
@@ -22,7 +23,11 @@ nlohmann::json mesh_info(const std::string& spec, const std::string& write_to) {
                       {"genus", r.genus},
                       {"area", r.area},
                       {"bbox_min", {lo.x(), lo.y(), lo.z()}},
-                      {"bbox_max", {hi.x(), hi.y(), hi.z()}}};
+                      {"bbox_max", {hi.x(), hi.y(), hi.z()}},
+                      {"reoriented_faces", r.reoriented_faces},
+                      {"repaired_faces", r.repaired_faces},
+                      {"degenerate_faces", r.degenerate_faces}};
+  if (!m.notes.empty()) j["notes"] = m.notes;
   if (m.sphere_radius) j["sphere_radius"] = *m.sphere_radius;
   if (m.cylinder_radius) j["cylinder_radius"] = *m.cylinder_radius;
   // Written before the report is printed: a write that fails (an unknown extension, a missing

@@ -1,6 +1,8 @@
 #pragma once
 // `mcfbench mesh-info SPEC`: a mesh spec loaded, validated and described.
 
+#include "datasets/mesh_spec.h"
+
 #include <nlohmann/json.hpp>
 
 #include <string>
@@ -8,10 +10,12 @@
 namespace mcf {
 
 /// {spec, kind, analytic, vertices, faces, unreferenced_vertices, boundary_loops,
-/// connected_components, euler_characteristic, genus, area, bbox_min, bbox_max[,
-/// sphere_radius][, cylinder_radius]} of the mesh `spec` gives. When `write_to` is not empty the
-/// (generated / scaled / subdivided) mesh is also written there, before the description is
-/// returned: a write that fails throws.
-nlohmann::json mesh_info(const std::string& spec, const std::string& write_to);
+/// connected_components, euler_characteristic, genus, area, bbox_min, bbox_max,
+/// reoriented_faces, repaired_faces, degenerate_faces[, notes][, sphere_radius][,
+/// cylinder_radius]} of the mesh `spec` gives, loaded with `options`. When `write_to` is not
+/// empty the (generated / scaled / repaired / subdivided) mesh is also written there, before the
+/// description is returned: a write that fails throws.
+nlohmann::json mesh_info(const std::string& spec, const std::string& write_to,
+                         const MeshLoadOptions& options = {});
 
 }  // namespace mcf

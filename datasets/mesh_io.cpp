@@ -8,6 +8,7 @@
 #include "datasets/mesh_io.h"
 
 #include "core/atomic_file.h"
+#include "datasets/orientation.h"
 #include "datasets/ply_format.h"
 #include "datasets/walked_mesh.h"
 
@@ -725,6 +726,55 @@ StlLayout scan_stl(const std::string& path) {
   return {false, lines.facets()};
 }
 
+// Face f's corners are vertices of the mesh, three different ones; else throws naming the face.
+void check_corners(const std::string& path, const std::string& prefix, const TriangleMesh& mesh,
+                   Eigen::Index f, const std::function<std::string(Eigen::Index)>& name_face,
+                   const std::function<std::string(int)>& name_vertex) {
+  const Eigen::Index nv = mesh.num_vertices();
+  const int a = mesh.faces(f, 0), b = mesh.faces(f, 1), c = mesh.faces(f, 2);
+  for (int v : {a, b, c})
+    if (v < 0 || v >= nv)
+      fail(path, prefix + name_face(f) + " references vertex " + std::to_string(v) +
+                     " but the mesh has " + std::to_string(nv) + " vertices");
+  // OpenMesh's add_face does not expect a repeated corner (its readers skip such faces).
+  if (a == b || b == c || c == a)
+    fail(path, prefix + name_face(f) + " repeats vertex " + name_vertex(a == b || a == c ? a : b) +
+                   " (a degenerate face)");
+}
+
+// Orients the faces consistently (datasets/orientation.h) before the half-edge mesh is built, so
+// that a manifold surface listed with mixed orientation loads; what cannot be oriented is an error
+// naming the faces and the edge, and whether the mesh is non-manifold or non-orientable. Returns
+// how many faces were reversed.
+long long orient_or_fail(const std::string& path, TriangleMesh& mesh,
+                         const std::function<std::string(Eigen::Index)>& name_face,
+                         const std::function<std::string(int)>& name_vertex) {
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f)
+    check_corners(path, "", mesh, f, name_face, name_vertex);
+  const OrientationResult o = orient_faces(mesh.faces);
+  auto face_with_corners = [&](Eigen::Index f) {
+    return name_face(f) + " (vertices " + name_vertex(mesh.faces(f, 0)) + ", " +
+           name_vertex(mesh.faces(f, 1)) + ", " + name_vertex(mesh.faces(f, 2)) + ")";
+  };
+  const std::string edge = "(" + name_vertex(o.edge[0]) + ", " + name_vertex(o.edge[1]) + ")";
+  switch (o.problem) {
+    case OrientationResult::Problem::none:
+      return o.reoriented;
+    case OrientationResult::Problem::non_manifold_edge:
+      fail(path, "non-manifold mesh: " + face_with_corners(o.faces[2]) +
+                     " cannot be added: its edge " + edge + " already has a face on each side (" +
+                     name_face(o.faces[0]) + " and " + name_face(o.faces[1]) +
+                     "): an edge in three or more faces is non-manifold");
+    case OrientationResult::Problem::non_orientable:
+      fail(path, "non-orientable mesh: " + face_with_corners(o.faces[1]) +
+                     " cannot be oriented to agree with both its neighbours (reached across edge " +
+                     edge + " from " + name_face(o.faces[0]) +
+                     "): the surface is one-sided, like a Möbius strip, so no consistent "
+                     "orientation of its faces exists");
+  }
+  return o.reoriented;
+}
+
 // Adds the faces to an OpenMesh half-edge mesh in order, as its readers do. A face it cannot add
 // means a non-manifold ("complex") edge or vertex, or inconsistently oriented faces: the error
 // names the first such face (name_face(f)) and why, after prefix. The half-edge mesh is
@@ -740,15 +790,8 @@ IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const 
     vh[i] =
         om.add_vertex(IoMesh::Point(mesh.vertices(i, 0), mesh.vertices(i, 1), mesh.vertices(i, 2)));
   for (Eigen::Index f = 0; f < nf; ++f) {
+    check_corners(path, prefix, mesh, f, name_face, name_vertex);
     const int a = mesh.faces(f, 0), b = mesh.faces(f, 1), c = mesh.faces(f, 2);
-    for (int v : {a, b, c})
-      if (v < 0 || v >= nv)
-        fail(path, prefix + name_face(f) + " references vertex " + std::to_string(v) +
-                       " but the mesh has " + std::to_string(nv) + " vertices");
-    // OpenMesh's add_face does not expect a repeated corner (its readers skip such faces).
-    if (a == b || b == c || c == a)
-      fail(path, prefix + name_face(f) + " repeats vertex " +
-                     name_vertex(a == b || a == c ? a : b) + " (a degenerate face)");
     if (om.add_face(vh[a], vh[b], vh[c]).is_valid()) continue;
     // Why OpenMesh refused it, from the half-edge structure as it stood (a failed add_face
     // changes nothing).
@@ -828,7 +871,8 @@ TriangleMesh read_stl_through_openmesh(const std::string& path, const StlLayout&
 
 }  // namespace
 
-TriangleMesh read_mesh(const std::string& path) {
+TriangleMesh read_mesh(const std::string& path, ReadReport* report) {
+  if (report) *report = ReadReport{};
   silence_openmesh();
   std::error_code ec;
   if (!fs::exists(path, ec)) fail(path, "no such file");
@@ -871,6 +915,8 @@ TriangleMesh read_mesh(const std::string& path) {
            " fanned from " + face;
   };
   auto name_vertex = [&](int v) { return std::to_string(v + walk.index_base); };
+  const long long reoriented = orient_or_fail(path, mesh, name_face, name_vertex);
+  if (report) report->reoriented_faces = reoriented;
   half_edge_mesh(path, "", mesh, name_face, name_vertex);
   return mesh;
 }

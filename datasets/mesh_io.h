@@ -12,13 +12,22 @@
 
 namespace mcf {
 
+/// What read_mesh changed of the file's faces.
+struct ReadReport {
+  /// Faces whose corner order was reversed so that every face agrees with its neighbours
+  /// (datasets/orientation.h); 0 for a consistently oriented file.
+  long long reoriented_faces = 0;
+};
+
 /// Reads a triangle mesh; the format follows the extension; polygons are fan-triangulated from
-/// their first corner. Throws MeshError naming the file, and where it can the line, byte or face,
-/// on a missing/unreadable file, a parse error, a face repeating a vertex, or a face a half-edge
-/// mesh cannot hold (naming the first such face, its vertices as the file numbers them, and
-/// why). Vertex and face order of the file are kept. Does not validate geometry: see
-/// validate_mesh.
-TriangleMesh read_mesh(const std::string& path);
+/// their first corner. OFF, OBJ and PLY faces listed with mixed orientation are oriented
+/// consistently (orient_faces; how many were reversed goes to `report`). Throws MeshError naming
+/// the file, and where it can the line, byte or face, on a missing/unreadable file, a parse error,
+/// a face repeating a vertex, an edge in three or more faces (non-manifold), a non-orientable
+/// surface, or a face a half-edge mesh cannot hold (naming the first such face, its vertices as
+/// the file numbers them, and why). Vertex and face order of the file are kept. Does not validate
+/// geometry: see validate_mesh.
+TriangleMesh read_mesh(const std::string& path, ReadReport* report = nullptr);
 
 /// Adds the faces to an OpenMesh half-edge mesh, as read_mesh and write_mesh do, and throws
 /// MeshError naming `name` and the first face it cannot hold, and why. load_mesh_spec runs it on

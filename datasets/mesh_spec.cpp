@@ -8,6 +8,7 @@
 #include "datasets/catalogue.h"
 #include "datasets/generators.h"
 #include "datasets/mesh_io.h"
+#include "datasets/repair.h"
 #include "datasets/subdivide.h"
 
 #include <algorithm>
@@ -351,7 +352,15 @@ MeshSpecRequest parse_mesh_spec(const std::string& spec) {
   return r;
 }
 
-MeshSource load_mesh_spec(const std::string& spec) {
+namespace {
+
+std::string count_of(long long n, const std::string& what) {
+  return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+}
+
+}  // namespace
+
+MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& options) {
   MeshSource src;
   src.spec = spec;
   std::string head;
@@ -359,9 +368,10 @@ MeshSource load_mesh_spec(const std::string& spec) {
   if (head.empty()) fail(spec, "empty mesh spec");
 
   std::string validate_name = spec;
+  ReadReport read;
   if (looks_like_file(head)) {
     src.kind = "file";
-    src.mesh = read_mesh(head);  // its errors name the file
+    src.mesh = read_mesh(head, &read);  // its errors name the file
     fit_unit_cube(src.mesh);
     validate_name = head;
   } else {
@@ -372,7 +382,7 @@ MeshSource load_mesh_spec(const std::string& spec) {
       src.kind = "cgal";
       if (args.empty()) fail(spec, "cgal needs a model name, e.g. cgal:armadillo");
       try {
-        src.mesh = read_mesh(catalogue_path(args));
+        src.mesh = read_mesh(catalogue_path(args), &read);
       } catch (const MeshError& e) {
         fail(spec, e.what());
       }
@@ -381,8 +391,44 @@ MeshSource load_mesh_spec(const std::string& spec) {
       load_generated(spec, name, args, colon != std::string::npos, src);
     }
   }
+  const Eigen::Index faces_read = src.mesh.num_faces();
+  if (read.reoriented_faces > 0)
+    src.notes.push_back("reoriented " + std::to_string(read.reoriented_faces) + " of " +
+                        count_of(faces_read, "face") +
+                        " so that every face agrees with its neighbours (the file lists them "
+                        "with mixed orientation)");
+  DegenerateRepair repaired;
+  if (options.degenerate == DegenerateFaces::repair) {
+    // Before subdivision, which would make four zero-area faces of each.
+    repaired = repair_degenerate_faces(src.mesh);
+    if (repaired.degenerate_faces > 0) {
+      try {
+        check_half_edge_faces(src.mesh, validate_name);
+      } catch (const MeshError& e) {
+        fail(spec, std::string("removing its zero-area faces left a mesh a half-edge mesh "
+                               "cannot hold: ") +
+                       e.what());
+      }
+      const long long collapsed = repaired.degenerate_faces - repaired.flipped_faces;
+      src.notes.push_back(
+          "removed " + count_of(repaired.degenerate_faces, "zero-area face") +
+          " (repair_degenerate): " + std::to_string(repaired.flipped_faces) +
+          " flipped away across their longest edge, " + std::to_string(collapsed) + " collapsed (" +
+          std::to_string(repaired.removed_faces) + " of " + count_of(faces_read, "face") +
+          " gone, " + std::to_string(repaired.merged_vertices) +
+          (repaired.merged_vertices == 1 ? " vertex" : " vertices") + " merged into a neighbour)");
+    }
+  }
   if (target_faces > 0) subdivide_source(src, target_faces);
-  src.report = validate_mesh(src.mesh, validate_name);
+  ValidateOptions validate;
+  validate.keep_degenerate = options.degenerate == DegenerateFaces::keep;
+  validate.degenerate_hint = options.degenerate_hint;
+  src.report = validate_mesh(src.mesh, validate_name, validate);
+  src.report.reoriented_faces = read.reoriented_faces;
+  src.report.repaired_faces = repaired.degenerate_faces;
+  if (src.report.degenerate_faces > 0)
+    src.notes.push_back("kept " + count_of(src.report.degenerate_faces, "zero-area face") +
+                        " as they are");
   return src;
 }
 

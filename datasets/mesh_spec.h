@@ -13,6 +13,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace mcf {
 
@@ -26,6 +27,22 @@ struct MeshSource {
   std::optional<double> sphere_radius;    ///< set for sphere and icosphere (centre at the origin)
   std::optional<double> cylinder_radius;  ///< set for open_cylinder (axis z through the origin)
   MeshReport report;                      ///< validation report (validate_mesh has passed)
+  /// What loading changed or let through, one sentence each (faces reoriented, zero-area faces
+  /// removed or kept), for the user to see on stderr; the counts are in `report`.
+  std::vector<std::string> notes;
+};
+
+/// What to do with zero-area faces (validate.h's degenerate_faces).
+enum class DegenerateFaces {
+  refuse,  ///< a MeshError naming the first one (the default)
+  keep,    ///< counted in MeshReport::degenerate_faces (a basis that needs no cotangents)
+  repair,  ///< repair_degenerate_faces (datasets/repair.h), counted in repaired_faces
+};
+
+struct MeshLoadOptions {
+  DegenerateFaces degenerate = DegenerateFaces::refuse;
+  /// Appended to the refusal of a zero-area face: what the caller offers instead (an option).
+  std::string degenerate_hint;
 };
 
 /// What a spec asks for, as load_mesh_spec reads it, before anything is built or read.
@@ -43,10 +60,11 @@ struct MeshSpecRequest {
 /// anything: the file and the model are not looked at.
 MeshSpecRequest parse_mesh_spec(const std::string& spec);
 
-/// Parses the spec, builds/loads, scales real models to the unit cube, subdivides to @faces,
+/// Parses the spec, builds/loads (a file's faces oriented consistently, read_mesh), scales real
+/// models to the unit cube, treats zero-area faces as `options` says, subdivides to @faces,
 /// validates. Throws MeshError naming the spec (and file) on any problem, including an unknown
 /// generator or parameter.
-MeshSource load_mesh_spec(const std::string& spec);
+MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& options = {});
 
 /// Uniform scale and translation into the unit cube [0,1]^3: the longest bounding-box side
 /// becomes [0,1], the other axes are centred. What load_mesh_spec does to real models.

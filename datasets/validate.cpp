@@ -98,23 +98,34 @@ void check_faces(const TriangleMesh& mesh, const std::string& name) {
   }
 }
 
-/// The total area; a face degenerate relative to the model's size throws (the studies mix
-/// unit-cube models and big analytic shapes, so an absolute area threshold would be wrong for
-/// one of them).
-double checked_area(const TriangleMesh& mesh, const std::string& name,
-                    const std::vector<char>& referenced) {
+/// The smallest area a face of this mesh may have (degenerate_faces).
+double min_face_area(const TriangleMesh& mesh, const std::vector<char>& referenced) {
   const double diag2 = bounds_of(mesh.vertices, referenced)
                            .extent()
                            .squaredNorm();  // a stray vertex is not the model's size
-  const double min_area = 1e-14 * diag2;
+  return 1e-14 * diag2;
+}
+
+bool is_degenerate(double area, double min_area) {
+  return area == 0.0 || area <= min_area;
+}
+
+/// The total area; a degenerate face throws unless options.keep_degenerate, which counts it.
+double checked_area(const TriangleMesh& mesh, const std::string& name,
+                    const std::vector<char>& referenced, const ValidateOptions& options,
+                    MeshReport& report) {
+  const double min_area = min_face_area(mesh, referenced);
   double total = 0;
   for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
     const double area = face_area(mesh, f);
-    if (area == 0.0 || area <= min_area)
-      fail(name, "face " + std::to_string(f) + " is degenerate (area " + std::to_string(area) +
-                     ", vertices " + std::to_string(mesh.faces(f, 0)) + ", " +
-                     std::to_string(mesh.faces(f, 1)) + ", " + std::to_string(mesh.faces(f, 2)) +
-                     ")");
+    if (is_degenerate(area, min_area)) {
+      if (!options.keep_degenerate)
+        fail(name, "face " + std::to_string(f) + " is degenerate (area " + std::to_string(area) +
+                       ", vertices " + std::to_string(mesh.faces(f, 0)) + ", " +
+                       std::to_string(mesh.faces(f, 1)) + ", " + std::to_string(mesh.faces(f, 2)) +
+                       ")" + options.degenerate_hint);
+      ++report.degenerate_faces;
+    }
     total += area;
   }
   return total;
@@ -185,13 +196,14 @@ void count_components(const TriangleMesh& mesh, const std::vector<char>& referen
 
 }  // namespace
 
-MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
+MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name,
+                         const ValidateOptions& options) {
   check_faces(mesh, name);
   const std::vector<char> referenced = referenced_vertices(mesh.num_vertices(), mesh.faces);
   MeshReport report;
   report.vertices = mesh.num_vertices();
   report.faces = mesh.num_faces();
-  report.area = checked_area(mesh, name, referenced);
+  report.area = checked_area(mesh, name, referenced, options, report);
   UnionFind uf(static_cast<size_t>(mesh.num_vertices()));
   for (Eigen::Index f = 0; f < mesh.num_faces(); ++f) {
     uf.unite(mesh.faces(f, 0), mesh.faces(f, 1));
@@ -200,6 +212,18 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const std::string& name) {
   EdgeCounts edges = count_edges(mesh, name, uf, report);
   count_components(mesh, referenced, uf, edges, report);
   return report;
+}
+
+double degenerate_area(const TriangleMesh& mesh) {
+  return min_face_area(mesh, referenced_vertices(mesh.num_vertices(), mesh.faces));
+}
+
+std::vector<Eigen::Index> degenerate_faces(const TriangleMesh& mesh) {
+  const double min_area = degenerate_area(mesh);
+  std::vector<Eigen::Index> out;
+  for (Eigen::Index f = 0; f < mesh.num_faces(); ++f)
+    if (is_degenerate(face_area(mesh, f), min_area)) out.push_back(f);
+  return out;
 }
 
 std::vector<std::array<int, 2>> boundary_edges(const Triangles& faces) {

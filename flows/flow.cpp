@@ -207,7 +207,10 @@ nlohmann::json mesh_json(const MeshSource& source) {
           {"components", rep.connected_components},
           {"unreferenced_vertices", rep.unreferenced_vertices},
           {"area", rep.area},
-          {"analytic", source.analytic}};
+          {"analytic", source.analytic},
+          {"reoriented_faces", rep.reoriented_faces},
+          {"repaired_faces", rep.repaired_faces},
+          {"degenerate_faces", rep.degenerate_faces}};
 }
 
 /// x -> (x - centroid) * scale, row by row.
@@ -281,6 +284,17 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
   integrator_ = make_integrator(config.integrator, config.extrapolate);
   result["system"] = stats_json(basis_->stats());
   result["system"]["setup_seconds"]["total"] = seconds_since(setup_start);
+  const Eigen::Index free_functions =
+      basis_->dimension() - Eigen::Index(basis_->locked_functions().size());
+  result["system"]["free_functions"] = free_functions;
+  if (free_functions == 0)
+    // A single triangle, a quad, a planar patch: every vertex (hat) or every function whose
+    // support meets the boundary (octree) is held, and the boundary does not move. The flow
+    // completes with the mesh as it is (ReducedSystem asks no solver), whatever the solver.
+    result["notes"].push_back("nothing free to move: all " + std::to_string(basis_->dimension()) +
+                              " functions of the " + config.basis +
+                              " basis are held by the mesh's boundary, which the flow keeps "
+                              "fixed, so the mesh stays as it is");
   result["solver_name"] = solver_->name();
 
   stabilized_ = config.basis == "octree" && config.octree.stabilization == "normal-gradient";
@@ -495,6 +509,7 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   out.result["status"] = "ok";
   out.result["config"] = to_json(config);
   out.result["mesh"] = mesh_json(source);
+  if (!source.notes.empty()) out.result["mesh"]["notes"] = source.notes;
   FlowRun flow(config, source, out.result);
   const int blas_threads = config.blas_threads > 0 ? std::min(config.blas_threads, runnable)
                                                    : auto_blas_threads(runnable, flow.dimension());

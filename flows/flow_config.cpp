@@ -54,6 +54,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   c.threads = int(r.get_integer("threads", c.threads, 0, 4096));
   c.blas_threads = int(r.get_integer("blas_threads", c.blas_threads, 0, 4096));
   c.save_every = int(r.get_integer("save_every", c.save_every, 0, 100000000));
+  c.repair_degenerate = r.get_bool("repair_degenerate", c.repair_degenerate);
   r.finish();
   if (c.solver.tolerance < 0) c.solver.tolerance = c.solver.name == "multigrid" ? 0.0 : 1e-10;
   validate_flow_config(c, source);
@@ -61,36 +62,44 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
 }
 
 nlohmann::json to_json(const FlowConfig& c) {
-  return {{"mesh", c.mesh},
-          {"flow", c.flow},
-          {"basis", c.basis},
-          {"mass", c.mass},
-          {"octree",
-           {{"tracking", c.octree.tracking},
-            {"depth", c.octree.depth},
-            {"cubature", c.octree.cubature},
-            {"cube", c.octree.cube},
-            {"refine_input", c.octree.refine_input},
-            {"stabilization", c.octree.stabilization},
-            {"stabilization_weight", c.octree.stabilization_weight}}},
-          {"solver",
-           {{"name", c.solver.name},
-            {"tolerance", c.solver.tolerance},
-            {"max_iterations", c.solver.max_iterations},
-            {"preconditioner", c.solver.preconditioner},
-            {"cycle", c.solver.cycle},
-            {"cycles", c.solver.cycles},
-            {"smooth", c.solver.smooth},
-            {"stall_ratio", c.solver.stall_ratio},
-            {"fallback_tolerance", c.solver.fallback_tolerance}}},
-          {"integrator", c.integrator},
-          {"extrapolate", c.extrapolate},
-          {"dt", c.dt},
-          {"steps", c.steps},
-          {"normalize_area", c.normalize_area},
-          {"threads", c.threads},
-          {"blas_threads", c.blas_threads},
-          {"save_every", c.save_every}};
+  nlohmann::json j = {{"mesh", c.mesh},
+                      {"flow", c.flow},
+                      {"basis", c.basis},
+                      {"mass", c.mass},
+                      {"octree",
+                       {{"tracking", c.octree.tracking},
+                        {"depth", c.octree.depth},
+                        {"cubature", c.octree.cubature},
+                        {"cube", c.octree.cube},
+                        {"refine_input", c.octree.refine_input},
+                        {"stabilization", c.octree.stabilization},
+                        {"stabilization_weight", c.octree.stabilization_weight}}},
+                      {"solver",
+                       {{"name", c.solver.name},
+                        {"tolerance", c.solver.tolerance},
+                        {"max_iterations", c.solver.max_iterations},
+                        {"preconditioner", c.solver.preconditioner},
+                        {"cycle", c.solver.cycle},
+                        {"cycles", c.solver.cycles},
+                        {"smooth", c.solver.smooth}}},
+                      {"integrator", c.integrator},
+                      {"extrapolate", c.extrapolate},
+                      {"dt", c.dt},
+                      {"steps", c.steps},
+                      {"normalize_area", c.normalize_area},
+                      {"threads", c.threads},
+                      {"blas_threads", c.blas_threads},
+                      {"save_every", c.save_every}};
+  // Only when set: a key present with its default would change the config key of every cell
+  // (bench/cell_hash.h), and `compare` would find no cell of an earlier run to compare with.
+  if (c.repair_degenerate) j["repair_degenerate"] = true;
+  // The multigrid's fallback only where a multigrid runs, for the same reason: the config keys of
+  // the other solvers' cells stay those of versions without it.
+  if (c.solver.name == "multigrid") {
+    j["solver"]["stall_ratio"] = c.solver.stall_ratio;
+    j["solver"]["fallback_tolerance"] = c.solver.fallback_tolerance;
+  }
+  return j;
 }
 
 void validate_flow_config(const FlowConfig& c, const std::string& source) {
@@ -126,7 +135,27 @@ void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::
     throw ConfigError(
         source + ": normalize_area: the mesh has " + std::to_string(mesh.boundary_loops) +
         " boundary loop(s), held fixed through the flow, which rescaling to unit area every "
-        "step would move; run an open surface without normalize_area");
+        "step would move; run an open surface without normalize_area (leave out "
+        "--normalize-area, or set \"normalize_area\": false): its boundary stays where it is and "
+        "a time step then means what it does at the mesh's own size (files are scaled into the "
+        "unit cube), or close its holes first to flow it at unit area");
+}
+
+MeshLoadOptions mesh_load_options(const FlowConfig& c) {
+  MeshLoadOptions o;
+  if (c.repair_degenerate) {
+    o.degenerate = DegenerateFaces::repair;
+  } else if (c.basis == "octree") {
+    // The octree basis integrates over the surface by cubature on clipped pieces, and a
+    // zero-area face leaves no piece: it changes nothing there.
+    o.degenerate = DegenerateFaces::keep;
+  } else {
+    o.degenerate_hint =
+        ": the hat basis needs every face's cotangents, which a zero-area face lacks; "
+        "--repair-degenerate (config key repair_degenerate) removes zero-area faces, or "
+        "--basis octree takes them as they are";
+  }
+  return o;
 }
 
 }  // namespace mcf

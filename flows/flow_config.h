@@ -2,6 +2,7 @@
 // Every option of one flow run. The same JSON object is a cell of the experiment matrix and the
 // "config" of result.json (with all defaults filled in), so the names below are stable.
 
+#include "datasets/mesh_spec.h"
 #include "datasets/validate.h"
 
 #include <nlohmann/json.hpp>
@@ -58,6 +59,9 @@ struct FlowConfig {
   /// this many, at most `threads`.
   int blas_threads = 0;
   int save_every = 0;  ///< write frame_NNNN.ply every K steps (0 = never)
+  /// Collapse the mesh's zero-area faces before the flow (datasets/repair.h) instead of refusing
+  /// them where the basis needs their cotangents (hat); the octree basis takes them as they are.
+  bool repair_degenerate = false;
 };
 
 /// Reads a flow config strictly (unknown keys, wrong types, out-of-range values are errors that
@@ -67,6 +71,10 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
 nlohmann::json to_json(const FlowConfig& c);
 /// Cross-option checks (e.g. multigrid needs the octree, cMCF needs a fixed basis).
 void validate_flow_config(const FlowConfig& c, const std::string& source);
+/// How the flow's mesh is loaded: zero-area faces removed (repair_degenerate), kept (the octree
+/// basis, which integrates over the surface and needs no face's cotangents) or refused with a
+/// message naming the option that goes on (the hat basis).
+MeshLoadOptions mesh_load_options(const FlowConfig& c);
 /// Checks of the config against its mesh (unit-area normalisation needs a closed surface).
 /// Throws ConfigError naming `source` and the key.
 void validate_flow_mesh(const FlowConfig& c, const MeshReport& mesh, const std::string& source);

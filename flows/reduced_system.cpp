@@ -188,6 +188,14 @@ Coefficients ReducedSystem::solve_reduced(std::vector<int> eliminated, bool shar
     Rf.row(i) = R.row(free_[i]) - coupling.row(free_[i]);
     Xf.row(i) = warm.row(free_[i]);
   }
+  if (nf == 0) {
+    // Every function is held (a mesh whose vertices all lie on its boundary): the solution is
+    // the held values, and no solver is asked to factorize or cycle on an empty matrix, which
+    // each would report in its own way as a failure.
+    report_ = SolveReport{};
+    report_.message = "nothing free to move: every function is held";
+    return Yfixed;
+  }
   HierarchyView reduced_view;
   if (!view.empty()) reduced_view = HierarchyView{&prolongations_, &colours_};
   reduced_view.pattern_key = shared ? reduced_key_ : 0;

@@ -31,7 +31,9 @@ class ReducedSystem {
   };
 
   /// Solves (a M + b K [+ s S]) Y = R; `report()` then holds the solver's report, its message also
-  /// carrying set_matrix's note on an accepted matrix. Returns the full solution. Empty rows are
+  /// carrying set_matrix's note on an accepted matrix. Returns the full solution. With every
+  /// function held the solver is not called: Y is the held values, and the report says
+  /// "converged" after 0 iterations with a message saying nothing is free to move. Empty rows are
   /// those of a M + b K; with an extra term they are eliminated instead of held in place (the
   /// term couples them to their neighbours).
   /// An iterative solver's passes: the solve is repeated (each pass continues from the last

@@ -19,7 +19,7 @@ struct FlowArgs {
   int depth = 0, cubature = 0, max_iterations = 0, cycles = 0, smooth = 0, steps = 0, threads = 0,
       save_every = 0;
   double dt = 0, tolerance = 0, stabilization_weight = 0, stall_ratio = 0, fallback_tolerance = 0;
-  bool refine_input = false, normalize_area = false, frozen = false;
+  bool refine_input = false, normalize_area = false, frozen = false, repair_degenerate = false;
 };
 
 void add_flow_options(CLI::App& cmd, FlowArgs& args) {
@@ -84,6 +84,9 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
   cmd.add_option("--max-memory", args.max_memory,
                  "Refuse a flow whose estimated peak memory exceeds SIZE (8G, 512M; none: no "
                  "check; default: the memory available now)");
+  cmd.add_flag("--repair-degenerate", args.repair_degenerate,
+               "Collapse the mesh's zero-area faces first (the hat basis refuses them; the octree "
+               "basis takes them as they are)");
   cmd.add_option("--out", args.out, "Output folder")->required();
 }
 
@@ -139,6 +142,7 @@ FlowRequest flow_request(const CLI::App& cmd, const FlowArgs& args) {
     r.settings.emplace_back("blas_threads", n);
   }
   set("--save-every", "save_every", args.save_every);
+  set("--repair-degenerate", "repair_degenerate", args.repair_degenerate);
   return r;
 }
 
@@ -156,10 +160,7 @@ void add_flow_command(CLI::App& app, std::function<int()>& run) {
 
   run = nullptr;
   cmd->callback([cmd, args, &run] {
-    run = [cmd, args]() -> int {
-      run_flow_into_folder(flow_request(*cmd, *args));
-      return 0;
-    };
+    run = [cmd, args]() -> int { return run_flow_into_folder(flow_request(*cmd, *args)); };
   });
 }
 

@@ -83,6 +83,45 @@ TEST(Runner, PerStepMetricsFramesAndReferenceDistance) {
   EXPECT_EQ(other["reference_cell"]["hash"], plans[0].hash);
 }
 
+TEST(Runner, EachCellLoadsItsMeshAsItsBasisAndRepairSettingAsk) {
+  // A tent whose bottom edge carries a zero-area cap: the octree cell keeps it, the hat cell with
+  // repair_degenerate removes it, and one mesh cache serves both (the treatment is part of its
+  // key).
+  const fs::path out = fresh_dir("degenerate_cells");
+  const fs::path tent = out / "tent.off";
+  write_text(tent,
+             "OFF\n6 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0 0\n0.5 0.5 0.5\n"
+             "3 0 4 5\n3 4 1 5\n3 1 2 5\n3 2 3 5\n3 3 0 5\n3 0 1 4\n");
+  const json j = {{"name", "d"},
+                  {"defaults", {{"mesh", tent.string()}, {"steps", 1}, {"octree.depth", 4}}},
+                  {"zip", {{{"basis", {"octree", "hat"}}, {"repair_degenerate", {false, true}}}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "d.json", false);
+  RunOptions o;
+  o.out_dir = (out / "results").string();
+  const RunSummary s = run_experiment(e, o);
+  EXPECT_EQ(s.errors, 0);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, o.out_dir, meshes);
+  ASSERT_EQ(plans.size(), 2u);
+  const json octree = read_json(plans[0].file), hat = read_json(plans[1].file);
+  EXPECT_EQ(octree["status"], "ok");
+  EXPECT_EQ(octree["mesh"]["degenerate_faces"], 1);
+  EXPECT_EQ(hat["status"], "ok");
+  EXPECT_EQ(hat["mesh"]["repaired_faces"], 1);
+  EXPECT_EQ(hat["mesh"]["faces"], 4);
+  // Without the repair, the hat cell stops the plan before anything runs, naming the option.
+  json bare = j;
+  bare.erase("zip");
+  bare["defaults"]["basis"] = "hat";
+  try {
+    MeshCache fresh;
+    plan_cells(parse_experiment_config(bare, "bare.json", false), "", fresh);
+    FAIL() << "a hat cell planned on a mesh with a zero-area face";
+  } catch (const std::exception& ex) {
+    EXPECT_NE(std::string(ex.what()).find("--repair-degenerate"), std::string::npos) << ex.what();
+  }
+}
+
 TEST(Runner, AFlowThatStopsEarlyHasMetricsAtItsLastCompletedStep) {
   // Explicit Euler beyond its stability limit: the area grows by more than 5% at step 6 and the
   // flow stops there, so step 5 is its last state. With every=4 step 5 is neither a multiple of

@@ -209,13 +209,18 @@ TEST(MeshIo, NonManifoldEdge) {
       "face 2 (vertices 0, 1, 4)");
 }
 
-TEST(MeshIo, InconsistentlyOrientedFaces) {
+TEST(MeshIo, InconsistentlyOrientedFacesAreOriented) {
   TempDir dir;
-  // Both triangles run along 0 -> 1: a half-edge mesh cannot hold them (nor can the flows).
-  expect_error_naming(
-      dir.write("flip.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n3 0 1 2\n3 0 1 3\n"),
-      "face 1 (vertices 0, 1, 3) cannot be added: its edge (0, 1) already has a face on the same "
-      "side");
+  // Both triangles run along 0 -> 1: a half-edge mesh cannot hold them as listed (nor can the
+  // flows), so the second is reversed to agree with the first.
+  const std::string path =
+      dir.write("flip.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n3 0 1 2\n3 0 1 3\n");
+  ReadReport report;
+  const TriangleMesh m = read_mesh(path, &report);
+  EXPECT_EQ(report.reoriented_faces, 1);
+  EXPECT_EQ(m.faces.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(m.faces.row(1), Eigen::RowVector3i(0, 3, 1));
+  EXPECT_EQ(validate_mesh(m, path).misoriented_edges, 0);
 }
 
 TEST(MeshIo, NonManifoldVertex) {
@@ -242,21 +247,23 @@ TEST(MeshIo, OpenFansMeetingAtAVertexLoad) {
 
 TEST(MeshIo, NonManifoldPolygonNamesItsFan) {
   TempDir dir;
-  // The quad 0 1 4 5 is fanned into (0 1 4) and (0 4 5); the first repeats edge 0 -> 1.
+  // The quad 0 1 4 5 is fanned into (0 1 4) and (0 4 5); the first is a third face on the edge
+  // (0, 1), which two triangles hold already.
   expect_error_naming(dir.write("quadfin.off",
-                                "OFF\n6 2 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 -1 0\n0 0 1\n"
-                                "3 0 1 2\n4 0 1 4 5\n"),
-                      "triangle 1 of 2 fanned from face 1 (vertices 0, 1, 4)");
+                                "OFF\n6 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 -1 0\n0 0 1\n"
+                                "3 0 1 2\n3 1 0 3\n4 0 1 4 5\n"),
+                      "triangle 1 of 2 fanned from face 2 (vertices 0, 1, 4)");
 }
 
 // Random small polygon soups (4-8 vertices, 1-10 faces, some quads) reach every way a face can be
 // refused, including OpenMesh's failed patch re-linking; each either loads as the file's fans, in
-// order, or fails with a MeshError that names the file and a face. (Run under ASan/UBSan with
+// order (some reversed to agree with their neighbours), or fails with a MeshError that names the
+// file and a face. (Run under ASan/UBSan with
 // 20,000 soups and 12,000 byte-mutated OFF/OBJ/PLY files when written: no report.)
 TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
   TempDir dir;
   std::mt19937 rng(7);
-  int loaded = 0;
+  int loaded = 0, reoriented = 0;
   std::map<std::string, int> refusals;
   for (int trial = 0; trial < 3000; ++trial) {
     const int nv = 4 + static_cast<int>(rng() % 5), nf = 1 + static_cast<int>(rng() % 10);
@@ -280,16 +287,29 @@ TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
     }
     const std::string path = dir.write("soup.off", off);
     try {
-      const TriangleMesh m = read_mesh(path);
+      ReadReport report;
+      const TriangleMesh m = read_mesh(path, &report);
       ASSERT_EQ(m.num_faces(), static_cast<Eigen::Index>(fans.size())) << off;
-      for (std::size_t t = 0; t < fans.size(); ++t)
-        ASSERT_EQ(m.faces.row(t), Eigen::RowVector3i(fans[t][0], fans[t][1], fans[t][2])) << off;
+      long long reversed = 0;
+      for (std::size_t t = 0; t < fans.size(); ++t) {
+        // Each fan as the file lists it, or reversed to agree with its neighbours.
+        const bool as_listed =
+            m.faces.row(t) == Eigen::RowVector3i(fans[t][0], fans[t][1], fans[t][2]);
+        reversed += !as_listed;
+        if (!as_listed)
+          ASSERT_EQ(m.faces.row(t), Eigen::RowVector3i(fans[t][0], fans[t][2], fans[t][1])) << off;
+      }
+      ASSERT_EQ(report.reoriented_faces, reversed) << off;
+      ASSERT_EQ(validate_mesh(m, path, {true, ""}).misoriented_edges, 0) << off;
       ++loaded;
+      reoriented += reversed > 0;
     } catch (const MeshError& e) {
       const std::string msg = e.what();
       ASSERT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
       if (msg.find(" repeats vertex ") != std::string::npos) {
         ++refusals["repeats"];
+      } else if (msg.find("non-orientable mesh: ") != std::string::npos) {
+        ++refusals["non-orientable"];
       } else {
         const auto at = msg.find("cannot be added: its ");
         ASSERT_NE(at, std::string::npos) << msg;
@@ -298,9 +318,9 @@ TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
       }
     }
   }
-  // With this seed: 510 loaded, 756 repeated corners, 1689 edges, 38 unordered fans, 7 closed
-  // fans; the bounds only make sure the soups keep reaching every branch.
+  // The bounds only make sure the soups keep reaching every branch.
   EXPECT_GT(loaded, 100);
+  EXPECT_GT(reoriented, 20);
   EXPECT_GT(refusals["repeats"], 100);
   EXPECT_GT(refusals["edge ("], 100);
   EXPECT_GT(refusals["faces "], 5);  // the faces around a vertex cannot be ordered into one fan

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -200,6 +201,42 @@ std::string names(const std::map<std::string, std::string>& m) {
   return s;
 }
 
+/// `mcfbench flow` of a long flow into `out`, saving every frame, in the background with its
+/// stderr in `err`; the child's pid.
+pid_t start_long_flow(const fs::path& out, const fs::path& err) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::freopen(err.c_str(), "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "flow", "--mesh", "icosphere:level=4", "--solver",
+          "pcg", "--preconditioner", "none", "--dt", "1e-5", "--steps", "100000", "--save-every",
+          "1", "--threads", "1", "--out", out.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Waits (a minute at most) until the flow into `out` has saved frame 3, wherever it keeps its
+/// frames while it runs.
+void wait_for_frame_3(const fs::path& out) {
+  auto saved = [&] {
+    std::error_code ec;
+    for (fs::recursive_directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec))
+      if (it->path().filename() == "frame_00003.ply") return true;
+    return false;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!saved() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 TEST(Cli, AnInterruptedOrFailedFlowIntoAFolderLeavesTheEarlierRunWhole) {
   const fs::path out = temp_dir() / "out_interrupted";
   fs::remove_all(out);
@@ -210,35 +247,42 @@ TEST(Cli, AnInterruptedOrFailedFlowIntoAFolderLeavesTheEarlierRunWhole) {
   ASSERT_EQ(names(earlier),
             "final.ply frame_00000.ply frame_00001.ply frame_00002.ply result.json ");
 
-  // A long flow of another mesh into the same folder, interrupted (Ctrl-C) once it has saved
-  // frames past the earlier run's last one.
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    std::freopen("/dev/null", "w", stderr);
-    std::freopen("/dev/null", "w", stdout);
-    execl(MCFBENCH_BINARY, MCFBENCH_BINARY, "flow", "--mesh", "icosphere:level=4", "--solver",
-          "pcg", "--preconditioner", "none", "--dt", "1e-5", "--steps", "100000", "--save-every",
-          "1", "--threads", "1", "--out", out.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
+  // A long flow of another mesh into the same folder, stopped by Ctrl-C (SIGINT) and, the second
+  // time, by a scheduler's SIGTERM, once it has saved frames past the earlier run's last one: as
+  // `run` does, it stops after the running step, exits with 128 + the signal, says so, and leaves
+  // the folder as it was, with no staging folder and no temporary file.
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const std::string name = signal == SIGINT ? "SIGINT" : "SIGTERM";
+    const fs::path err = temp_dir() / ("flow_stopped_" + name + ".txt");
+    const pid_t pid = start_long_flow(out, err);
+    ASSERT_GT(pid, 0);
+    wait_for_frame_3(out);
+    ::kill(pid, signal);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << name << " ended the flow without its handler";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal) << name;
+    const std::string message = slurp(err);
+    EXPECT_NE(message.find("mcfbench flow: stopped by " + name + " after step "), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("holds what it held before"), std::string::npos) << message;
+    const auto now = folder_contents(out);
+    EXPECT_EQ(names(now), names(earlier)) << name << ": the stopped run's files are in the folder";
+    EXPECT_TRUE(now == earlier) << name << ": the earlier run's files changed";
   }
-  auto saved_frame_3 = [&] {  // wherever the flow keeps its frames while it runs
-    std::error_code ec;
-    for (fs::recursive_directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec))
-      if (it->path().filename() == "frame_00003.ply") return true;
-    return false;
-  };
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!saved_frame_3() && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  ::kill(pid, SIGINT);
+
+  // Stopped in a folder it created, it removes that folder.
+  const fs::path fresh = temp_dir() / "out_interrupted_fresh";
+  fs::remove_all(fresh);
+  const fs::path err = temp_dir() / "flow_stopped_fresh.txt";
+  const pid_t pid = start_long_flow(fresh, err);
+  ASSERT_GT(pid, 0);
+  wait_for_frame_3(fresh);
+  ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the flow ended before it was interrupted";
-  auto now = folder_contents(out);
-  now.erase(".mcfbench-staging");  // the interrupted run's, hidden; the next flow removes it
-  EXPECT_EQ(names(now), names(earlier)) << "the interrupted run's files are in the folder";
-  EXPECT_TRUE(now == earlier) << "the earlier run's files changed";
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << slurp(err);
+  EXPECT_FALSE(fs::exists(fresh)) << slurp(err);
 
   // A flow that fails in its set-up leaves the earlier run as it was too.
   EXPECT_NE(
@@ -247,8 +291,7 @@ TEST(Cli, AnInterruptedOrFailedFlowIntoAFolderLeavesTheEarlierRunWhole) {
           out.string())
           .status,
       0);
-  now = folder_contents(out);
-  now.erase(".mcfbench-staging");
+  auto now = folder_contents(out);
   EXPECT_TRUE(now == earlier) << names(now);
 
   // The next flow that finishes replaces the earlier run entirely and leaves no staging behind.
@@ -343,6 +386,159 @@ TEST(Cli, MemoryEstimateIsWithinTwiceTheMeasuredPeak) {
     EXPECT_EQ(j["memory_budget"]["total"], false);
     fs::remove_all(out);
   }
+}
+
+/// `mcfbench ARGS` with its stdout and stderr.
+struct Output {
+  int status;
+  std::string out, err;
+};
+Output mcfbench_output(const std::string& args) {
+  const fs::path out = temp_dir() / "stdout.txt", err = temp_dir() / "stderr.txt";
+  const std::string cmd =
+      std::string(MCFBENCH_BINARY) + " " + args + " >" + out.string() + " 2>" + err.string();
+  const int raw = std::system(cmd.c_str());
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
+}
+
+TEST(Cli, AnUnknownSubcommandIsNamedAndFails) {
+  for (const std::string args : {"bogus", "bogus --help", "bogus --mesh icosphere:level=1"}) {
+    const Output r = mcfbench_output(args);
+    EXPECT_NE(r.status, 0) << args;
+    EXPECT_NE(r.err.find("unknown subcommand 'bogus'"), std::string::npos) << args << ": " << r.err;
+    EXPECT_NE(r.err.find("mesh-info"), std::string::npos) << r.err;  // the list of subcommands
+    EXPECT_EQ(r.out, "") << args;
+  }
+  EXPECT_EQ(mcfbench_output("--help").status, 0);
+  EXPECT_EQ(mcfbench_output("mesh-info --help").status, 0);
+  EXPECT_NE(mcfbench_output("").status, 0);  // no subcommand at all
+}
+
+TEST(Cli, MeshInfoTakesItsMeshAsSpecOrAsMesh) {
+  const Output positional = mcfbench_output("mesh-info torus:n_major=12,n_minor=6");
+  const Output named = mcfbench_output("mesh-info --mesh torus:n_major=12,n_minor=6");
+  ASSERT_EQ(positional.status, 0) << positional.err;
+  ASSERT_EQ(named.status, 0) << named.err;
+  EXPECT_EQ(named.out, positional.out);
+  EXPECT_EQ(nlohmann::json::parse(named.out)["genus"], 1);
+  const Output both = mcfbench_output("mesh-info icosphere:level=1 --mesh icosphere:level=2");
+  EXPECT_NE(both.status, 0);
+  EXPECT_EQ(both.out, "");
+  const Output neither = mcfbench_output("mesh-info");
+  EXPECT_NE(neither.status, 0);
+  EXPECT_NE(neither.err.find("--mesh"), std::string::npos) << neither.err;
+}
+
+const char* kTetShuffled =
+    "OFF\n4 4 0\n0 0 0\n0 1 0\n1 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 0 2 3\n3 1 2 3\n";
+
+TEST(Cli, AMeshListedWithMixedOrientationIsOrientedAndSaysSo) {
+  const fs::path tet = write("tet-shuffled.off", kTetShuffled);
+  const fs::path out = temp_dir() / "out_shuffled";
+  fs::remove_all(out);
+  const Output r =
+      mcfbench_output("flow --mesh " + tet.string() + " --steps 2 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("reoriented 2 of 4 faces"), std::string::npos) << r.err;
+  std::ifstream in(out / "result.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["status"], "ok");
+  EXPECT_EQ(j["mesh"]["reoriented_faces"], 2);
+  EXPECT_NE(j["mesh"]["notes"][0].get<std::string>().find("reoriented"), std::string::npos);
+  const Output info = mcfbench_output("mesh-info " + tet.string());
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_EQ(nlohmann::json::parse(info.out)["reoriented_faces"], 2);
+  EXPECT_NE(info.err.find("reoriented 2 of 4 faces"), std::string::npos) << info.err;
+}
+
+TEST(Cli, WhatCannotBeOrientedIsNamedNonManifoldOrNonOrientable) {
+  // A strip of 6 quads closed with a half twist.
+  std::string moebius = "OFF\n12 12 0\n";
+  for (int i = 0; i < 6; ++i)
+    for (int side = 0; side < 2; ++side) {
+      const double u = 2 * 3.141592653589793 * i / 6, w = side == 0 ? 0.5 : -0.5;
+      moebius += std::to_string((1 + w * std::cos(u / 2)) * std::cos(u)) + " " +
+                 std::to_string((1 + w * std::cos(u / 2)) * std::sin(u)) + " " +
+                 std::to_string(w * std::sin(u / 2)) + "\n";
+    }
+  for (int i = 0; i < 6; ++i) {
+    const int t = 2 * i, b = 2 * i + 1, t1 = i < 5 ? t + 2 : 1, b1 = i < 5 ? b + 2 : 0;
+    moebius += "3 " + std::to_string(t) + " " + std::to_string(b) + " " + std::to_string(b1) +
+               "\n3 " + std::to_string(t) + " " + std::to_string(b1) + " " + std::to_string(t1) +
+               "\n";
+  }
+  expect_flow_rejected("--mesh " + write("moebius.off", moebius).string() + " --steps 1",
+                       {"moebius.off", "non-orientable mesh", "Möbius"},
+                       temp_dir() / "out_moebius");
+  expect_flow_rejected(
+      "--mesh " +
+          write("fin.off",
+                "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n")
+              .string() +
+          " --steps 1",
+      {"fin.off", "non-manifold mesh: face 2", "an edge in three or more faces is non-manifold"},
+      temp_dir() / "out_fin");
+}
+
+TEST(Cli, AMeshWithNothingFreeToMoveCompletesUnchanged) {
+  // CGAL's triangle.off: one triangle, every vertex on the boundary the flow holds.
+  const fs::path tri = write("triangle.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  for (const std::string solver : {"cholmod", "multigrid", "pcg"}) {
+    const fs::path out = temp_dir() / ("out_triangle_" + solver);
+    const Output r = mcfbench_output("flow --mesh " + tri.string() + " --solver " + solver +
+                                     " --steps 2 --out " + out.string());
+    ASSERT_EQ(r.status, 0) << solver << ": " << r.err;
+    EXPECT_NE(r.err.find("nothing free to move"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("singular"), std::string::npos) << r.err;
+    std::ifstream in(out / "result.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["status"], "ok") << solver;
+    EXPECT_EQ(j["stop"]["reason"], "completed") << solver;
+    EXPECT_EQ(j["system"]["free_functions"], 0) << solver;
+  }
+}
+
+TEST(Cli, ZeroAreaFacesAreRefusedNamingTheWaysOnOrRepairedOnRequest) {
+  // A tent over a unit square whose bottom edge carries a zero-area cap (face 5).
+  const fs::path tent = write("tent.off",
+                              "OFF\n6 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0 0\n0.5 0.5 0.5\n"
+                              "3 0 4 5\n3 4 1 5\n3 1 2 5\n3 2 3 5\n3 3 0 5\n3 0 1 4\n");
+  expect_flow_rejected(
+      "--mesh " + tent.string() + " --steps 1",
+      {"tent.off", "face 5 is degenerate", "--repair-degenerate", "--basis octree"},
+      temp_dir() / "out_tent_refused");
+  const fs::path out = temp_dir() / "out_tent";
+  const Output r = mcfbench_output("flow --mesh " + tent.string() +
+                                   " --repair-degenerate --steps 1 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("removed 1 zero-area face"), std::string::npos) << r.err;
+  std::ifstream in(out / "result.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["mesh"]["repaired_faces"], 1);
+  EXPECT_EQ(j["config"]["repair_degenerate"], true);
+  const Output octree = mcfbench_output("flow --mesh " + tent.string() +
+                                        " --basis octree --depth 5 --steps 1 --out " +
+                                        (temp_dir() / "out_tent_octree").string());
+  EXPECT_EQ(octree.status, 0) << octree.err;
+  EXPECT_NE(octree.err.find("kept 1 zero-area face"), std::string::npos) << octree.err;
+  // mesh-info refuses them too, naming its own options, and takes either.
+  const Output info = mcfbench_output("mesh-info " + tent.string());
+  EXPECT_NE(info.status, 0);
+  EXPECT_NE(info.err.find("--repair-degenerate"), std::string::npos) << info.err;
+  EXPECT_EQ(
+      nlohmann::json::parse(
+          mcfbench_output("mesh-info --repair-degenerate " + tent.string()).out)["repaired_faces"],
+      1);
+  EXPECT_EQ(
+      nlohmann::json::parse(
+          mcfbench_output("mesh-info --keep-degenerate " + tent.string()).out)["degenerate_faces"],
+      1);
+}
+
+TEST(Cli, UnitAreaOnAnOpenSurfaceSaysWhatToRunInstead) {
+  expect_flow_rejected("--mesh open_cylinder --normalize-area --steps 1",
+                       {"normalize_area", "boundary loop", "leave out --normalize-area"},
+                       temp_dir() / "out_open_normalized");
 }
 
 }  // namespace
