@@ -215,6 +215,7 @@ const std::vector<std::string>& flow_config_keys() {
     // With every key that to_json writes only when it is set.
     FlowConfig every;
     every.repair_degenerate = true;
+    every.solver.name = "multigrid";
     flatten_keys(to_json(every), "", k);
     return k;
   }();
