@@ -69,7 +69,7 @@ struct FlowConfig {
 FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& source);
 /// The config as JSON with every default filled in (what result.json records).
 nlohmann::json to_json(const FlowConfig& c);
-/// Cross-option checks (e.g. multigrid needs the octree, cMCF needs a fixed basis).
+/// Cross-option checks (e.g. cMCF and two-step integrators need a fixed basis).
 void validate_flow_config(const FlowConfig& c, const std::string& source);
 /// How the flow's mesh is loaded: zero-area faces removed (repair_degenerate), kept (the octree
 /// basis, which integrates over the surface and needs no face's cotangents) or refused with a

@@ -10,6 +10,18 @@
 namespace mcf {
 namespace {
 
+TEST(Environment, TheBuildSaysHowItWasCompiled) {
+  // Results of a -march=native build and of a portable one differ in their last bits (FMA,
+  // vector widths): a result says which it came from.
+  const nlohmann::json b = environment_json(1)["build"];
+  ASSERT_TRUE(b.contains("march_native") && b["march_native"].is_boolean());
+  ASSERT_TRUE(b.contains("sanitized") && b["sanitized"].is_boolean());
+#if defined(__SANITIZE_ADDRESS__)
+  EXPECT_TRUE(b["sanitized"].get<bool>());
+#endif
+  EXPECT_FALSE(b.value("type", "").empty());
+}
+
 TEST(Environment, StealIsTheEighthValueOfTheAggregateCpuLine) {
   // proc(5): cpu user nice system idle iowait irq softirq steal guest guest_nice
   EXPECT_DOUBLE_EQ(
