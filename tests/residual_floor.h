@@ -24,8 +24,8 @@ template <class Sequence>
     if (before <= floor) break;
     if (!(after < before)) {
       std::ostringstream s;
-      s << "residual rises at iteration " << i << ": " << before << " -> " << after
-        << " (floor " << floor << ")";
+      s << "residual rises at iteration " << i << ": " << before << " -> " << after << " (floor "
+        << floor << ")";
       return ::testing::AssertionFailure() << s.str();
     }
   }
