@@ -1,5 +1,7 @@
 #include "bench/flow_folder.h"
 
+#include "flows/registry.h"
+
 #include "bench/environment.h"
 #include "bench/experiment_config.h"
 #include "bench/memory_budget.h"
@@ -85,6 +87,9 @@ void publish(const fs::path& out, const fs::path& staging, const std::set<std::s
 
 void run_flow_into_folder(const FlowRequest& request) {
   const FlowConfig config = flow_config_of(request);
+  // PETSc's options are checked (a trial solve, solvers/petsc_solver.h), and a build without
+  // PETSc refuses, before anything is read or written.
+  if (config.solver.name == "petsc") make_solver(config.solver);
   const MemoryBudget budget = memory_budget(request.max_memory);
   // Before the mesh is generated or read (a generator's size is known from its spec), then with
   // the mesh's own sizes before the basis is built.

@@ -25,15 +25,17 @@ struct OctreeConfig {
 };
 
 struct SolverConfig {
-  std::string name =
-      "cholmod";  ///< cholmod | pcg | multigrid | dense (LLT reference, small systems)
+  std::string name = "cholmod";  ///< cholmod | pcg | multigrid | petsc | dense (LLT reference)
   double tolerance =
       -1;  ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
-  int max_iterations = 1000;              ///< PCG iteration cap
+  int max_iterations = 1000;              ///< PCG iteration cap (petsc: 3000, the paper's)
   std::string preconditioner = "jacobi";  ///< PCG: none | jacobi | ichol | multigrid
   std::string cycle = "W";                ///< multigrid: V | W
   int cycles = 1;                         ///< multigrid cycles per solve
   int smooth = 5;                         ///< Gauss–Seidel sweeps before and after (each)
+  /// petsc: PETSc options ("-pc_type hypre -pc_hypre_type boomeramg") over the defaults (CG +
+  /// GAMG, solvers/petsc_solver.h), kept verbatim in result.json.
+  std::string petsc_options;
 };
 
 struct FlowConfig {

@@ -8,6 +8,7 @@
 #include "solvers/multigrid.h"
 #include "solvers/multigrid_pcg.h"
 #include "solvers/pcg_solver.h"
+#include "solvers/petsc_solver.h"
 
 #include <stdexcept>
 
@@ -66,6 +67,13 @@ std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config) {
   if (config.name == "dense") return std::make_unique<DenseLltSolver>();
   if (config.name == "multigrid")
     return std::make_unique<MultigridSolver>(multigrid_options(config));
+  if (config.name == "petsc") {
+    PetscSolverOptions o;
+    o.options = config.petsc_options;
+    o.relative_tolerance = config.tolerance;
+    o.max_iterations = config.max_iterations;
+    return std::make_unique<PetscSolver>(o);  // checks the options: invalid_argument naming one
+  }
   if (config.name == "pcg") {
     PcgOptions o;
     o.relative_tolerance = config.tolerance;
