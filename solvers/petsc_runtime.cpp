@@ -1,5 +1,6 @@
 #include "solvers/petsc_runtime.h"
 
+#include <cstdlib>
 #include <mutex>
 
 #ifdef MCFBENCH_HAVE_PETSC
@@ -12,6 +13,15 @@ std::string petsc_unavailable_message() {
   return "this mcfbench was built without PETSc; install it (Debian: apt-get install "
          "libpetsc-real-dev openmpi-bin, which scripts/setup.sh does) and reconfigure "
          "(cmake -DMCFBENCH_PETSC=AUTO or ON, then rebuild)";
+}
+
+int launched_ranks() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* value = std::getenv(name)) {
+      const int n = std::atoi(value);
+      if (n > 0) return n;
+    }
+  return 1;
 }
 
 #ifndef MCFBENCH_HAVE_PETSC

@@ -55,6 +55,10 @@ class PetscRuntime {
   int rank_ = 0, size_ = 1;
 };
 
+/// The number of processes the MPI launcher started, read from its environment before MPI is
+/// started (Open MPI's OMPI_COMM_WORLD_SIZE, MPICH's and Slurm's PMI_SIZE); 1 without a launcher.
+int launched_ranks();
+
 /// Turns a PETSc error code into a PetscFailure naming `what` and PETSc's message (no-op on 0).
 void petsc_check(int code, const char* what);
 

@@ -119,6 +119,17 @@ struct PetscSolver::Impl {
   bool reuse_interpolation = false;       // GAMG with -pc_gamg_reuse_interpolation
   PetscBool user_reuse_pc = PETSC_FALSE;  // -ksp_reuse_preconditioner: kept even when values change
 
+  // Across MPI ranks (PETSC_COMM_WORLD of more than one rank) every rank holds the whole system,
+  // as every rank runs the whole flow, and hands PETSc its own block of rows [row_begin,
+  // row_end); the solution is gathered back to every rank (gather, all).
+  bool distributed = false;
+  MPI_Comm comm = PETSC_COMM_SELF;
+  PetscInt row_begin = 0, row_end = 0;
+  std::vector<PetscInt> local_ia, local_ja;  // the block's rows (distributed only)
+  std::vector<PetscScalar> kept_values;      // the values in the Mat (distributed only)
+  VecScatter gather = nullptr;
+  Vec all = nullptr;
+
   KSP ksp = nullptr;
   Mat A = nullptr;
   Vec b = nullptr, x = nullptr, r = nullptr;
@@ -137,15 +148,20 @@ struct PetscSolver::Impl {
     if (b != nullptr) VecDestroy(&b);
     if (x != nullptr) VecDestroy(&x);
     if (r != nullptr) VecDestroy(&r);
+    if (gather != nullptr) VecScatterDestroy(&gather);
+    if (all != nullptr) VecDestroy(&all);
+    local_ia.clear();
+    local_ja.clear();
+    kept_values.clear();
     rows = -1;
     nonzeros = 0;
     have_matrix = false;
   }
 
-  /// A KSP with this solver's prefix and options (not yet given operators).
-  KSP make_ksp() const {
+  /// A KSP on `on` with this solver's prefix and options (not yet given operators).
+  KSP make_ksp(MPI_Comm on) const {
     KSP k = nullptr;
-    petsc_check(KSPCreate(PETSC_COMM_SELF, &k), "KSPCreate");
+    petsc_check(KSPCreate(on, &k), "KSPCreate");
     try {
       petsc_check(KSPSetOptionsPrefix(k, prefix.c_str()), "KSPSetOptionsPrefix");
       petsc_check(KSPSetFromOptions(k), "KSPSetFromOptions");
@@ -180,25 +196,42 @@ struct PetscSolver::Impl {
     std::vector<PetscScalar> values(static_cast<std::size_t>(nonzeros));
     fill(values.data());
     const PetscInt n = PetscInt(rows);
-    petsc_check(MatCreate(PETSC_COMM_SELF, &A), "MatCreate");
-    petsc_check(MatSetSizes(A, n, n, n, n), "MatSetSizes");
-    petsc_check(MatSetType(A, MATSEQAIJ), "MatSetType");
-    petsc_check(MatSeqAIJSetPreallocationCSR(A, ia.data(), ja.data(), values.data()),
-                "MatSeqAIJSetPreallocationCSR");
+    petsc_check(MatCreate(comm, &A), "MatCreate");
+    if (!distributed) {
+      petsc_check(MatSetSizes(A, n, n, n, n), "MatSetSizes");
+      petsc_check(MatSetType(A, MATSEQAIJ), "MatSetType");
+      petsc_check(MatSeqAIJSetPreallocationCSR(A, ia.data(), ja.data(), values.data()),
+                  "MatSeqAIJSetPreallocationCSR");
+    } else {
+      PetscInt local = PETSC_DECIDE, global = n;
+      petsc_check(PetscSplitOwnership(comm, &local, &global), "PetscSplitOwnership");
+      petsc_check(MPI_Scan(&local, &row_end, 1, MPIU_INT, MPI_SUM, comm), "MPI_Scan");
+      row_begin = row_end - local;
+      local_ia.resize(std::size_t(local) + 1);
+      for (PetscInt i = 0; i <= local; ++i) local_ia[i] = ia[row_begin + i] - ia[row_begin];
+      local_ja.assign(ja.begin() + ia[row_begin], ja.begin() + ia[row_end]);
+      petsc_check(MatSetSizes(A, local, local, n, n), "MatSetSizes");
+      petsc_check(MatSetType(A, MATMPIAIJ), "MatSetType");
+      petsc_check(MatMPIAIJSetPreallocationCSR(A, local_ia.data(), local_ja.data(),
+                                               values.data() + ia[row_begin]),
+                  "MatMPIAIJSetPreallocationCSR");
+      kept_values = values;
+    }
     // Every flow's system is symmetric, whatever its values become: GAMG then skips making
     // its graph symmetric.
     petsc_check(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption");
     petsc_check(MatSetOption(A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE), "MatSetOption");
     petsc_check(MatSetOption(A, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE), "MatSetOption");
     MatInfo info;
-    petsc_check(MatGetInfo(A, MAT_LOCAL, &info), "MatGetInfo");
+    petsc_check(MatGetInfo(A, MAT_GLOBAL_SUM, &info), "MatGetInfo");
     // The value array is then Eigen's, entry for entry (refresh() relies on it).
     if (Index(info.nz_used) != nonzeros)
       throw PetscFailure("PETSc's AIJ matrix holds " + std::to_string(Index(info.nz_used)) +
                          " entries of " + std::to_string(nonzeros));
     petsc_check(MatCreateVecs(A, &x, &b), "MatCreateVecs");
     petsc_check(VecDuplicate(b, &r), "VecDuplicate");
-    ksp = make_ksp();
+    if (distributed) petsc_check(VecScatterCreateToAll(x, &gather, &all), "VecScatterCreateToAll");
+    ksp = make_ksp(comm);
     petsc_check(KSPSetOperators(ksp, A, A), "KSPSetOperators");
     PetscReal rtol = 0, abstol = 0, dtol = 0;
     PetscInt max_it = 0;
@@ -217,19 +250,33 @@ struct PetscSolver::Impl {
   void refresh(Fill fill) {
     std::vector<PetscScalar> values(static_cast<std::size_t>(nonzeros));
     fill(values.data());
-    const PetscScalar* current = nullptr;
-    petsc_check(MatSeqAIJGetArrayRead(A, &current), "MatSeqAIJGetArrayRead");
-    const bool same = std::equal(values.begin(), values.end(), current);
-    petsc_check(MatSeqAIJRestoreArrayRead(A, &current), "MatSeqAIJRestoreArrayRead");
+    bool same = false;
+    if (distributed) {
+      // Every rank compares the whole system (the same on every rank), so all take one branch.
+      same = values == kept_values;
+    } else {
+      const PetscScalar* current = nullptr;
+      petsc_check(MatSeqAIJGetArrayRead(A, &current), "MatSeqAIJGetArrayRead");
+      same = std::equal(values.begin(), values.end(), current);
+      petsc_check(MatSeqAIJRestoreArrayRead(A, &current), "MatSeqAIJRestoreArrayRead");
+    }
     if (same) {
       petsc_check(KSPSetReusePreconditioner(ksp, PETSC_TRUE), "KSPSetReusePreconditioner");
       if (setup != "new") setup = "kept";
       return;
     }
-    PetscScalar* v = nullptr;
-    petsc_check(MatSeqAIJGetArrayWrite(A, &v), "MatSeqAIJGetArrayWrite");
-    std::copy(values.begin(), values.end(), v);
-    petsc_check(MatSeqAIJRestoreArrayWrite(A, &v), "MatSeqAIJRestoreArrayWrite");
+    if (distributed) {
+      const PetscInt local = row_end - row_begin, n = PetscInt(rows);
+      petsc_check(MatUpdateMPIAIJWithArrays(A, local, local, n, n, local_ia.data(), local_ja.data(),
+                                            values.data() + outer[row_begin]),
+                  "MatUpdateMPIAIJWithArrays");
+      kept_values = std::move(values);
+    } else {
+      PetscScalar* v = nullptr;
+      petsc_check(MatSeqAIJGetArrayWrite(A, &v), "MatSeqAIJGetArrayWrite");
+      std::copy(values.begin(), values.end(), v);
+      petsc_check(MatSeqAIJRestoreArrayWrite(A, &v), "MatSeqAIJRestoreArrayWrite");
+    }
     // The assembly makes the new values a new object state (through public calls only): the
     // next KSPSolve then sets the preconditioner up again on SAME_NONZERO_PATTERN, unless the
     // user asked to keep it (-ksp_reuse_preconditioner). It moves no entry: the pattern is full.
@@ -270,6 +317,8 @@ PetscSolver::PetscSolver(PetscSolverOptions options) : impl_(std::make_unique<Im
   s.options = std::move(options);
   PetscRuntime& runtime = PetscRuntime::instance();
   s.prefix = runtime.new_prefix();
+  s.distributed = runtime.size() > 1;
+  s.comm = s.distributed ? PETSC_COMM_WORLD : PETSC_COMM_SELF;
   s.inserted = petsc_default_options(s.options.relative_tolerance, s.options.max_iterations) + " " +
                s.options.options;
   auto refuse = [&](const std::string& why) {
@@ -291,7 +340,7 @@ PetscSolver::PetscSolver(PetscSolverOptions options) : impl_(std::make_unique<Im
   Mat L = nullptr;
   Vec tb = nullptr, tx = nullptr;
   try {
-    trial = s.make_ksp();
+    trial = s.make_ksp(PETSC_COMM_SELF);
     const PetscInt g = 48, n = g * g;
     petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, n, n, 5, nullptr, &L), "MatCreateSeqAIJ");
     for (PetscInt i = 0; i < g; ++i)
@@ -433,12 +482,15 @@ SolveReport PetscSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
   std::vector<std::vector<double>> histories;
   try {
     for (Index c = 0; c < B.cols(); ++c) {
+      // This rank's rows (all of them when not distributed).
+      const Index first = s.distributed ? Index(s.row_begin) : 0;
+      const Index count = s.distributed ? Index(s.row_end - s.row_begin) : s.rows;
       PetscScalar* v = nullptr;
       petsc_check(VecGetArrayWrite(s.b, &v), "VecGetArrayWrite");
-      std::copy(B.col(c).data(), B.col(c).data() + s.rows, v);
+      std::copy(B.col(c).data() + first, B.col(c).data() + first + count, v);
       petsc_check(VecRestoreArrayWrite(s.b, &v), "VecRestoreArrayWrite");
       petsc_check(VecGetArrayWrite(s.x, &v), "VecGetArrayWrite");
-      std::copy(X.col(c).data(), X.col(c).data() + s.rows, v);
+      std::copy(X.col(c).data() + first, X.col(c).data() + first + count, v);
       petsc_check(VecRestoreArrayWrite(s.x, &v), "VecRestoreArrayWrite");
 
       petsc_check(KSPSolve(s.ksp, s.b, s.x), "KSPSolve");
@@ -447,10 +499,19 @@ SolveReport PetscSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
       petsc_check(KSPGetIterationNumber(s.ksp, &its), "KSPGetIterationNumber");
       petsc_check(KSPGetConvergedReason(s.ksp, &reason), "KSPGetConvergedReason");
 
+      // The whole solution on every rank: each runs the rest of the flow on it.
+      Vec whole = s.x;
+      if (s.distributed) {
+        petsc_check(VecScatterBegin(s.gather, s.x, s.all, INSERT_VALUES, SCATTER_FORWARD),
+                    "VecScatterBegin");
+        petsc_check(VecScatterEnd(s.gather, s.x, s.all, INSERT_VALUES, SCATTER_FORWARD),
+                    "VecScatterEnd");
+        whole = s.all;
+      }
       const PetscScalar* xv = nullptr;
-      petsc_check(VecGetArrayRead(s.x, &xv), "VecGetArrayRead");
+      petsc_check(VecGetArrayRead(whole, &xv), "VecGetArrayRead");
       std::copy(xv, xv + s.rows, X.col(c).data());
-      petsc_check(VecRestoreArrayRead(s.x, &xv), "VecRestoreArrayRead");
+      petsc_check(VecRestoreArrayRead(whole, &xv), "VecRestoreArrayRead");
 
       // The true residual, whatever norm the KSP tested.
       PetscReal bnorm = 0, rnorm = 0;
@@ -521,7 +582,14 @@ std::vector<std::pair<std::string, std::string>> PetscSolver::settings() const {
           {"relative_tolerance", tolerance},
           {"max_iterations", std::to_string(s.max_it)},
           {"preconditioner_reuse", reuse},
-          {"version", version()}};
+          {"version", version()},
+          {"ranks", std::to_string(PetscRuntime::instance().size())},
+          {"distribution",
+           s.distributed ? "every rank reads the mesh, assembles and holds the whole system and "
+                           "runs the whole flow; PETSc holds a block of rows of the matrix, "
+                           "vectors and preconditioner on each rank, and the solution is "
+                           "gathered to every rank after each solve"
+                         : "one process"}};
 }
 
 int PetscSolver::preconditioner_setups() const {

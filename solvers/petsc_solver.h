@@ -12,6 +12,10 @@
 // kept (KSPSetReusePreconditioner; heat flow's system never changes). The three coordinates are
 // solved one after another by the same KSP, each from its warm start.
 //
+// Under mpirun (PETSC_COMM_WORLD of several ranks) every rank runs the whole flow and holds the
+// whole system; the Mat is then an MPIAIJ of which each rank holds its block of rows, and each
+// solution is gathered back to every rank (docs/petsc.md, "Across MPI ranks").
+//
 // PETSc headers stay inside petsc_solver.cpp: this header compiles without PETSc, and in a build
 // without it the constructor throws PetscUnavailable.
 
