@@ -22,13 +22,17 @@ std::string petsc_default_options(double relative_tolerance, int max_iterations)
   char numbers[96];
   std::snprintf(numbers, sizeof numbers, "-ksp_rtol %.17g -ksp_max_it %d", relative_tolerance,
                 max_iterations);
-  // -pc_gamg_use_sa_esteig false: the smoothers' Chebyshev bounds are estimated again on each
-  // set-up instead of taken from the prolongator smoothing's estimate, which a kept interpolation
-  // keeps stale; with the stale bound CG met an indefinite preconditioner after 6 steps of MCF on
-  // the bunny (the mesh's Laplacian changed under it).
+  // The levels' smoother: Richardson with symmetric SOR, not GAMG's Chebyshev. Chebyshev needs a
+  // bound of the level's largest eigenvalue: taken from the prolongator smoothing's estimate it
+  // goes stale while the interpolation is kept, and the preconditioner turned indefinite after 6
+  // steps of MCF on the bunny; estimated by Chebyshev itself it fell short on the octree's
+  // (paper's) system, indefinite in the first solve. A symmetric SOR sweep needs no bound and
+  // keeps the cycle symmetric positive definite, so CG applies; it also took fewer iterations on
+  // both (docs/petsc.md).
   return std::string(
              "-ksp_type cg -pc_type gamg -pc_gamg_reuse_interpolation true "
-             "-pc_gamg_use_sa_esteig false -ksp_initial_guess_nonzero true ") +
+             "-mg_levels_ksp_type richardson -mg_levels_pc_type sor "
+             "-ksp_initial_guess_nonzero true ") +
          numbers;
 }
 
