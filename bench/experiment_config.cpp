@@ -212,11 +212,18 @@ bool excluded(const json& raw, const json& exclude, std::vector<bool>& used) {
 const std::vector<std::string>& flow_config_keys() {
   static const std::vector<std::string> keys = [] {
     std::vector<std::string> k;
-    // With every key that to_json writes only when it is set.
+    // With every key that to_json writes only when it is set, or only for some solvers (the
+    // multigrid's fallback, PETSc's options).
     FlowConfig every;
     every.repair_degenerate = true;
-    every.solver.name = "multigrid";
-    flatten_keys(to_json(every), "", k);
+    for (const char* solver : {"multigrid", "petsc"}) {
+      every.solver.name = solver;
+      std::vector<std::string> keys;
+      flatten_keys(to_json(every), "", keys);
+      for (const std::string& key : keys)
+        if (std::find(k.begin(), k.end(), key) == k.end()) k.push_back(key);
+    }
+    std::sort(k.begin(), k.end());
     return k;
   }();
   return keys;

@@ -4,10 +4,12 @@
 #include "bench/progress.h"
 #include "bench/runner.h"
 #include "bench/stop_signals.h"
+#include "solvers/petsc_runtime.h"
 
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 
 namespace mcf {
 namespace {
@@ -64,6 +66,11 @@ class RunProgress {
 }  // namespace
 
 int run_experiment_with_progress(const RunRequest& request) {
+  // Every rank would run every cell into the same folder (docs/petsc.md, "Across MPI ranks").
+  if (launched_ranks() > 1)
+    throw std::runtime_error("run: started as one of " + std::to_string(launched_ranks()) +
+                             " MPI ranks; a study runs in one process (use --shard to spread "
+                             "its cells, or mpirun one `mcfbench flow` with --solver petsc)");
   const ExperimentConfig e = load_experiment_config(request.config, request.quick);
   const double line_seconds = progress_line_seconds();  // a bad value: nothing written
   RunOptions o;

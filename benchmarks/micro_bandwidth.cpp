@@ -36,15 +36,16 @@ Arrays& arrays() {
 // thread's memory node as first touch placed them.
 template <class Kernel>
 void run(benchmark::State& state, double bytes_per_element, Kernel kernel) {
-  const int threads = int(state.range(0)) > 0 ? int(state.range(0))
-                                               : int(std::thread::hardware_concurrency());
+  const int threads =
+      int(state.range(0)) > 0 ? int(state.range(0)) : int(std::thread::hardware_concurrency());
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   Arrays& arr = arrays();
   const std::size_t n = arr.a.size();
   for (auto _ : state) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, n / (8 * threads) + 1),
-                      [&](const tbb::blocked_range<std::size_t>& r) { kernel(arr, r.begin(), r.end()); },
-                      tbb::static_partitioner());
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, n / (8 * threads) + 1),
+        [&](const tbb::blocked_range<std::size_t>& r) { kernel(arr, r.begin(), r.end()); },
+        tbb::static_partitioner());
     benchmark::ClobberMemory();
   }
   state.counters["threads"] = threads;

@@ -104,6 +104,15 @@ class FlowStepContext final : public StepContext {
       ++fallbacks_;
       fallback_iterations_ += r.fallback_iterations;
     }
+    if (!r.columns.empty()) {
+      nlohmann::json columns = nlohmann::json::array();
+      for (const ColumnReport& c : r.columns)
+        columns.push_back({{"iterations", c.iterations},
+                           {"relative_residual", c.relative_residual},
+                           {"reason", c.reason}});
+      columns_per_solve_.push_back(std::move(columns));
+    }
+    if (!r.preconditioner_setup.empty()) preconditioner_setups_.push_back(r.preconditioner_setup);
     if (severity(r.status) >= severity(worst_.status)) worst_ = r;
     return Y;
   }
@@ -116,6 +125,8 @@ class FlowStepContext final : public StepContext {
     solves_ = iterations_ = fallbacks_ = fallback_iterations_ = 0;
     contraction_ = -1;
     residuals_per_solve_.clear();
+    columns_per_solve_ = nlohmann::json::array();
+    preconditioner_setups_.clear();
     worst_ = SolveReport{};
   }
   void rebuilt() {
@@ -134,6 +145,10 @@ class FlowStepContext final : public StepContext {
   SolveReport worst_;
   // Every solve's residuals, in order (Taylor-2 and Neumann-2 solve twice a step).
   std::vector<std::vector<double>> residuals_per_solve_;
+  // Per solve, per right-hand side (PETSc): iterations, true residual, the KSP's reason.
+  nlohmann::json columns_per_solve_ = nlohmann::json::array();
+  // Per solve (PETSc): what it did with its preconditioner (new | refreshed | kept).
+  std::vector<std::string> preconditioner_setups_;
   std::size_t fixed() const { return system_->num_fixed(); }
 
  private:
@@ -267,10 +282,12 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
   const Triangles& F = mesh_.faces;
   if (config.normalize_area) apply(unit_area_normalization(mesh_.vertices, F), mesh_.vertices);
 
+  // The solver first: it may refuse its configuration (PETSc's options) before the basis is
+  // built.
+  solver_ = make_solver(config.solver);
   const auto setup_start = Clock::now();
   basis_ = make_basis(config, mesh_, source.analytic);
   build_seconds_ = seconds_since(setup_start);
-  solver_ = make_solver(config.solver);
   // A solver that takes only small systems (the dense reference) would refuse this one at its
   // first factorization: say so now, as the configuration error it is, rather than stop the
   // flow at step 1 as if it had turned singular.
@@ -296,11 +313,14 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
                               " basis are held by the mesh's boundary, which the flow keeps "
                               "fixed, so the mesh stays as it is");
   result["solver_name"] = solver_->name();
+  if (const auto settings = solver_->settings(); !settings.empty())
+    for (const auto& [key, text] : settings) result["solver_settings"][key] = text;
 
   stabilized_ = config.basis == "octree" && config.octree.stabilization == "normal-gradient";
   // The start is the stabilized solve's prediction too (FlowStepContext::solve_increment), so a
   // direct solver needs X_{n-1} then as well.
-  const bool iterative = config.solver.name == "multigrid" || config.solver.name == "pcg";
+  const bool iterative = config.solver.name == "multigrid" || config.solver.name == "pcg" ||
+                         config.solver.name == "petsc";
   keeps_previous_for_start_ = stabilized_ || iterative;
   ctx_ = std::make_unique<FlowStepContext>(*basis_, *solver_, config.flow, config.dt, iterative,
                                            stabilized_ ? config.octree.stabilization_weight : 0.0);
@@ -349,6 +369,9 @@ nlohmann::json FlowRun::solver_record(int step, double t) const {
   if (ctx.fallbacks_ > 0)
     record["solver"]["fallback"] = {{"solves", ctx.fallbacks_},
                                     {"iterations", ctx.fallback_iterations_}};
+  if (!ctx.columns_per_solve_.empty()) record["solver"]["rhs_per_solve"] = ctx.columns_per_solve_;
+  if (!ctx.preconditioner_setups_.empty())
+    record["solver"]["preconditioner_setup"] = ctx.preconditioner_setups_;
   // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
   // Gauss-Seidel on a level), or why it failed.
   if (!worst.message.empty()) record["solver"]["message"] = worst.message;

@@ -30,7 +30,10 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   }
   {
     auto s = r.child("solver");
-    c.solver.name = s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "dense"});
+    c.solver.name =
+        s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "petsc", "dense"});
+    // PETSc's default cap is the paper's baseline's: CG + AMG stopped at 3000 iterations.
+    if (c.solver.name == "petsc") c.solver.max_iterations = 3000;
     c.solver.tolerance =
         s.get_number("tolerance", c.solver.tolerance, 0, 1);  // absent: -1, the solver's default
     c.solver.max_iterations =
@@ -43,6 +46,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
     c.solver.stall_ratio = s.get_number("stall_ratio", c.solver.stall_ratio, 0, 1);
     c.solver.fallback_tolerance =
         s.get_number("fallback_tolerance", c.solver.fallback_tolerance, 1e-300, 1);
+    c.solver.petsc_options = s.get_string("petsc_options", c.solver.petsc_options);
     s.finish();
   }
   c.integrator = r.get_string("integrator", c.integrator, integrator_names());
@@ -95,6 +99,7 @@ nlohmann::json to_json(const FlowConfig& c) {
   if (c.repair_degenerate) j["repair_degenerate"] = true;
   // The multigrid's fallback only where a multigrid runs, for the same reason: the config keys of
   // the other solvers' cells stay those of versions without it.
+  if (c.solver.name == "petsc") j["solver"]["petsc_options"] = c.solver.petsc_options;
   if (c.solver.name == "multigrid") {
     j["solver"]["stall_ratio"] = c.solver.stall_ratio;
     j["solver"]["fallback_tolerance"] = c.solver.fallback_tolerance;
@@ -107,6 +112,10 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
     throw ConfigError(source + ": " + key + ": " + what);
   };
   const bool rebuilt = c.basis == "octree" && c.octree.tracking == "rebuilt";
+  // Options no solver reads would be recorded as if they had shaped the run.
+  if (c.solver.name != "petsc" && !c.solver.petsc_options.empty())
+    fail("solver.petsc_options",
+         "applies to solver \"petsc\" only, the solver is \"" + c.solver.name + "\"");
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
   if (c.basis != "hat" && c.mass != "consistent")
     fail("mass", "\"" + c.mass +

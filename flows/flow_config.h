@@ -26,11 +26,10 @@ struct OctreeConfig {
 };
 
 struct SolverConfig {
-  std::string name =
-      "cholmod";  ///< cholmod | pcg | multigrid | dense (LLT reference, small systems)
+  std::string name = "cholmod";  ///< cholmod | pcg | multigrid | petsc | dense (LLT reference)
   double tolerance =
       -1;  ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
-  int max_iterations = 1000;              ///< PCG iteration cap
+  int max_iterations = 1000;              ///< PCG iteration cap (petsc: 3000, the paper's)
   std::string preconditioner = "jacobi";  ///< PCG: none | jacobi | ichol | multigrid
   std::string cycle = "W";                ///< multigrid: V | W
   int cycles = 1;                         ///< multigrid cycles per solve
@@ -40,6 +39,9 @@ struct SolverConfig {
   /// (never below `fallback_tolerance`; solvers/multigrid_fallback.h). 0 = never.
   double stall_ratio = 0.2;
   double fallback_tolerance = 1e-10;
+  /// petsc: PETSc options ("-pc_type hypre -pc_hypre_type boomeramg") over the defaults (CG +
+  /// GAMG, solvers/petsc_solver.h), kept verbatim in result.json.
+  std::string petsc_options;
 };
 
 struct FlowConfig {

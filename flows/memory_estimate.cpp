@@ -27,6 +27,18 @@ constexpr double kDensePerUnknown2 = 16;            // the dense matrix and its 
 // faces: 627-664 MiB against 449 MiB with PCG).
 constexpr double kHatMultigridPerVertex = 480;
 
+// PETSc (solvers/petsc_solver.h): a model, not a fit. Its AIJ copy of the system costs 12 bytes a
+// nonzero (value and column index) and the set-up copies of the values and indices 12 more; the
+// smoothed-aggregation hierarchy (GAMG, BoomerAMG) and its Galerkin products add about twice the
+// finest matrix again, so 3 matrices in all; and the KSP's vectors (CG's four, the three of the
+// solve, the hierarchy's smoothers') about 16 doubles per unknown. Nonzeros per row: 7 on a
+// triangle mesh (the vertex and its neighbours), at most 27 for the octree's trilinear functions.
+constexpr double kPetscMatrixCopies = 3;
+constexpr double kPetscBytesPerNonzero = 12 + 12.0 / kPetscMatrixCopies;
+constexpr double kPetscVectorBytesPerUnknown = 16 * 8;
+constexpr double kHatNonzerosPerRow = 7;
+constexpr double kOctreeNonzerosPerRow = 27;
+
 /// About this many finest functions per (h^2 of surface): measured 2.84-3.02 on the armadillo,
 /// the elephant and spheres at depths 6 to 9.
 constexpr double kFunctionsPerArea = 3.0;
@@ -114,6 +126,11 @@ MemoryEstimate estimate_flow_memory(const FlowConfig& config, const FlowSizes& s
   else if (cholmod)
     e.solver_bytes =
         (config.basis == "octree" ? kOctreeCholmodPerFunction : kHatCholmodPerVertex) * e.dimension;
+  else if (solver.name == "petsc")
+    e.solver_bytes = (kPetscMatrixCopies * kPetscBytesPerNonzero *
+                          (config.basis == "octree" ? kOctreeNonzerosPerRow : kHatNonzerosPerRow) +
+                      kPetscVectorBytesPerUnknown) *
+                     e.dimension;
   else if (config.solver.name == "dense")
     e.solver_bytes = kDensePerUnknown2 * e.dimension * e.dimension;
   return e;

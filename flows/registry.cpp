@@ -10,6 +10,7 @@
 #include "solvers/multigrid_fallback.h"
 #include "solvers/multigrid_pcg.h"
 #include "solvers/pcg_solver.h"
+#include "solvers/petsc_solver.h"
 
 #include <stdexcept>
 
@@ -77,6 +78,13 @@ std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config) {
     f.tolerance = config.fallback_tolerance;
     f.max_iterations = config.max_iterations;
     return std::make_unique<FallbackMultigridSolver>(multigrid_options(config), f);
+  }
+  if (config.name == "petsc") {
+    PetscSolverOptions o;
+    o.options = config.petsc_options;
+    o.relative_tolerance = config.tolerance;
+    o.max_iterations = config.max_iterations;
+    return std::make_unique<PetscSolver>(o);  // checks the options: invalid_argument naming one
   }
   if (config.name == "pcg") {
     PcgOptions o;

@@ -213,14 +213,21 @@ def applies(key, basis):
 
 
 def label(result, keys):
-    """Legend label: the values of `keys` in the result's assignment, "key=value" joined; a true
+    """Legend label: the values of `keys` in the result's assignment, "key=value" joined (a PETSc
+    solver as the method it ran, "solver=petsc-cg-gamg"); a true
     flag is its key alone and a false one is left out ("tracking=rebuilt, refine_input" beside
     "tracking=rebuilt"), unless false flags are all there is to tell the variants apart. Keys of
     another basis are left out ("basis=hat, solver=pcg", not "tracking=tracked")."""
     a = assignment(result)
     basis = get(result, "config.basis", a.get("basis"))
     present = [k for k in keys if k in a and applies(k, basis)]
-    parts = [key_name(k) if a[k] is True else "%s=%s" % (key_name(k), short_value(a[k]))
+    def shown(k):
+        # A PETSc cell names the method it ran ("solver=petsc-cg-gamg": CG with smoothed-
+        # aggregation AMG), which its options, not its solver.name, chose.
+        if k == "solver.name" and a[k] == "petsc" and isinstance(result.get("solver_name"), str):
+            return result["solver_name"]
+        return short_value(a[k])
+    parts = [key_name(k) if a[k] is True else "%s=%s" % (key_name(k), shown(k))
              for k in present if a[k] is not False]
     if not parts:
         parts = ["%s=%s" % (key_name(k), short_value(a[k])) for k in present]

@@ -12,6 +12,7 @@ packages=(
   libopenmesh-dev
   nlohmann-json3-dev
   libcli11-dev
+  libpetsc-real-dev openmpi-bin          # --solver petsc: PETSc's KSP, GAMG, hypre's BoomerAMG (docs/petsc.md)
   libbenchmark-dev
   libgtest-dev
   clang-format                           # scripts/format.sh and the `format` test

@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mcf {
@@ -26,6 +27,13 @@ enum class SolveStatus {
 
 const char* to_string(SolveStatus s);
 
+/// One right-hand side of a solver that solves the columns one after another (PETSc's KSP).
+struct ColumnReport {
+  int iterations = 0;
+  double relative_residual = 0.0;  ///< the true ||b - A x|| / ||b|| at exit (||r|| when b = 0)
+  std::string reason;              ///< why it stopped, in the solver's words (KSPConvergedReason)
+};
+
 struct SolveReport {
   SolveStatus status = SolveStatus::converged;
   int iterations = 0;              ///< cycles (multigrid), CG iterations (PCG), 1 (direct)
@@ -37,6 +45,11 @@ struct SolveReport {
   /// Iterations of a fallback solver that took over after this one stalled (0: none ran).
   int fallback_iterations = 0;
   std::string message;
+  /// Per right-hand side, from a solver that reports them (PETSc); empty otherwise.
+  std::vector<ColumnReport> columns;
+  /// What this solve did with its preconditioner, from a solver that says (PETSc: "new",
+  /// "refreshed", "kept"); empty otherwise.
+  std::string preconditioner_setup;
   bool ok() const {
     return status == SolveStatus::converged || status == SolveStatus::max_iterations;
   }
@@ -166,6 +179,9 @@ class LinearSolver {
   /// The largest system this solver takes (the dense reference's n² storage); a flow refuses a
   /// larger basis before its first step, as a configuration error.
   virtual Eigen::Index max_dimension() const { return std::numeric_limits<Eigen::Index>::max(); }
+  /// How the solver is set up, as (key, text) pairs that result.json records under
+  /// "solver_settings" (PETSc's options and types); empty where the config says it all.
+  virtual std::vector<std::pair<std::string, std::string>> settings() const { return {}; }
 
   /// Sets (or updates) the matrix A (full symmetric storage, compressed). A solver detects
   /// whether the sparsity pattern is unchanged and then reuses its symbolic work.

@@ -15,7 +15,7 @@ struct FlowArgs {
   // Every flag maps to one key of the flow config; only flags given on the command line are
   // set, so --config FILE supplies the rest.
   std::string mesh, flow, basis, mass, tracking, cube, stabilization, solver, preconditioner, cycle,
-      integrator;
+      integrator, petsc_options;
   int depth = 0, cubature = 0, max_iterations = 0, cycles = 0, smooth = 0, steps = 0, threads = 0,
       save_every = 0;
   double dt = 0, tolerance = 0, stabilization_weight = 0, stall_ratio = 0, fallback_tolerance = 0;
@@ -47,12 +47,16 @@ void add_flow_options(CLI::App& cmd, FlowArgs& args) {
   cmd.add_option("--stabilization-weight", args.stabilization_weight,
                  "Octree: the normal-gradient term's diagonal over the system's (default 0.5)");
   cmd.add_option("--solver", args.solver,
-                 "cholmod (default) | pcg | multigrid | dense (LLT of the dense matrix: a "
-                 "reference for small meshes)");
+                 "cholmod (default) | pcg | multigrid | petsc (PETSc's KSP, default CG + GAMG) | "
+                 "dense (LLT of the dense matrix: a reference for small meshes)");
   cmd.add_option(
       "--tolerance", args.tolerance,
       "Relative residual to stop at (PCG default 1e-10; multigrid default 0 = run --cycles)");
-  cmd.add_option("--max-iterations", args.max_iterations, "PCG iteration cap (default 1000)");
+  cmd.add_option("--max-iterations", args.max_iterations,
+                 "PCG iteration cap (default 1000; petsc: 3000)");
+  cmd.add_option("--petsc-options", args.petsc_options,
+                 "petsc: PETSc options over the defaults, e.g. \"-pc_type hypre -pc_hypre_type "
+                 "boomeramg\" (docs/petsc.md)");
   cmd.add_option("--preconditioner", args.preconditioner,
                  "PCG: none | jacobi (default) | ichol | multigrid");
   cmd.add_option("--cycle", args.cycle, "Multigrid cycle: V | W (default)");
@@ -115,6 +119,7 @@ FlowRequest flow_request(const CLI::App& cmd, const FlowArgs& args) {
   set("--tolerance", "solver.tolerance", args.tolerance);
   set("--max-iterations", "solver.max_iterations", args.max_iterations);
   set("--preconditioner", "solver.preconditioner", args.preconditioner);
+  set("--petsc-options", "solver.petsc_options", args.petsc_options);
   set("--cycle", "solver.cycle", args.cycle);
   set("--cycles", "solver.cycles", args.cycles);
   set("--smooth", "solver.smooth", args.smooth);

@@ -79,6 +79,16 @@ TEST(MemoryEstimate, SharesGrowWithDepthMeshAndFactor) {
   EXPECT_GT(total(factored), total(octree));
   EXPECT_GT(total({{"mesh", "x"}, {"solver", {{"name", "cholmod"}}}}),
             total({{"mesh", "x"}, {"solver", {{"name", "pcg"}}}}));
+  // PETSc: its copy of the matrix and the AMG hierarchy, about three matrices, and more for the
+  // octree's 27-point rows than for a triangle mesh's 7.
+  const auto petsc = [&](const nlohmann::json& j) { return estimate_flow_memory(config(j), s, 0); };
+  const MemoryEstimate hat_petsc = petsc({{"mesh", "x"}, {"solver", {{"name", "petsc"}}}});
+  EXPECT_GT(hat_petsc.solver_bytes, 3 * 12 * 7 * 1e5);
+  EXPECT_LT(hat_petsc.solver_bytes, 1000 * 1e5);
+  nlohmann::json octree_petsc = octree;
+  octree_petsc["solver"]["name"] = "petsc";
+  EXPECT_GT(petsc(octree_petsc).solver_bytes / petsc(octree_petsc).dimension,
+            2 * hat_petsc.solver_bytes / hat_petsc.dimension);
   // The dense reference stores n^2 doubles and their factor.
   EXPECT_GE(total({{"mesh", "x"}, {"solver", {{"name", "dense"}}}}), 16 * 1e5 * 1e5);
   // The resident memory is part of the total.

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# One flow's PETSc solves across two MPI ranks (docs/petsc.md, "Across MPI ranks"):
+# `mpirun -n 2 mcfbench flow ... --solver petsc` writes one result whose final surface matches the
+# same flow run without mpirun to 1e-8 of the bounding box's diagonal, records two ranks, and
+# leaves no second output; a solver other than petsc under mpirun is refused, writing nothing.
+#
+# usage: test_mpi_flow.sh MCFBENCH
+#
+# Exits 77 (skipped) without mpirun or in a build without PETSc. Open MPI refuses to run as root
+# unless told: the two OMPI_ALLOW_RUN_AS_ROOT variables (CI runs as root).
+set -u
+mcfbench=${1:?usage: test_mpi_flow.sh MCFBENCH}
+py=/usr/bin/python3
+command -v mpirun >/dev/null 2>&1 || { echo "skipped: no mpirun (apt-get install openmpi-bin)"; exit 77; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+flow=(flow --mesh sphere:vertices=3000 --solver petsc --threads 1 --dt 1e-3 --steps 3)
+if ! "$mcfbench" "${flow[@]}" --out "$work/serial" 2>"$work/serial.log"; then
+  if grep -q "built without PETSc" "$work/serial.log"; then echo "skipped: built without PETSc"; exit 77; fi
+  cat "$work/serial.log"; echo "FAIL: the serial flow failed"; exit 1
+fi
+fail() { echo "FAIL: $*"; exit 1; }
+mpirun -n 2 "$mcfbench" "${flow[@]}" --out "$work/mpi" >"$work/mpi.log" 2>&1 ||
+  { cat "$work/mpi.log"; fail "mpirun -n 2 failed"; }
+[ -f "$work/mpi/result.json" ] || fail "no result.json from the MPI run"
+[ "$(ls "$work" | sort | tr '\n' ' ')" = "mpi mpi.log serial serial.log " ] || fail "other output: $(ls "$work")"
+"$py" - "$work/serial" "$work/mpi" <<'PY' || exit 1
+import json, sys
+import numpy as np
+def read(p):
+    d = open(p + "/final.ply", "rb").read()
+    h = d.index(b"end_header\n") + len(b"end_header\n")
+    n = int([l for l in d[:h].decode().split("\n") if l.startswith("element vertex")][0].split()[-1])
+    return np.frombuffer(d[h:h + 24 * n], dtype="<f8").reshape(n, 3)
+a, b = read(sys.argv[1]), read(sys.argv[2])
+diag = np.linalg.norm(a.max(0) - a.min(0))
+dev = np.abs(a - b).max() / diag
+r = json.load(open(sys.argv[2] + "/result.json"))
+ranks = r["solver_settings"]["ranks"]
+ok = dev < 1e-8 and ranks == "2" and r["status"] == "ok"
+for step in r["steps"]:
+    ok = ok and step["solver"]["status"] == "converged" and step["solver"]["relative_residual"] <= 1e-10
+print("mpi vs serial: %.3g of the diagonal, ranks %s, status %s" % (dev, ranks, r["status"]))
+sys.exit(0 if ok else 1)
+PY
+mpirun -n 2 "$mcfbench" flow --mesh sphere:vertices=500 --threads 1 --steps 1 --out "$work/cholmod" \
+  >"$work/cholmod.log" 2>&1 && fail "cholmod under mpirun -n 2 was not refused"
+grep -q 'only "petsc" runs across the 2 ranks' "$work/cholmod.log" || fail "no refusal message: $(cat "$work/cholmod.log")"
+[ ! -e "$work/cholmod" ] || fail "the refused run wrote $work/cholmod"
+echo "mpi_flow: ok"
