@@ -114,9 +114,9 @@ int run_flow_into_folder(const FlowRequest& request) {
   // Ranks other than 0 run the same flow, so that every collective solve has all its ranks,
   // and write nothing.
   if (config.solver.name == "petsc" && PetscRuntime::instance().rank() != 0) {
-    const MeshSource mesh = load_mesh_spec(config.mesh);
+    const MeshSource mesh = load_mesh_spec(config.mesh, mesh_load_options(config));
     run_flow(config, mesh);
-    return;
+    return 0;
   }
   const MemoryBudget budget = memory_budget(request.max_memory);
   // Before the mesh is generated or read (a generator's size is known from its spec), then with

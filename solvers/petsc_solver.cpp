@@ -4,6 +4,8 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #ifdef MCFBENCH_HAVE_PETSC
 #include "core/parallel.h"
@@ -17,6 +19,15 @@
 #endif
 
 namespace mcf {
+
+namespace {
+SolveReport failed_report(std::string message) {
+  SolveReport r;
+  r.status = SolveStatus::failed;
+  r.message = std::move(message);
+  return r;
+}
+}  // namespace
 
 std::string petsc_default_options(double relative_tolerance, int max_iterations) {
   char numbers[96];
@@ -48,13 +59,13 @@ std::string PetscSolver::name() const {
   return "petsc";
 }
 SolveReport PetscSolver::set_matrix(const SparseMatrix&, HierarchyView) {
-  return {SolveStatus::failed, 0, 0.0, {}, petsc_unavailable_message(), {}, {}};
+  return failed_report(petsc_unavailable_message());
 }
 SolveReport PetscSolver::set_matrix_sum(const MatrixSum&, HierarchyView) {
-  return {SolveStatus::failed, 0, 0.0, {}, petsc_unavailable_message(), {}, {}};
+  return failed_report(petsc_unavailable_message());
 }
 SolveReport PetscSolver::solve_in_place(const ConstMatrixRef&, MatrixRef) {
-  return {SolveStatus::failed, 0, 0.0, {}, petsc_unavailable_message(), {}, {}};
+  return failed_report(petsc_unavailable_message());
 }
 std::vector<std::pair<std::string, std::string>> PetscSolver::settings() const {
   return {};
@@ -450,7 +461,7 @@ std::string PetscSolver::name() const {
 
 SolveReport PetscSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
   if (A.rows() != A.cols())
-    return {SolveStatus::failed, 0, 0.0, {}, "matrix is not square", {}, {}};
+    return failed_report("matrix is not square");
   if (!A.isCompressed()) {
     SparseMatrix C = A;
     C.makeCompressed();
