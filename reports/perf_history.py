@@ -237,14 +237,19 @@ def store_result_set(store, config_name, results_dir, info):
             fail("%s: cells of different machines, threads or builds in one set" % results_dir)
         cell = r["cell"]
         b = benchmarks.setdefault(cell_label(cell), {"key": cell.get("config_key", ""),
-                                                     "samples": [], "failed": 0})
+                                                     "samples": [], "contended": [],
+                                                     "failed": 0})
         if r.get("status", "error") != "ok":
             b["failed"] += 1
         s = repetition_sample(r)
         if s is not None:
             b["samples"].append(s)
+            b["contended"].append(bool((r.get("contention") or {}).get("contended")))
     for b in benchmarks.values():
-        b["median"] = median(b["samples"]) if b["samples"] else None
+        # Repetitions that shared the machine with other work measured the machine as much as
+        # the code: the median leaves them out while any repetition ran alone.
+        quiet = [v for v, c in zip(b["samples"], b["contended"]) if not c]
+        b["median"] = median(quiet or b["samples"]) if b["samples"] else None
     mid = machine_id(identity)
     folder = os.path.join(store, mid, config_name)
     os.makedirs(folder, exist_ok=True)
@@ -331,6 +336,10 @@ def config_name_of(config):
     return os.path.splitext(os.path.basename(config))[0]
 
 
+class RunnerFailed(Exception):
+    pass
+
+
 def run_in(args, worktree, commit, out, repetitions):
     """Runs the runner in `worktree` (checked out at `commit`) into the folder `out`."""
     env = dict(os.environ, MCFBENCH_HISTORY_COMMIT=commit,
@@ -339,7 +348,7 @@ def run_in(args, worktree, commit, out, repetitions):
                                                                 os.path.abspath(out)))
     r = subprocess.run(cmd, shell=True, cwd=worktree, env=env)
     if r.returncode != 0:
-        fail("runner failed on %s (exit %d): %s" % (commit[:12], r.returncode, cmd))
+        raise RunnerFailed("runner failed on %s (exit %d): %s" % (commit[:12], r.returncode, cmd))
 
 
 def run_commit(args, commit, log):
@@ -349,11 +358,14 @@ def run_commit(args, commit, log):
     wt, out = os.path.join(work, "src"), os.path.join(work, "out")
     os.makedirs(out)
     git(args.repo, "worktree", "add", "--detach", "--force", wt, commit)
+    log.append(commit)  # a failed run counts as a run too
     try:
         run_in(args, wt, commit, out, args.repetitions)
+    except RunnerFailed:
+        shutil.rmtree(work, ignore_errors=True)
+        raise
     finally:
         git(args.repo, "worktree", "remove", "--force", wt)
-    log.append(commit)
     return work, out
 
 
@@ -428,13 +440,22 @@ def cmd_run(args):
         commits = commit_range(args.repo, args.range)
         # A..B leaves A out, as git does; the user named it, so it is measured too.
         commits = [git(args.repo, "rev-parse", args.range.split("..")[0] + "^{commit}")] + commits
+    elif args.range:
+        commits = [git(args.repo, "rev-parse", args.range + "^{commit}")]
     else:
-        fail("run needs A..B or --last N")
-    state, log = {"machine": args.machine}, []
+        fail("run needs A..B, a commit or --last N")
+    state, log, failed = {"machine": args.machine}, [], []
     for c in commits:
-        measure(args, c, state, log)
-    print("history: %d commits, %d runs; store %s" % (len(commits), len(log), args.store))
-    return 0
+        # A commit that does not build or run leaves a gap in the series, not an end to it.
+        try:
+            measure(args, c, state, log)
+        except RunnerFailed as e:
+            print("history: " + str(e), file=sys.stderr)
+            failed.append(c)
+    print("history: %d commits, %d runs, %d failed%s; store %s" % (
+        len(commits), len(log), len(failed),
+        "".join(" " + c[:12] for c in failed), args.store))
+    return 1 if failed else 0
 
 
 def cmd_add(args):
@@ -506,11 +527,13 @@ def cmd_bisect(args):
 
 
 def series_steps(entries, threshold, alpha, min_run):
-    """{benchmark: (points, steps)}: points = [(entry, median, samples)] in git order."""
+    """{benchmark: (points, steps)}: points = [(entry, median, samples, contended flags)] in git
+    order."""
     out = {}
     names = sorted({n for e in entries for n in e["benchmarks"]})
     for n in names:
-        pts = [(e, e["benchmarks"][n]["median"], e["benchmarks"][n]["samples"]) for e in entries
+        pts = [(e, e["benchmarks"][n]["median"], e["benchmarks"][n]["samples"],
+                e["benchmarks"][n].get("contended") or []) for e in entries
                if n in e["benchmarks"] and e["benchmarks"][n].get("median")]
         steps = detect_steps([p[1] for p in pts], threshold=threshold, alpha=alpha,
                              min_run=min_run)
@@ -558,7 +581,7 @@ def svg_chart(pts, steps, width=640, height=220):
     vertical line labelled with its commit and ratio. Rendered here, so the page needs no
     script or network."""
     ml, mr, mt, mb = 56, 10, 14, 28
-    vals = [v for _, m, s in pts for v in (s or [m])]
+    vals = [v for _, m, s, _ in pts for v in (s or [m])]
     lo, hi = min(vals), max(vals)
     if hi <= lo:
         hi = lo * 1.1 + 1e-12
@@ -587,9 +610,13 @@ def svg_chart(pts, steps, width=640, height=220):
                  'stroke-dasharray="4 3"/>' % (x, x, mt, height - mb, color))
         o.append('<text x="%.1f" y="%d" font-size="10" fill="%s">%s %+.0f%%</text>' %
                  (x + 3, mt + 11, color, s["commit"][:8], 100 * (s["ratio"] - 1)))
-    for i, (e, m, samples) in enumerate(pts):
-        for v in samples:
-            o.append('<circle cx="%.1f" cy="%.1f" r="1.8" fill="#99b"/>' % (X(i), Y(v)))
+    for i, (e, m, samples, contended) in enumerate(pts):
+        for k, v in enumerate(samples):
+            if k < len(contended) and contended[k]:  # hollow: shared the machine
+                o.append('<circle class="contended" cx="%.1f" cy="%.1f" r="2.2" fill="none" '
+                         'stroke="#c80"/>' % (X(i), Y(v)))
+            else:
+                o.append('<circle cx="%.1f" cy="%.1f" r="1.8" fill="#99b"/>' % (X(i), Y(v)))
     o.append('<polyline class="series" fill="none" stroke="#225" stroke-width="1.5" '
              'points="%s"/>' % " ".join("%.1f,%.1f" % (X(i), Y(p[1])) for i, p in
                                         enumerate(pts)))
@@ -656,8 +683,9 @@ table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;font-
 <body>
 <h1>mcfbench performance history</h1>
 <p>Store: %s. Each chart: one benchmark on one machine, commits in git order; dots are
-repetitions (median step after the first), the line their median; dashed lines mark detected
-steps (red: slower, green: faster).</p>
+repetitions (median step after the first; hollow orange: other work shared the machine), the
+line the commit medians (contended repetitions left out while any ran alone), in seconds; dashed
+lines mark detected steps (red: slower, green: faster).</p>
 <h2>Regressions</h2>
 <table id="regressions"><tr><th>machine</th><th>config</th><th>benchmark</th><th>first slow
 commit</th><th>change</th><th>confidence</th></tr>
@@ -680,6 +708,13 @@ commit</th><th>change</th><th>confidence</th></tr>
 
 
 def main(argv):
+    try:
+        return dispatch(argv)
+    except RunnerFailed as e:
+        fail(str(e))
+
+
+def dispatch(argv):
     ap = argparse.ArgumentParser(prog="history", description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
 
@@ -705,7 +740,8 @@ def main(argv):
                        "first run")
         p.add_argument("--force", action="store_true", help="rerun commits already stored")
 
-    p = sub.add_parser("run", help="run and store commits A..B (A included) or the last N")
+    p = sub.add_parser("run", help="run and store commits A..B (A included), one commit or the "
+                       "last N; a commit whose runner fails is skipped (exit 1 at the end)")
     p.add_argument("config")
     p.add_argument("range", nargs="?", default="")
     p.add_argument("--last", type=int, default=0)

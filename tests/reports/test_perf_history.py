@@ -62,6 +62,23 @@ def test_detector():
     check(not ph.detect_steps([1.0] * 20), "a constant series has no step")
 
 
+def test_contended_repetitions(work):
+    """A commit's median leaves out repetitions that shared the machine while one ran alone."""
+    folder = os.path.join(work, "contended")
+    os.makedirs(folder)
+    for r, (v, contended) in enumerate([(10.0, True), (1.0, False), (12.0, True)]):
+        with open(os.path.join(folder, "c%d.json" % r), "w") as f:
+            json.dump({"status": "ok", "environment": {"commit": "abc", "cpu": "X"},
+                       "cell": {"config_key": "k", "repetition": r, "assignment": {"a": 1}},
+                       "timing": {"step_median_seconds": v},
+                       "contention": {"contended": contended}}, f)
+    e = ph.store_result_set(os.path.join(work, "store_c"), "c", folder,
+                            {"commit": "abc", "date": "2026-01-01", "parents": []})
+    b = e["benchmarks"]["a=1"]
+    check(b["median"] == 1.0 and b["samples"] == [10.0, 1.0, 12.0] and
+          b["contended"] == [True, False, True], "contended repetitions are kept, not counted")
+
+
 def git(repo, *args):
     return subprocess.run(["git", "-C", repo] + list(args), check=True, capture_output=True,
                           text=True).stdout.strip()
@@ -133,6 +150,17 @@ def test_repository(work, mcfbench):
     tool(work, "run", config, commits[3] + ".." + commits[5], "--store", "store", *common,
          "--machine", os.listdir(os.path.join(work, "store"))[0])
     check(runs(work) == 0, "run A..B of stored commits runs nothing")
+    # A commit that does not run is skipped, the others stored: exit 1 naming it.
+    with open(os.path.join(work, "failing_runner.sh"), "w") as f:
+        f.write('[ "$MCFBENCH_HISTORY_COMMIT" = %s ] && exit 3\nexec %s "$@"\n' %
+                (commits[2], RUNNER))
+    r = tool(work, "run", config, commits[1] + ".." + commits[3], "--store", "store_gap",
+             "--repo", repo, "--runner", "bash " + os.path.join(work, "failing_runner.sh"),
+             expect=1)
+    runs(work)
+    gap = list(ph.load_store(os.path.join(work, "store_gap")).values())[0]
+    check([e["commit"] for e in gap] == [commits[1], commits[3]] and commits[2][:12] in r.stdout,
+          "a commit whose runner fails is skipped and named")
     series = ph.load_store(os.path.join(work, "store"))
     check(len(series) == 1, "one (machine, config) series")
     entries = list(series.values())[0]
@@ -197,6 +225,7 @@ def main():
         shutil.rmtree(work, ignore_errors=True)
         os.makedirs(work)
     try:
+        test_contended_repetitions(work)
         test_repository(work, a.mcfbench)
     finally:
         if not a.keep:
