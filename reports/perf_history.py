@@ -332,6 +332,36 @@ def find_entry(store, config_name, commit, machine):
 # ----------------------------------------------------------------------------- running
 
 
+def local_cpu():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown"
+
+
+def guess_machine(args):
+    """The machine folder of this session before anything ran: --machine, else the only folder
+    of the store holding this config whose CPU model and core count are this computer's (none
+    when there are several, e.g. runs at different thread counts)."""
+    if args.machine:
+        return args.machine
+    name, found = config_name_of(args.config), []
+    if os.path.isdir(args.store):
+        for mid in os.listdir(args.store):
+            path = os.path.join(args.store, mid, "machine.json")
+            if not (os.path.isfile(path) and os.path.isdir(os.path.join(args.store, mid, name))):
+                continue
+            with open(path) as f:
+                m = json.load(f)
+            if m.get("cpu") == local_cpu() and m.get("cores") == os.cpu_count():
+                found.append(mid)
+    return found[0] if len(found) == 1 else ""
+
+
 def config_name_of(config):
     return os.path.splitext(os.path.basename(config))[0]
 
@@ -415,8 +445,8 @@ def shlex_quote(s):
 
 def measure(args, commit, state, log):
     """The entry of `commit`: from the store when this machine already measured it, else run
-    and stored. `state['machine']` is the machine of this session, known after the first run
-    (or from --machine)."""
+    and stored. `state['machine']` is the machine of this session: guessed before the first
+    run (guess_machine), known after it."""
     name = config_name_of(args.config)
     e = find_entry(args.store, name, commit, state.get("machine"))
     if e is not None and not args.force:
@@ -444,7 +474,7 @@ def cmd_run(args):
         commits = [git(args.repo, "rev-parse", args.range + "^{commit}")]
     else:
         fail("run needs A..B, a commit or --last N")
-    state, log, failed = {"machine": args.machine}, [], []
+    state, log, failed = {"machine": guess_machine(args)}, [], []
     for c in commits:
         # A commit that does not build or run leaves a gap in the series, not an end to it.
         try:
@@ -483,7 +513,7 @@ def cmd_bisect(args):
     if not candidates:
         fail("%s..%s holds no commit" % (args.good, args.bad))
     good = git(args.repo, "rev-parse", args.good + "^{commit}")
-    state, log = {"machine": args.machine}, []
+    state, log = {"machine": guess_machine(args)}, []
     g = measure(args, good, state, log)
     names = [n for n, b in g["benchmarks"].items() if b["median"] and args.benchmark in n]
     if not names:
@@ -737,7 +767,7 @@ def dispatch(argv):
                        help="repetitions of each cell (default 5)")
         p.add_argument("--machine", default="",
                        help="machine folder of the store to reuse results from before the "
-                       "first run")
+                       "first run (default: the only one with this CPU and core count)")
         p.add_argument("--force", action="store_true", help="rerun commits already stored")
 
     p = sub.add_parser("run", help="run and store commits A..B (A included), one commit or the "

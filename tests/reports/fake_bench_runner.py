@@ -16,7 +16,11 @@ reps = int(os.environ.get("MCFBENCH_HISTORY_REPETITIONS", "1"))
 speed = float(open("speed.txt").read())
 with open(os.environ["FAKE_RUNNER_LOG"], "a") as f:
     f.write(commit + "\n")
-env = {"commit": commit[:12], "cpu": "Fake CPU 3000", "cores": 2, "threads": 2,
+# This computer's CPU model and core count, as mcfbench records them, so that the history finds
+# its machine folder before it runs anything.
+cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
+            if line.startswith("model name")), "unknown")
+env = {"commit": commit[:12], "cpu": cpu, "cores": os.cpu_count(), "threads": 2,
        "blas_threads": 2, "build": {"type": "Release", "compiler": "fake"}, "hostname": "h"}
 for cell, base in (("slowed", speed), ("steady", 1.0)):
     for r in range(reps):

@@ -141,8 +141,7 @@ def test_repository(work, mcfbench):
     # A second bisect over the same store runs nothing it has measured before.
     tool(work, "bisect", config, "--good", commits[0], "--bad", commits[-1], "--store",
          "store_bisect", "--repetitions", "3", *common)
-    check(runs(work) == 1, "a repeated bisect only reruns the good end (its machine unknown "
-          "before the first run)")
+    check(runs(work) == 0, "a repeated bisect runs nothing (the store's machine of this CPU)")
 
     # Run the last 16 commits into a store; entries carry date and parents.
     tool(work, "run", config, "--last", "16", "--store", "store", "--repetitions", "3", *common)
@@ -150,6 +149,8 @@ def test_repository(work, mcfbench):
     tool(work, "run", config, commits[3] + ".." + commits[5], "--store", "store", *common,
          "--machine", os.listdir(os.path.join(work, "store"))[0])
     check(runs(work) == 0, "run A..B of stored commits runs nothing")
+    tool(work, "run", config, "--last", "3", "--store", "store", *common)
+    check(runs(work) == 0, "nor does run --last N without --machine")
     # A commit that does not run is skipped, the others stored: exit 1 naming it.
     with open(os.path.join(work, "failing_runner.sh"), "w") as f:
         f.write('[ "$MCFBENCH_HISTORY_COMMIT" = %s ] && exit 3\nexec %s "$@"\n' %
