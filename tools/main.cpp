@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   mcf::add_collect_command(app, run);
   mcf::add_compare_command(app, run);
   mcf::add_distance_command(app, run);
+  mcf::add_history_command(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
