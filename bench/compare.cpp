@@ -164,6 +164,10 @@ int add_repetition(const json& r, const std::string& metric, ResultSet& set) {
     c.mixed_identity = true;
   for (const char* kind : kAccuracyKinds)
     if (const double e = accuracy_of(r, kind); std::isfinite(e)) c.errors[kind].push_back(e);
+  if (const json* k = json_at_path(r, "contention.contended"); k && k->is_boolean()) {
+    ++set.contention_recorded;
+    set.contended += k->get<bool>() ? 1 : 0;
+  }
   const json* run = json_at_path(r, "run_seconds");
   const json* steal = json_at_path(r, "steal_seconds");
   if (run && steal && run->is_number() && steal->is_number()) {
@@ -358,6 +362,16 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
     md << "Hypervisor steal (CPU time the host gave other guests, all vCPUs) per cell run time: "
           "OLD "
        << share(old_set) << ", NEW " << share(new_set) << ".\n\n";
+  }
+  if (old_set.contention_recorded > 0 || new_set.contention_recorded > 0) {
+    // A verdict on sets that shared the machine may be the machine's: said, not overridden.
+    const auto share = [](const ResultSet& s) {
+      return s.contention_recorded > 0
+                 ? std::to_string(s.contended) + " of " + std::to_string(s.contention_recorded)
+                 : std::string("–");
+    };
+    md << "Repetitions that shared the machine with other work (contended): OLD " << share(old_set)
+       << ", NEW " << share(new_set) << ".\n\n";
   }
   int changed = 0;
   std::ostringstream table;

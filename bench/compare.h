@@ -40,6 +40,9 @@ struct ResultSet {
   /// Sums over the cells that record both (`run_seconds`, `steal_seconds`): the share of their
   /// run time that the hypervisor gave to other guests, to tell a noisy machine from slower code.
   double run_seconds = 0, steal_seconds = 0;
+  /// Repetitions that record `contention`, and of those the ones that shared the machine with
+  /// other work (`contention.contended`): their timings measure the machine as well as the code.
+  int contention_recorded = 0, contended = 0;
 };
 
 /// Reads DIR[@COMMIT]: every cell result (*.json with a "cell" object) in DIR, keeping only

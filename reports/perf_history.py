@@ -570,6 +570,8 @@ def series_steps(entries, threshold, alpha, min_run):
         for s in steps:
             s["commit"] = pts[s["index"]][0]["commit"]
             s["previous"] = pts[s["index"] - 1][0]["commit"]
+            # Commits between the two were not measured: the step lies somewhere in between.
+            s["adjacent"] = s["previous"] in pts[s["index"]][0].get("parents", [])
             s["subject"] = pts[s["index"]][0].get("subject", "")
         out[n] = (pts, steps)
     return out
@@ -600,6 +602,12 @@ def cmd_detect(args):
             s["machine"], s["config"], s["benchmark"], s["commit"][:12], s["previous"][:12],
             s["before"], s["after"], s["ratio"], " **slower**" if s["ratio"] > 1 else "",
             s["confidence"]))
+    for s in steps:
+        if not s["adjacent"] and s["ratio"] > 1:
+            print("\n%s: commits between %s and %s were not measured; to name the first slow "
+                  "one:\n  scripts/history.sh bisect CONFIG --good %s --bad %s --store %s" % (
+                      s["benchmark"], s["previous"][:12], s["commit"][:12], s["previous"][:12],
+                      s["commit"][:12], args.store))
     return 1 if args.fail_on_regression and any(s["ratio"] > 1 for s in steps) else 0
 
 

@@ -337,6 +337,13 @@ TEST(CompareCli, SamplesAreRepetitionsNotSteps) {
   c = mcfbench("compare old summary_slow", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(c.out.find("**slower**"), std::string::npos) << c.out;
+  // Contended repetitions are counted per set (the line is left out when neither records it).
+  EXPECT_EQ(c.out.find("contended"), std::string::npos) << c.out;
+  copy_set(dir / "old", dir / "busy", "eeee", [](json& r, int rep) {
+    r["contention"] = {{"contended", rep < 2}};
+  });
+  c = mcfbench("compare old busy", dir);
+  EXPECT_NE(c.out.find("(contended): OLD –, NEW 6 of 15."), std::string::npos) << c.out;
 }
 
 TEST(CompareCli, RefusesDifferentMachinesThreadsOrBuilds) {

@@ -7,7 +7,8 @@
   stand-in runner (tests/reports/fake_bench_runner.py) instead of building mcfbench:
   `bisect` names the planted commit within log2(16) + 1 = 5 runs, `run --last 16` stores one
   entry per commit in git order (also when stored out of order), `detect` reports the step at
-  the planted commit and nowhere else, `publish` lists it in its regressions, and `ab` with
+  the planted commit and nowhere else (with every other commit stored, it points `bisect` at the
+  gap, which then runs one commit), `publish` lists it in its regressions, and `ab` with
   `mcfbench compare` (given with --mcfbench) fails on the slowdown and passes without one.
 
 usage: test_perf_history.py [--mcfbench BIN] [--keep DIR]
@@ -186,6 +187,20 @@ def test_repository(work, mcfbench):
                                                                      s["confidence"]))
     tool(work, "detect", "--store", "store", "--fail-on-regression", expect=1)
 
+    # Every other commit measured: the step lies between two measured commits, detect says how
+    # to bisect it, and the bisect that reuses the store runs the one commit in between.
+    for c in commits[::2]:
+        tool(work, "run", config, c, "--store", "store_sparse", "--repetitions", "3", *common)
+    runs(work)
+    # 5 commits before the step and 3 after: the U test's p is 0.037 at best, so alpha 0.05.
+    r = tool(work, "detect", "--store", "store_sparse", "--alpha", "0.05")
+    hint = "--good %s --bad %s" % (commits[PLANTED - 1][:12], commits[PLANTED + 1][:12])
+    check(hint in r.stdout, "detect suggests bisecting between the measured neighbours")
+    r = tool(work, "bisect", config, "--good", commits[PLANTED - 1][:12], "--bad",
+             commits[PLANTED + 1][:12], "--store", "store_sparse", "--repetitions", "3", *common)
+    check(runs(work) == 1 and commits[PLANTED] in r.stdout,
+          "that bisect runs one commit and names the planted one")
+
     tool(work, "publish", os.path.join(work, "site"), "--store", "store")
     page = open(os.path.join(work, "site", "index.html")).read()
     check(page.count('<svg class="chart"') == 2, "the page has one chart per benchmark")
@@ -220,6 +235,7 @@ def main():
     ap.add_argument("--mcfbench", default="")
     ap.add_argument("--keep", default="")
     a = ap.parse_args()
+    a.mcfbench = os.path.abspath(a.mcfbench) if a.mcfbench else ""
     test_detector()
     work = a.keep or tempfile.mkdtemp(prefix="test_perf_history-")
     if a.keep:
