@@ -21,14 +21,14 @@ void add_history_command(CLI::App& app, std::function<int()>& run) {
       "mcfbench history publish OUT                              OUT/index.html, offline\n"
       "Options (see `mcfbench history COMMAND --help`): --store, --repo, --runner, --repetitions, "
       "--machine,\n"
-      "--force, --last, --threshold, --alpha, --min-run, --json, --fail-on-regression, "
+      "--force, --last, --good, --bad, --threshold, --alpha, --min-run, --json, "
+      "--fail-on-regression, "
       "--benchmark,\n"
       "--rounds, --out, --compare, --name. docs/benchmarks.md#history explains them.");
   // Everything after `history` (its subcommand, flags, --help) is the tool's to parse.
   cmd->prefix_command();
-  cmd->callback([cmd, &run] {
-    run = [cmd]() -> int { return run_history_tool(cmd->remaining()); };
-  });
+  cmd->callback(
+      [cmd, &run] { run = [cmd]() -> int { return run_history_tool(cmd->remaining()); }; });
 }
 
 }  // namespace mcf
