@@ -19,8 +19,8 @@ int main(int argc, char** argv) {
   mcf::add_expand_command(app, run);
   mcf::add_collect_command(app, run);
   mcf::add_compare_command(app, run);
-  mcf::add_distance_command(app, run);
   mcf::add_history_command(app, run);
+  mcf::add_distance_command(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
