@@ -4,7 +4,7 @@ step detection, bisection and a static dashboard.
 
 usage: /usr/bin/python3 reports/perf_history.py COMMAND ...   (scripts/history.sh wraps it)
 
-  run CONFIG (A..B | --last N)   build and run the commits, store each result set
+  run CONFIG (A..B|C|--last N)   build and run the commits, store each result set
   add CONFIG RESULTS_DIR         store a result set measured elsewhere (`mcfbench run` output)
   detect                         step changes per (benchmark, machine) series
   bisect CONFIG --good A --bad B the first commit of A..B that is slower than A
@@ -121,7 +121,7 @@ def l1_partition(x, penalty):
     return sorted(cps)
 
 
-def detect_steps(values, samples=None, threshold=0.1, alpha=0.01, min_run=2):
+def detect_steps(values, threshold=0.1, alpha=0.01, min_run=2):
     """Steps of a series of per-commit medians `values` (in git order).
 
     A candidate from the L1 fit of log(values) is kept when the levels on either side differ
@@ -130,8 +130,7 @@ def detect_steps(values, samples=None, threshold=0.1, alpha=0.01, min_run=2):
     dropped and the others re-tested until all pass. Commit medians, not the repetitions, are
     the test's samples: repetitions of one commit ran back to back and share a noisy spell.
     Returns [{index, before, after, ratio, p, confidence}] with `index` the first commit of
-    the new level. `samples` is accepted for symmetry and not used by the decision."""
-    del samples
+    the new level."""
     x = [math.log(v) for v in values if v > 0]
     if len(x) != len(values) or len(x) < 2 * min_run:
         return []
@@ -295,9 +294,9 @@ def load_store(store):
 
 
 def git_order(entries):
-    """Topological order of the entries by their recorded parents (a parent before its child,
-    also through commits not stored, followed by their own stored ancestry only when stored),
-    ties broken by commit date."""
+    """Topological order of the entries by their recorded parents: a stored parent comes before
+    its child; between entries not linked so (the commits between them were not stored), the
+    commit date decides."""
     by = {e["commit"]: e for e in entries}
     children = {c: [] for c in by}
     indeg = {c: 0 for c in by}
