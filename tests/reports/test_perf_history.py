@@ -80,9 +80,14 @@ def test_contended_repetitions(work):
           b["contended"] == [True, False, True], "contended repetitions are kept, not counted")
 
 
+# The scratch repository ignores the user's and the system's git configuration (signing,
+# hooks, default branch), so its commits are the same everywhere.
+GIT_ENV = dict(os.environ, GIT_CONFIG_GLOBAL=os.devnull, GIT_CONFIG_NOSYSTEM="1")
+
+
 def git(repo, *args):
     return subprocess.run(["git", "-C", repo] + list(args), check=True, capture_output=True,
-                          text=True).stdout.strip()
+                          text=True, env=GIT_ENV).stdout.strip()
 
 
 def scratch_repo(path):
@@ -96,7 +101,7 @@ def scratch_repo(path):
         with open(os.path.join(path, "notes.txt"), "a") as f:
             f.write("change %d\n" % i)
         git(path, "add", "-A")
-        env = dict(os.environ, GIT_AUTHOR_DATE="2026-01-%02dT12:00:00Z" % (i + 1),
+        env = dict(GIT_ENV, GIT_AUTHOR_DATE="2026-01-%02dT12:00:00Z" % (i + 1),
                    GIT_COMMITTER_DATE="2026-01-%02dT12:00:00Z" % (i + 1),
                    GIT_AUTHOR_NAME="t", GIT_AUTHOR_EMAIL="t@t", GIT_COMMITTER_NAME="t",
                    GIT_COMMITTER_EMAIL="t@t")
