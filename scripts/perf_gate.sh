@@ -11,7 +11,7 @@
 # the git repository of the current folder ($MCFBENCH_GATE_REPO overrides).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 1 ] || { sed -n '2,13p' "$0" >&2; exit 2; }
+[ $# -ge 1 ] || { sed -n '2,11p' "$0" >&2; exit 2; }
 config=$1
 repo=${MCFBENCH_GATE_REPO:-$(git rev-parse --show-toplevel 2>/dev/null || echo "$root")}
 head=${3:-HEAD}
