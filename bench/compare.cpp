@@ -14,10 +14,46 @@
 #include <stdexcept>
 
 namespace mcf {
+
+using nlohmann::json;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  const size_t n = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + long(n), v.end());
+  if (v.size() % 2) return v[n];
+  const double hi = v[n];
+  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + long(n)));
+}
+
+json machine_identity(const json& result) {
+  json id = json::object();
+  if (!result.is_object() || !result.contains("environment") || !result["environment"].is_object())
+    return id;
+  const json& env = result["environment"];
+  for (const char* k : {"cpu", "cores", "threads", "blas_threads", "build", "libraries"})
+    if (env.contains(k)) id[k] = env[k];
+  return id;
+}
+
+std::string identity_difference(const json& a, const json& b) {
+  for (auto it = a.begin(); it != a.end(); ++it)
+    if (b.contains(it.key()) && b[it.key()] != *it)
+      return it.key() + ": " + it->dump() + " vs " + b[it.key()].dump();
+  return "";
+}
+
+double smallest_mann_whitney_p(int n1, int n2) {
+  if (n1 <= 0 || n2 <= 0) return 1.0;
+  std::vector<double> a, b;
+  for (int i = 0; i < n1; ++i) a.push_back(i);
+  for (int i = 0; i < n2; ++i) b.push_back(n1 + i);
+  return mann_whitney_p(a, b);
+}
+
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
 std::string label_of(const json& assignment, const std::string& key) {
   if (!assignment.is_object() || assignment.empty()) return key;
@@ -84,6 +120,24 @@ std::vector<json> read_cell_results(const std::string& dir, const std::string& c
   return results;
 }
 
+/// One repetition's sample of `metric` (NaN when it has none): the median over steps 2..N, so
+/// that step 1's first-touch costs (page faults, the first factorization) do not count, and one
+/// number per run, so that a cell's samples vary as whole runs do.
+double repetition_sample(const json& r, const std::string& metric) {
+  if (metric == "seconds.total") {
+    const json* t = json_at_path(r, "timing.step_median_seconds");
+    if (t && t->is_number()) return t->get<double>();
+  }
+  if (!r.contains("steps") || !r["steps"].is_array()) return NAN;
+  std::vector<double> values;
+  for (const auto& s : r["steps"]) {
+    const json* v = json_at_path(s, metric);
+    if (v && v->is_number()) values.push_back(v->get<double>());
+  }
+  if (values.size() > 1) values.erase(values.begin());
+  return values.empty() ? NAN : median(values);
+}
+
 /// Adds one repetition's result to its cell's samples; returns its number of steps.
 int add_repetition(const json& r, const std::string& metric, ResultSet& set) {
   const json& cell = r["cell"];
@@ -102,13 +156,18 @@ int add_repetition(const json& r, const std::string& metric, ResultSet& set) {
   }
   const int steps = r.contains("steps") && r["steps"].is_array() ? int(r["steps"].size()) : 0;
   c.min_steps = c.min_steps < 0 ? steps : std::min(c.min_steps, steps);
-  if (r.contains("steps"))
-    for (const auto& s : r["steps"]) {
-      const json* v = json_at_path(s, metric);
-      if (v && v->is_number()) c.values.push_back(v->get<double>());
-    }
+  if (const double v = repetition_sample(r, metric); std::isfinite(v)) c.values.push_back(v);
+  const json identity = machine_identity(r);
+  if (c.repetitions == 1)
+    c.identity = identity;
+  else if (!identity_difference(c.identity, identity).empty())
+    c.mixed_identity = true;
   for (const char* kind : kAccuracyKinds)
     if (const double e = accuracy_of(r, kind); std::isfinite(e)) c.errors[kind].push_back(e);
+  if (const json* k = json_at_path(r, "contention.contended"); k && k->is_boolean()) {
+    ++set.contention_recorded;
+    set.contended += k->get<bool>() ? 1 : 0;
+  }
   const json* run = json_at_path(r, "run_seconds");
   const json* steal = json_at_path(r, "steal_seconds");
   if (run && steal && run->is_number() && steal->is_number()) {
@@ -119,15 +178,6 @@ int add_repetition(const json& r, const std::string& metric, ResultSet& set) {
 }
 
 }  // namespace
-
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  const size_t n = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + long(n), v.end());
-  if (v.size() % 2) return v[n];
-  const double hi = v[n];
-  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + long(n)));
-}
 
 double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b) {
   const double n1 = double(a.size()), n2 = double(b.size());
@@ -210,6 +260,22 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
       continue;
     }
     const CellSamples& old = it->second;
+    // Timings of different machines, thread counts or builds differ for reasons other than the
+    // code; so do the repetitions of one cell taken on different machines.
+    for (const CellSamples* s : {&old, &n})
+      if (s->mixed_identity && !o.allow_cross_machine)
+        throw std::runtime_error("cell `" + n.label + "`: its repetitions in " +
+                                 (s == &old ? old_set.dir : new_set.dir) +
+                                 " ran on different machines, thread counts or builds "
+                                 "(--allow-cross-machine compares them anyway)");
+    if (const std::string d = identity_difference(old.identity, n.identity); !d.empty()) {
+      if (!o.allow_cross_machine)
+        throw std::runtime_error("cell `" + n.label + "` ran on different machines, thread " +
+                                 "counts or builds in OLD and NEW (" + d +
+                                 "); timings across machines do not measure the code "
+                                 "(--allow-cross-machine compares them anyway)");
+      rep.cross_machine.push_back(n.label + ": " + d);
+    }
     CellComparison c;
     c.key = key;
     c.label = n.label;
@@ -219,6 +285,7 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
     c.new_median = median(n.values);
     c.ratio = c.old_median > 0 ? c.new_median / c.old_median : NAN;
     c.p_value = mann_whitney_p(old.values, n.values);
+    c.untestable = smallest_mann_whitney_p(c.n_old, c.n_new) >= o.alpha;
     c.slower = std::isfinite(c.ratio) && c.ratio > 1 + o.threshold && c.p_value < o.alpha;
     c.faster = std::isfinite(c.ratio) && c.ratio < 1 / (1 + o.threshold) && c.p_value < o.alpha;
     c.failed = (n.failed > 0 && old.failed == 0) || (n.errored > 0 && old.errored == 0);
@@ -269,9 +336,22 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
   std::ostringstream md;
   md << "## compare " << old_set.dir << " (" << old_set.commit << ") → " << new_set.dir << " ("
      << new_set.commit << ")\n\n";
-  md << "Metric `" << o.metric << "` per step (median over steps and repetitions); Mann–Whitney U, "
-     << "slower/faster when the ratio passes 1±" << o.threshold << " with p < " << o.alpha
+  md << "Metric `" << o.metric
+     << "`: one sample per repetition (its median step after the first), median over "
+     << "repetitions; Mann–Whitney U over the repetitions, slower/faster when the ratio passes 1±"
+     << o.threshold << " with p < " << o.alpha
      << "; accuracy = final reference distance or radial error (RMS).\n\n";
+  int untestable = 0;
+  for (const auto& c : r.cells) untestable += c.untestable ? 1 : 0;
+  if (untestable)
+    md << untestable << " cells have too few repetitions for the U test to reach p < " << o.alpha
+       << " (at least 4 a side are needed, 5 or more recommended): their timings cannot be "
+          "called slower or faster (marked `untested`).\n\n";
+  if (!r.cross_machine.empty()) {
+    md << "**Cross-machine comparison** (--allow-cross-machine): " << r.cross_machine.size()
+       << " cells ran on different machines, thread counts or builds, e.g. "
+       << r.cross_machine.front() << ".\n\n";
+  }
   if (old_set.run_seconds > 0 || new_set.run_seconds > 0) {
     // Stolen time is CPU time of all vCPUs, run time is wall time: on a 2-vCPU guest the share
     // can reach 200%. A slower NEW with a much larger share may be the machine, not the code.
@@ -283,6 +363,16 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
           "OLD "
        << share(old_set) << ", NEW " << share(new_set) << ".\n\n";
   }
+  if (old_set.contention_recorded > 0 || new_set.contention_recorded > 0) {
+    // A verdict on sets that shared the machine may be the machine's: said, not overridden.
+    const auto share = [](const ResultSet& s) {
+      return s.contention_recorded > 0
+                 ? std::to_string(s.contended) + " of " + std::to_string(s.contention_recorded)
+                 : std::string("–");
+    };
+    md << "Repetitions that shared the machine with other work (contended): OLD " << share(old_set)
+       << ", NEW " << share(new_set) << ".\n\n";
+  }
   int changed = 0;
   std::ostringstream table;
   table << "| cell | old | new | new/old | p | old error | new error | error ratio | verdict |\n"
@@ -291,6 +381,9 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
     std::string verdict;
     if (c.slower) verdict += "**slower** ";
     if (c.faster) verdict += "faster ";
+    if (c.untestable && std::isfinite(c.ratio) &&
+        (c.ratio > 1 + o.threshold || c.ratio < 1 / (1 + o.threshold)))
+      verdict += "untested ";
     if (c.less_accurate) verdict += "**less accurate** ";
     if (c.has_error && c.error_ratio < 1 / (1 + o.threshold)) verdict += "more accurate ";
     if (c.failed) verdict += "**failed** (" + c.failure + ") ";
@@ -327,9 +420,11 @@ json history_entry(const ResultSet& set, const std::string& metric) {
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   json cells = json::object();
   for (const auto& [key, c] : set.cells)
-    cells[key] = {{"label", c.label}, {"median", median(c.values)}};
-  return {{"commit", set.commit}, {"date", date},     {"study", set.study},
-          {"dir", set.dir},       {"metric", metric}, {"cells", cells}};
+    cells[key] = {
+        {"label", c.label}, {"median", median(c.values)}, {"repetitions", c.values.size()}};
+  const json machine = set.cells.empty() ? json::object() : set.cells.begin()->second.identity;
+  return {{"commit", set.commit}, {"date", date},       {"study", set.study}, {"dir", set.dir},
+          {"metric", metric},     {"machine", machine}, {"cells", cells}};
 }
 
 int compare_and_record(const CompareRequest& request) {

@@ -1,7 +1,10 @@
 #pragma once
 // `mcfbench compare OLD NEW`: cell-by-cell performance and accuracy comparison of two result
 // sets (e.g. two commits), for regression tracking. Cells are matched by their config key
-// (config + input mesh, without code version or repetition, which are pooled).
+// (config + input mesh, without code version or repetition). A cell's samples are its
+// repetitions, one number each (the median step after the first), so the U test measures how
+// much whole runs vary, not how much steps of one run do; two sets are compared only when they
+// come from the same kind of machine, thread counts and build.
 
 #include <nlohmann/json.hpp>
 
@@ -12,8 +15,15 @@
 namespace mcf {
 
 struct CellSamples {
-  std::string label;           ///< "basis=hat solver.name=cholmod" (the assignment)
-  std::vector<double> values;  ///< the metric per step, all repetitions pooled
+  std::string label;  ///< "basis=hat solver.name=cholmod" (the assignment)
+  /// One sample per repetition that has one: for `seconds.total` the cell's
+  /// `timing.step_median_seconds` where recorded, else the median of the metric over steps 2..N
+  /// (step 1 alone when it is the only step).
+  std::vector<double> values;
+  /// What the timings depend on besides the code (`machine_identity`), from the first
+  /// repetition; `mixed_identity` when a later repetition's differs.
+  nlohmann::json identity = nlohmann::json::object();
+  bool mixed_identity = false;
   /// Accuracy per repetition by measure: "reference_distance" (the final distance to the
   /// reference flow, RMS) and "radial_error" (the last step's radial RMS), where recorded.
   std::map<std::string, std::vector<double>> errors;
@@ -30,6 +40,9 @@ struct ResultSet {
   /// Sums over the cells that record both (`run_seconds`, `steal_seconds`): the share of their
   /// run time that the hypervisor gave to other guests, to tell a noisy machine from slower code.
   double run_seconds = 0, steal_seconds = 0;
+  /// Repetitions that record `contention`, and of those the ones that shared the machine with
+  /// other work (`contention.contended`): their timings measure the machine as well as the code.
+  int contention_recorded = 0, contended = 0;
 };
 
 /// Reads DIR[@COMMIT]: every cell result (*.json with a "cell" object) in DIR, keeping only
@@ -43,7 +56,23 @@ struct CompareOptions {
   double threshold = 0.1, alpha = 0.05;
   std::string metric = "seconds.total";
   bool show_all = false;  ///< table lists unchanged cells too
+  /// Compare cells whose machine, threads or build differ (listed in the report) instead of
+  /// refusing to.
+  bool allow_cross_machine = false;
 };
+
+/// The fields of a result's `environment` that its timings depend on besides the code: `cpu`,
+/// `cores`, `threads`, `blas_threads`, `build` and `libraries` (not the host name: identical
+/// machines of a CI pool have different names). Absent fields are left out.
+nlohmann::json machine_identity(const nlohmann::json& result);
+
+/// The first field that two identities both have and disagree on, as "threads: 2 vs 1"; empty
+/// when they agree on every field they share.
+std::string identity_difference(const nlohmann::json& a, const nlohmann::json& b);
+
+/// The smallest two-sided p-value the U test can give with n1 and n2 samples (all of one sample
+/// below all of the other): when it is not below alpha, no difference can be significant.
+double smallest_mann_whitney_p(int n1, int n2);
 
 struct CellComparison {
   std::string key, label;
@@ -52,6 +81,9 @@ struct CellComparison {
   bool has_error = false;
   double old_error = 0, new_error = 0, error_ratio = 1;
   bool slower = false, faster = false, less_accurate = false;
+  /// Too few repetitions on one side for the U test to ever reach alpha: the ratio is shown
+  /// but cannot make the cell slower or faster.
+  bool untestable = false;
   /// NEW failed (status not "ok") where OLD never did, or errored where OLD at worst stopped as
   /// singular, or stopped earlier than OLD's fewest steps: a regression whatever the timings say
   /// (a cell that errors has no timings at all).
@@ -70,13 +102,18 @@ struct CompareReport {
   std::vector<std::string> only_old, only_new;  ///< labels of unmatched cells
   /// Slower, less accurate, failed, stopped earlier, or a cell of OLD missing from NEW.
   bool regression = false;
+  /// With allow_cross_machine: the matched cells whose identities differ ("label: difference").
+  std::vector<std::string> cross_machine;
 };
 
+/// Throws (naming the cell and the field) when a matched cell's identity differs between the
+/// sets, or within one set, unless o.allow_cross_machine.
 CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set,
                               const CompareOptions& o);
 std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
                              const ResultSet& new_set, const CompareOptions& o);
-/// One line for the history file: {commit, date, study, dir, metric, cells: {key: median}}.
+/// One line for the history file: {commit, date, study, dir, metric, machine (the first cell's
+/// identity), cells: {key: {label, median, repetitions}}}.
 nlohmann::json history_entry(const ResultSet& set, const std::string& metric);
 
 struct CompareRequest {

@@ -18,5 +18,6 @@ void add_expand_command(CLI::App& app, std::function<int()>& run);
 void add_collect_command(CLI::App& app, std::function<int()>& run);
 void add_compare_command(CLI::App& app, std::function<int()>& run);
 void add_distance_command(CLI::App& app, std::function<int()>& run);
+void add_history_command(CLI::App& app, std::function<int()>& run);
 
 }  // namespace mcf

@@ -1,6 +1,7 @@
 // `mcfbench compare OLD NEW`: the flags of the regression check between two result sets
-// (bench/compare.h: exit 1 when a cell got significantly slower or less accurate), optionally
-// appended to a history file.
+// (bench/compare.h: exit 1 when a cell got significantly slower or less accurate; sets of
+// different machines refused unless --allow-cross-machine), optionally appended to a history
+// file.
 
 #include "bench/compare.h"
 #include "tools/commands.h"
@@ -16,7 +17,8 @@ void add_compare_command(CLI::App& app, std::function<int()>& run) {
       "Compare two result sets cell by cell (speed and accuracy); exit 1 on a regression.");
   cmd->footer(
       "OLD and NEW are result folders, optionally DIR@COMMIT to pick one commit's results from a "
-      "shared folder.");
+      "shared folder.\nEach repetition of a cell is one sample (its median step after the "
+      "first); the U test needs at least 4 repetitions a side.");
   cmd->add_option("old", a->old_dir, "Baseline results folder[@commit]")->required();
   cmd->add_option("new", a->new_dir, "New results folder[@commit]")->required();
   cmd->add_option("--threshold", a->options.threshold,
@@ -29,6 +31,9 @@ void add_compare_command(CLI::App& app, std::function<int()>& run) {
                   "Per-step value compared (dotted path in steps[]; default seconds.total; e.g. "
                   "seconds.solve)");
   cmd->add_flag("--all", a->options.show_all, "List unchanged cells in the table too");
+  cmd->add_flag("--allow-cross-machine", a->options.allow_cross_machine,
+                "Compare cells that ran on different machines, thread counts or builds (refused "
+                "otherwise)");
   cmd->add_option("--history", a->history,
                   "Append one JSON line for NEW to this file (no value: results/history.jsonl)")
       ->expected(0, 1);

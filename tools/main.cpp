@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   mcf::add_expand_command(app, run);
   mcf::add_collect_command(app, run);
   mcf::add_compare_command(app, run);
+  mcf::add_history_command(app, run);
   mcf::add_distance_command(app, run);
   // The first word that is not an option names the subcommand (the app itself takes no option
   // with a value). CLI11 would answer an unknown one with "A subcommand is required", and with

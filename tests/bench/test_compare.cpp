@@ -1,6 +1,7 @@
 // Regression comparison: the Mann–Whitney test, a 2x slowdown flagged (synthetic and on a real
 // run's copy), a set compared with itself or with tiny noise stays quiet, accuracy losses are
-// flagged, history lines are appended.
+// flagged, history lines are appended; samples are per-repetition medians of steps 2..N, and
+// sets of different machines, threads or builds are refused.
 
 #include "bench/compare.h"
 
@@ -32,7 +33,9 @@ TEST(Compare, MannWhitney) {
   EXPECT_DOUBLE_EQ(median({4, 1, 3, 2}), 2.5);
 }
 
-/// A synthetic result set: 3 cells, 2 repetitions, 15 steps each; per-step seconds scaled by
+constexpr int kReps = 5;  // the fewest a side at which the U test can reach p < 0.05 is 4
+
+/// A synthetic result set: 3 cells, kReps repetitions, 15 steps each; per-step seconds scaled by
 /// `slow` with multiplicative noise of +-noise; final radial error scaled by `error`.
 /// With `steal` >= 0 each cell also records run_seconds 1 and steal_seconds `steal`.
 void make_set(const fs::path& dir, const std::string& commit, double slow, double noise,
@@ -41,7 +44,7 @@ void make_set(const fs::path& dir, const std::string& commit, double slow, doubl
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(1 - noise, 1 + noise);
   for (int cell = 0; cell < 3; ++cell)
-    for (int rep = 0; rep < 2; ++rep) {
+    for (int rep = 0; rep < kReps; ++rep) {
       json steps = json::array();
       for (int s = 1; s <= 15; ++s)
         steps.push_back(
@@ -55,7 +58,7 @@ void make_set(const fs::path& dir, const std::string& commit, double slow, doubl
                 {"cell",
                  {{"key", key + "r" + std::to_string(rep)},
                   {"config_key", key},
-                  {"index", cell * 2 + rep},
+                  {"index", cell * kReps + rep},
                   {"repetition", rep},
                   {"study", "synthetic"},
                   {"assignment", {{"solver.name", "solver" + std::to_string(cell)}}}}},
@@ -203,8 +206,8 @@ TEST(CompareCli, FailedStoppedOrMissingCellsAndAnUnknownMetricAreNotPasses) {
   // A cell missing from NEW.
   variant(
       "missing", [](json&) {}, "");
-  fs::remove(dir / "missing" / "aaaa20.json");
-  fs::remove(dir / "missing" / "aaaa21.json");
+  for (int rep = 0; rep < kReps; ++rep)
+    fs::remove(dir / "missing" / ("aaaa2" + std::to_string(rep) + ".json"));
   c = mcfbench("compare old missing", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(
@@ -262,7 +265,7 @@ TEST(CompareCli, InjectedSlowdownOnARealRun) {
   const fs::path dir = fresh_dir("compare_real");
   write_text(
       dir / "c.json",
-      R"({"name": "c", "defaults": {"mesh": "icosphere:level=3", "steps": 30, "dt": 1e-4, "threads": 1}})");
+      R"({"name": "c", "repetitions": 4, "defaults": {"mesh": "icosphere:level=3", "steps": 10, "dt": 1e-4, "threads": 1}})");
   Command c = mcfbench("run c.json --out old", dir);
   ASSERT_EQ(c.status, 0) << c.err;
   fs::create_directories(dir / "new");
@@ -270,6 +273,7 @@ TEST(CompareCli, InjectedSlowdownOnARealRun) {
     json r = read_json(f);
     for (auto& s : r["steps"])
       for (auto& [k, v] : s["seconds"].items()) v = v.get<double>() * 2;
+    r["timing"]["step_median_seconds"] = r["timing"]["step_median_seconds"].get<double>() * 2;
     std::ofstream(dir / "new" / f.filename()) << r.dump();
   }
   c = mcfbench("compare old new", dir);
@@ -279,6 +283,115 @@ TEST(CompareCli, InjectedSlowdownOnARealRun) {
   EXPECT_EQ(c.status, 0) << c.out << c.err;
   c = mcfbench("compare old new --metric radial_error.rms", dir);  // same accuracy, other metric
   EXPECT_EQ(c.status, 0) << c.out << c.err;
+}
+
+TEST(Compare, SmallestPValueSaysHowManyRepetitionsTheTestNeeds) {
+  EXPECT_GE(smallest_mann_whitney_p(3, 3), 0.05);
+  EXPECT_LT(smallest_mann_whitney_p(4, 4), 0.05);
+  EXPECT_LT(smallest_mann_whitney_p(5, 5), 0.05);
+  EXPECT_DOUBLE_EQ(smallest_mann_whitney_p(0, 5), 1.0);
+}
+
+/// A copy of `from` under `to` with commit `commit`, each result passed through `edit`.
+void copy_set(const fs::path& from, const fs::path& to, const std::string& commit,
+              const std::function<void(json&, int rep)>& edit) {
+  fs::create_directories(to);
+  for (const auto& f : result_files(from)) {
+    json r = read_json(f);
+    r["environment"]["commit"] = commit;
+    edit(r, r["cell"]["repetition"].get<int>());
+    std::ofstream(to / f.filename()) << r.dump();
+  }
+}
+
+TEST(CompareCli, SamplesAreRepetitionsNotSteps) {
+  // A slow first step (set-up, first touch) does not count; one repetition is one sample, so a
+  // set of 2 repetitions cannot be called slower however many steps it has; the recorded
+  // timing.step_median_seconds is the sample where present.
+  const fs::path dir = fresh_dir("compare_reps");
+  make_set(dir / "old", "aaaa", 1.0, 0.03, 1.0, 1);
+  copy_set(dir / "old", dir / "first_slow", "bbbb",
+           [](json& r, int) { r["steps"][0]["seconds"]["total"] = 100.0; });
+  Command c = mcfbench("compare old first_slow", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("3 cells compared, 0 changed"), std::string::npos) << c.out;
+  // Two repetitions a side, twice as slow: listed as untested, not a regression.
+  fs::create_directories(dir / "old2");
+  fs::create_directories(dir / "slow2");
+  for (const auto& f : result_files(dir / "old")) {
+    json r = read_json(f);
+    if (r["cell"]["repetition"].get<int>() >= 2) continue;
+    std::ofstream(dir / "old2" / f.filename()) << r.dump();
+    r["environment"]["commit"] = "cccc";
+    for (auto& s : r["steps"]) s["seconds"]["total"] = s["seconds"]["total"].get<double>() * 2;
+    std::ofstream(dir / "slow2" / f.filename()) << r.dump();
+  }
+  c = mcfbench("compare old2 slow2", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("untested"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("too few repetitions"), std::string::npos) << c.out;
+  // The recorded summary wins over the steps for seconds.total, not for another metric.
+  copy_set(dir / "old", dir / "summary_slow", "dddd", [](json& r, int) {
+    r["timing"] = {{"step_median_seconds", 10.0}};
+  });
+  c = mcfbench("compare old summary_slow", dir);
+  EXPECT_EQ(c.status, 1) << c.out << c.err;
+  EXPECT_NE(c.out.find("**slower**"), std::string::npos) << c.out;
+  // Contended repetitions are counted per set (the line is left out when neither records it).
+  EXPECT_EQ(c.out.find("contended"), std::string::npos) << c.out;
+  copy_set(dir / "old", dir / "busy", "eeee", [](json& r, int rep) {
+    r["contention"] = {{"contended", rep < 2}};
+  });
+  c = mcfbench("compare old busy", dir);
+  EXPECT_NE(c.out.find("(contended): OLD –, NEW 6 of 15."), std::string::npos) << c.out;
+}
+
+TEST(CompareCli, RefusesDifferentMachinesThreadsOrBuilds) {
+  const fs::path dir = fresh_dir("compare_machine");
+  const json env = {{"cpu", "AMD EPYC"},
+                    {"cores", 2},
+                    {"threads", 2},
+                    {"blas_threads", 2},
+                    {"build", {{"type", "Release"}, {"compiler", "GNU 12"}}},
+                    {"hostname", "a"}};
+  make_set(dir / "raw", "aaaa", 1.0, 0.03, 1.0, 1);
+  const auto with = [&](const std::string& key, const json& value) {
+    return [=](json& r, int) {
+      const std::string commit = r["environment"]["commit"];
+      r["environment"] = env;
+      r["environment"]["commit"] = commit;
+      if (!key.empty()) r["environment"][key] = value;
+    };
+  };
+  copy_set(dir / "raw", dir / "old", "aaaa", with("", nullptr));
+  copy_set(dir / "raw", dir / "other_host", "bbbb", with("hostname", "b"));
+  copy_set(dir / "raw", dir / "one_thread", "cccc", with("threads", 1));
+  copy_set(dir / "raw", dir / "intel", "dddd", with("cpu", "Intel Xeon"));
+  copy_set(dir / "raw", dir / "debug", "eeee",
+           with("build", {{"type", "Debug"}, {"compiler", "GNU 12"}}));
+  Command c = mcfbench("compare old other_host", dir);  // a host name alone is no difference
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  for (const char* other : {"one_thread", "intel", "debug"}) {
+    c = mcfbench(std::string("compare old ") + other, dir);
+    EXPECT_NE(c.status, 0) << other;
+    EXPECT_EQ(c.out.find("regression"), std::string::npos) << other << ": an error, not a verdict";
+    EXPECT_NE(c.err.find("--allow-cross-machine"), std::string::npos) << c.err;
+  }
+  EXPECT_NE(mcfbench("compare old one_thread", dir).err.find("threads: 2 vs 1"), std::string::npos);
+  c = mcfbench("compare old intel --allow-cross-machine", dir);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("Cross-machine comparison"), std::string::npos) << c.out;
+  // Repetitions of one cell from two machines in one folder are not pooled either.
+  copy_set(dir / "raw", dir / "mixed", "ffff",
+           [&](json& r, int rep) { with(rep == 0 ? "cpu" : "", "Intel Xeon")(r, rep); });
+  c = mcfbench("compare old mixed", dir);
+  EXPECT_NE(c.status, 0);
+  EXPECT_NE(c.err.find("different machines"), std::string::npos) << c.err;
+  // The history line records the machine.
+  c = mcfbench("compare old old --history h.jsonl", dir);
+  const json line = json::parse(slurp(dir / "h.jsonl"));
+  EXPECT_EQ(line["machine"]["cpu"], "AMD EPYC");
+  EXPECT_EQ(line["machine"].contains("hostname"), false);
 }
 
 }  // namespace

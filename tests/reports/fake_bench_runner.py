@@ -1,0 +1,37 @@
+#!/usr/bin/python3
+"""A stand-in for scripts/history_runner.sh in the history tests: `fake_bench_runner.py CONFIG
+OUT`, run in a worktree of a scratch repository. Writes cell results of two cells, "slowed"
+(its step time is the number in the worktree's speed.txt) and "steady" (always 1), with
+$MCFBENCH_HISTORY_REPETITIONS repetitions and a deterministic +-1% jitter drawn from the commit
+and repetition, and appends the commit to $FAKE_RUNNER_LOG, so a test counts the runs."""
+
+import hashlib
+import json
+import os
+import sys
+
+config, out = sys.argv[1], sys.argv[2]
+commit = os.environ["MCFBENCH_HISTORY_COMMIT"]
+reps = int(os.environ.get("MCFBENCH_HISTORY_REPETITIONS", "1"))
+speed = float(open("speed.txt").read())
+with open(os.environ["FAKE_RUNNER_LOG"], "a") as f:
+    f.write(commit + "\n")
+# This computer's CPU model and core count, as mcfbench records them, so that the history finds
+# its machine folder before it runs anything.
+cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
+            if line.startswith("model name")), "unknown")
+env = {"commit": commit[:12], "cpu": cpu, "cores": os.cpu_count(), "threads": 2,
+       "blas_threads": 2, "build": {"type": "Release", "compiler": "fake"}, "hostname": "h"}
+for cell, base in (("slowed", speed), ("steady", 1.0)):
+    for r in range(reps):
+        h = int(hashlib.sha1(("%s/%s/%d" % (commit, cell, r)).encode()).hexdigest()[:8], 16)
+        v = base * (1 + 0.02 * (h / 0xFFFFFFFF - 0.5))
+        steps = [{"step": 1, "seconds": {"total": 3 * v}}] + [
+            {"step": s, "seconds": {"total": v}} for s in range(2, 5)]
+        res = {"schema": 1, "status": "ok", "stop": {"step": 4, "reason": "completed"},
+               "environment": env,
+               "cell": {"key": "%s-%d" % (cell, r), "config_key": cell, "repetition": r,
+                        "study": "fake", "assignment": {"solver.name": cell}},
+               "steps": steps, "timing": {"step_median_seconds": v}}
+        with open(os.path.join(out, "%s-%d.json" % (cell, r)), "w") as f:
+            json.dump(res, f)

@@ -1,0 +1,260 @@
+#!/usr/bin/python3
+"""Performance history (reports/perf_history.py, ctest `history`), all on synthetic data:
+
+- the step detector finds a 20% step under 5% noise at its index, and raises an alarm on fewer
+  than 5 of 100 flat noisy series with outliers (seeded, so the outcome is fixed);
+- on a scratch git repository of 16 commits with a 30% slowdown planted in one, run through a
+  stand-in runner (tests/reports/fake_bench_runner.py) instead of building mcfbench:
+  `bisect` names the planted commit within log2(16) + 1 = 5 runs, `run --last 16` stores one
+  entry per commit in git order (also when stored out of order), `detect` reports the step at
+  the planted commit and nowhere else (with every other commit stored, it points `bisect` at the
+  gap, which then runs one commit), `publish` lists it in its regressions, and `ab` with
+  `mcfbench compare` (given with --mcfbench) fails on the slowdown and passes without one.
+
+usage: test_perf_history.py [--mcfbench BIN] [--keep DIR]
+"""
+
+import argparse
+import json
+import math
+import os
+import random
+import shutil
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "reports"))
+import perf_history as ph  # noqa: E402
+
+TOOL = [sys.executable, os.path.join(ROOT, "reports", "perf_history.py")]
+RUNNER = "%s %s" % (sys.executable, os.path.join(HERE, "fake_bench_runner.py"))
+PLANTED = 9  # the commit (0-based) whose speed.txt says 1.3 instead of 1.0
+failures = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+def test_detector():
+    rng = random.Random(20261127)
+    exact, near = 0, 0
+    for _ in range(100):
+        v = [(1.0 if i < 15 else 1.2) * (1 + rng.gauss(0, 0.05)) for i in range(30)]
+        s = ph.detect_steps(v)
+        exact += len(s) == 1 and s[0]["index"] == 15
+        near += len(s) == 1 and abs(s[0]["index"] - 15) <= 2 and s[0]["ratio"] > 1.1
+    # Noise of 5% makes a point next to the step look like the other level now and then, which
+    # no detector can tell apart; found every time, at the exact commit in most.
+    check(exact >= 85, "20%% step under 5%% noise: at the exact index in %d of 100" % exact)
+    check(near == 100, "20%% step under 5%% noise: one step within 2 commits in %d of 100" % near)
+    alarms = 0
+    for k in range(100):
+        v = [1 + rng.gauss(0, 0.05) for _ in range(30)]
+        if k % 3 == 0:
+            v[rng.randrange(30)] *= 1.5  # a lone outlier: one noisy run, not a step
+        alarms += bool(ph.detect_steps(v))
+    check(alarms < 5, "flat series with 5%% noise and outliers: %d of 100 alarms" % alarms)
+    check(not ph.detect_steps([1.0] * 20), "a constant series has no step")
+
+
+def test_contended_repetitions(work):
+    """A commit's median leaves out repetitions that shared the machine while one ran alone."""
+    folder = os.path.join(work, "contended")
+    os.makedirs(folder)
+    for r, (v, contended) in enumerate([(10.0, True), (1.0, False), (12.0, True)]):
+        with open(os.path.join(folder, "c%d.json" % r), "w") as f:
+            json.dump({"status": "ok", "environment": {"commit": "abc", "cpu": "X"},
+                       "cell": {"config_key": "k", "repetition": r, "assignment": {"a": 1}},
+                       "timing": {"step_median_seconds": v},
+                       "contention": {"contended": contended}}, f)
+    e = ph.store_result_set(os.path.join(work, "store_c"), "c", folder,
+                            {"commit": "abc", "date": "2026-01-01", "parents": []})
+    b = e["benchmarks"]["a=1"]
+    check(b["median"] == 1.0 and b["samples"] == [10.0, 1.0, 12.0] and
+          b["contended"] == [True, False, True], "contended repetitions are kept, not counted")
+
+
+# The scratch repository ignores the user's and the system's git configuration (signing,
+# hooks, default branch), so its commits are the same everywhere.
+GIT_ENV = dict(os.environ, GIT_CONFIG_GLOBAL=os.devnull, GIT_CONFIG_NOSYSTEM="1")
+
+
+def git(repo, *args):
+    return subprocess.run(["git", "-C", repo] + list(args), check=True, capture_output=True,
+                          text=True, env=GIT_ENV).stdout.strip()
+
+
+def scratch_repo(path):
+    """16 commits; commit PLANTED makes the 'slowed' benchmark 30% slower. Dates increase."""
+    os.makedirs(path)
+    git(path, "init", "-q", "-b", "main")
+    commits = []
+    for i in range(16):
+        with open(os.path.join(path, "speed.txt"), "w") as f:
+            f.write("1.3" if i >= PLANTED else "1.0")
+        with open(os.path.join(path, "notes.txt"), "a") as f:
+            f.write("change %d\n" % i)
+        git(path, "add", "-A")
+        env = dict(GIT_ENV, GIT_AUTHOR_DATE="2026-01-%02dT12:00:00Z" % (i + 1),
+                   GIT_COMMITTER_DATE="2026-01-%02dT12:00:00Z" % (i + 1),
+                   GIT_AUTHOR_NAME="t", GIT_AUTHOR_EMAIL="t@t", GIT_COMMITTER_NAME="t",
+                   GIT_COMMITTER_EMAIL="t@t")
+        subprocess.run(["git", "-C", path, "commit", "-q", "-m", "commit %d" % i], check=True,
+                       env=env)
+        commits.append(git(path, "rev-parse", "HEAD"))
+    return commits
+
+
+def tool(work, *args, expect=0):
+    env = dict(os.environ, FAKE_RUNNER_LOG=os.path.join(work, "runs.log"))
+    r = subprocess.run(TOOL + list(args), cwd=work, env=env, capture_output=True, text=True)
+    if r.returncode != expect:
+        print(r.stdout + r.stderr)
+    check(r.returncode == expect, "history %s: exit %d (expected %d)" % (args[0], r.returncode,
+                                                                          expect))
+    return r
+
+
+def runs(work):
+    path = os.path.join(work, "runs.log")
+    n = len(open(path).read().split()) if os.path.exists(path) else 0
+    if os.path.exists(path):
+        os.remove(path)
+    return n
+
+
+def test_repository(work, mcfbench):
+    repo = os.path.join(work, "repo")
+    commits = scratch_repo(repo)
+    config = os.path.join(work, "fake.json")
+    with open(config, "w") as f:
+        json.dump({"name": "fake"}, f)
+    common = ["--repo", repo, "--runner", RUNNER]
+
+    # Bisect: the good end and one commit per halving of the 15 candidates.
+    r = tool(work, "bisect", config, "--good", commits[0], "--bad", commits[-1], "--store",
+             "store_bisect", "--repetitions", "3", "--json", "bisect.json", *common)
+    out = json.load(open(os.path.join(work, "bisect.json")))
+    n = runs(work)
+    check(out["first_bad"] == commits[PLANTED], "bisect names the planted commit")
+    check(n <= 5 and out["runs"] == n, "bisect ran %d commits (at most 5)" % n)
+    # A second bisect over the same store runs nothing it has measured before.
+    tool(work, "bisect", config, "--good", commits[0], "--bad", commits[-1], "--store",
+         "store_bisect", "--repetitions", "3", *common)
+    check(runs(work) == 0, "a repeated bisect runs nothing (the store's machine of this CPU)")
+
+    # Run the last 16 commits into a store; entries carry date and parents.
+    tool(work, "run", config, "--last", "16", "--store", "store", "--repetitions", "3", *common)
+    check(runs(work) == 16, "run --last 16 ran 16 commits")
+    tool(work, "run", config, commits[3] + ".." + commits[5], "--store", "store", *common,
+         "--machine", os.listdir(os.path.join(work, "store"))[0])
+    check(runs(work) == 0, "run A..B of stored commits runs nothing")
+    tool(work, "run", config, "--last", "3", "--store", "store", *common)
+    check(runs(work) == 0, "nor does run --last N without --machine")
+    # A commit that does not run is skipped, the others stored: exit 1 naming it.
+    with open(os.path.join(work, "failing_runner.sh"), "w") as f:
+        f.write('[ "$MCFBENCH_HISTORY_COMMIT" = %s ] && exit 3\nexec %s "$@"\n' %
+                (commits[2], RUNNER))
+    r = tool(work, "run", config, commits[1] + ".." + commits[3], "--store", "store_gap",
+             "--repo", repo, "--runner", "bash " + os.path.join(work, "failing_runner.sh"),
+             expect=1)
+    runs(work)
+    gap = list(ph.load_store(os.path.join(work, "store_gap")).values())[0]
+    check([e["commit"] for e in gap] == [commits[1], commits[3]] and commits[2][:12] in r.stdout,
+          "a commit whose runner fails is skipped and named")
+    series = ph.load_store(os.path.join(work, "store"))
+    check(len(series) == 1, "one (machine, config) series")
+    entries = list(series.values())[0]
+    check([e["commit"] for e in entries] == commits, "the series is in git order")
+    check(entries[5]["parents"] == [commits[4]], "an entry records its parents")
+    # Git order, not file or date order: a commit dated before its parent stays after it.
+    e = dict(entries[7], date="2025-01-01T00:00:00Z")
+    shuffled = [e] + entries[:7] + entries[8:]
+    random.Random(1).shuffle(shuffled)
+    check([x["commit"] for x in ph.git_order(shuffled)] == commits,
+          "git order survives shuffled entries and a skewed date")
+
+    tool(work, "detect", "--store", "store", "--json", "steps.json")
+    steps = json.load(open(os.path.join(work, "steps.json")))
+    check(len(steps) == 1, "detect finds one step (found %d)" % len(steps))
+    if steps:
+        s = steps[0]
+        check(s["commit"] == commits[PLANTED] and s["benchmark"] == "solver.name=slowed",
+              "the step is at the planted commit, on the slowed benchmark")
+        check(abs(s["ratio"] - 1.3) < 0.03 and s["confidence"] > 0.99,
+              "its size is 1.3 (%.3f), its confidence high (%.4f)" % (s["ratio"],
+                                                                     s["confidence"]))
+    tool(work, "detect", "--store", "store", "--fail-on-regression", expect=1)
+
+    # Every other commit measured: the step lies between two measured commits, detect says how
+    # to bisect it, and the bisect that reuses the store runs the one commit in between.
+    for c in commits[::2]:
+        tool(work, "run", config, c, "--store", "store_sparse", "--repetitions", "3", *common)
+    runs(work)
+    # 5 commits before the step and 3 after: the U test's p is 0.037 at best, so alpha 0.05.
+    r = tool(work, "detect", "--store", "store_sparse", "--alpha", "0.05")
+    hint = "--good %s --bad %s" % (commits[PLANTED - 1][:12], commits[PLANTED + 1][:12])
+    check(hint in r.stdout, "detect suggests bisecting between the measured neighbours")
+    r = tool(work, "bisect", config, "--good", commits[PLANTED - 1][:12], "--bad",
+             commits[PLANTED + 1][:12], "--store", "store_sparse", "--repetitions", "3", *common)
+    check(runs(work) == 1 and commits[PLANTED] in r.stdout,
+          "that bisect runs one commit and names the planted one")
+
+    tool(work, "publish", os.path.join(work, "site"), "--store", "store")
+    page = open(os.path.join(work, "site", "index.html")).read()
+    check(page.count('<svg class="chart"') == 2, "the page has one chart per benchmark")
+    check(commits[PLANTED][:12] in page.split('id="regressions"')[1].split("</table>")[0],
+          "the regressions list names the planted commit")
+    check("http://" not in page.replace("http://www.w3.org/2000/svg", "") and
+          "https://" not in page, "the page loads nothing from the network")
+
+    # The gate: base and head alternated, compared by mcfbench compare.
+    if mcfbench:
+        cmp = ["--compare", "%s compare" % mcfbench]
+        tool(work, "ab", config, commits[0], commits[-1], "--rounds", "5", "--out", "ab_slow",
+             *common, *cmp, expect=1)
+        check(runs(work) == 10, "ab ran each side once per round")
+        tool(work, "ab", config, commits[PLANTED], commits[-1], "--rounds", "5", "--out",
+             "ab_same", *common, *cmp, expect=0)
+        runs(work)
+        gate = subprocess.run(
+            ["bash", os.path.join(ROOT, "scripts", "perf_gate.sh"), config, commits[0],
+             commits[-1]], cwd=repo, capture_output=True, text=True,
+            env=dict(os.environ, FAKE_RUNNER_LOG=os.path.join(work, "runs.log"),
+                     MCFBENCH_GATE_RUNNER=RUNNER, MCFBENCH_GATE_COMPARE="%s compare" % mcfbench,
+                     MCFBENCH_GATE_OUT=os.path.join(work, "gate"), MCFBENCH_GATE_REPO=repo))
+        check(gate.returncode == 1 and "slower" in gate.stdout,
+              "perf_gate.sh fails on the slowdown (exit %d)" % gate.returncode)
+        if gate.returncode != 1:
+            print(gate.stdout + gate.stderr)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--mcfbench", default="")
+    ap.add_argument("--keep", default="")
+    a = ap.parse_args()
+    a.mcfbench = os.path.abspath(a.mcfbench) if a.mcfbench else ""
+    test_detector()
+    work = a.keep or tempfile.mkdtemp(prefix="test_perf_history-")
+    if a.keep:
+        shutil.rmtree(work, ignore_errors=True)
+        os.makedirs(work)
+    try:
+        test_contended_repetitions(work)
+        test_repository(work, a.mcfbench)
+    finally:
+        if not a.keep:
+            shutil.rmtree(work, ignore_errors=True)
+    print("%d failures" % len(failures))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
