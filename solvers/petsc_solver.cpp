@@ -460,8 +460,7 @@ std::string PetscSolver::name() const {
 }
 
 SolveReport PetscSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
-  if (A.rows() != A.cols())
-    return failed_report("matrix is not square");
+  if (A.rows() != A.cols()) return failed_report("matrix is not square");
   if (!A.isCompressed()) {
     SparseMatrix C = A;
     C.makeCompressed();
