@@ -1,8 +1,10 @@
 // Breadth-first orientation over edge-adjacent faces. Edges are found by sorting 64-bit keys of
-// the faces' corner pairs (as validate.cpp does), so a ~1M-face mesh is oriented in well under a
+// the faces' corner pairs (datasets/edge_uses.h), so a ~1M-face mesh is oriented in well under a
 // second.
 
 #include "datasets/orientation.h"
+
+#include "datasets/edge_uses.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -11,17 +13,6 @@
 
 namespace mcf {
 namespace {
-
-struct EdgeUse {
-  std::uint64_t key;  // (smaller vertex << 32) | larger vertex
-  Eigen::Index face;
-  bool forward;  // the face runs the edge from its smaller vertex to its larger one
-  bool operator<(const EdgeUse& o) const { return key < o.key || (key == o.key && face < o.face); }
-};
-
-std::array<int, 2> edge_of(std::uint64_t key) {
-  return {static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu)};
-}
 
 /// A neighbour across an edge, and whether the two faces run that edge the same way (then one of
 /// them has to be reversed).
@@ -36,16 +27,7 @@ struct Link {
 OrientationResult orient_faces(Triangles& faces) {
   OrientationResult result;
   const Eigen::Index m = faces.rows();
-  std::vector<EdgeUse> uses(static_cast<std::size_t>(3 * m));
-  for (Eigen::Index f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) {
-      std::uint64_t a = static_cast<std::uint32_t>(faces(f, c));
-      std::uint64_t b = static_cast<std::uint32_t>(faces(f, (c + 1) % 3));
-      const bool forward = a < b;
-      if (!forward) std::swap(a, b);
-      uses[static_cast<std::size_t>(3 * f + c)] = {(a << 32) | b, f, forward};
-    }
-  std::sort(uses.begin(), uses.end());
+  std::vector<EdgeUse> uses = sorted_edge_uses(faces);
 
   // Adjacency in CSR form: each manifold interior edge links its two faces both ways. An edge in
   // three or more faces has no orientation to agree on: the one whose third face comes first is
@@ -59,7 +41,7 @@ OrientationResult orient_faces(Triangles& faces) {
     if (j - i > 2 && uses[i + 2].face < first_third_face) {
       first_third_face = uses[i + 2].face;
       result.problem = OrientationResult::Problem::non_manifold_edge;
-      result.edge = edge_of(uses[i].key);
+      result.edge = edge_vertices(uses[i].key);
       result.faces = {uses[i].face, uses[i + 1].face, uses[i + 2].face};
     } else if (j - i == 2) {
       const bool same = uses[i].forward == uses[i + 1].forward;
@@ -107,7 +89,7 @@ OrientationResult orient_faces(Triangles& faces) {
           queue.push_back(l.face);
         } else if (g != wanted) {
           result.problem = OrientationResult::Problem::non_orientable;
-          result.edge = edge_of(l.key);
+          result.edge = edge_vertices(l.key);
           result.faces = {f, l.face};
           return result;
         }

@@ -3,6 +3,7 @@
 
 #include "datasets/validate.h"
 
+#include "datasets/edge_uses.h"
 #include "datasets/referenced_vertices.h"
 
 #include <Eigen/Geometry>
@@ -35,29 +36,6 @@ struct UnionFind {
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
   }
 };
-
-// One record per face corner: undirected edge key, and whether the face runs it low->high.
-struct EdgeUse {
-  std::uint64_t key;
-  std::int64_t face;
-  bool forward;
-  bool operator<(const EdgeUse& o) const { return key < o.key || (key == o.key && face < o.face); }
-};
-
-std::vector<EdgeUse> sorted_edge_uses(const Triangles& faces) {
-  const Eigen::Index m = faces.rows();
-  std::vector<EdgeUse> uses(3 * m);
-  for (Eigen::Index f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) {
-      std::uint64_t a = static_cast<std::uint32_t>(faces(f, c));
-      std::uint64_t b = static_cast<std::uint32_t>(faces(f, (c + 1) % 3));
-      const bool forward = a < b;
-      if (!forward) std::swap(a, b);
-      uses[3 * f + c] = {(a << 32) | b, f, forward};
-    }
-  std::sort(uses.begin(), uses.end());
-  return uses;
-}
 
 int edge_a(std::uint64_t key) {
   return static_cast<int>(key >> 32);
