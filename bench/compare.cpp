@@ -1,6 +1,7 @@
 #include "bench/compare.h"
 
 #include "bench/experiment_config.h"
+#include "bench/timing_summary.h"
 
 #include <algorithm>
 #include <chrono>
@@ -128,14 +129,7 @@ double repetition_sample(const json& r, const std::string& metric) {
     const json* t = json_at_path(r, "timing.step_median_seconds");
     if (t && t->is_number()) return t->get<double>();
   }
-  if (!r.contains("steps") || !r["steps"].is_array()) return NAN;
-  std::vector<double> values;
-  for (const auto& s : r["steps"]) {
-    const json* v = json_at_path(s, metric);
-    if (v && v->is_number()) values.push_back(v->get<double>());
-  }
-  if (values.size() > 1) values.erase(values.begin());
-  return values.empty() ? NAN : median(values);
+  return median_after_first_step(r, metric);
 }
 
 /// Adds one repetition's result to its cell's samples; returns its number of steps.

@@ -97,8 +97,8 @@ nlohmann::json to_json(const FlowConfig& c) {
   // Only when set: a key present with its default would change the config key of every cell
   // (bench/cell_hash.h), and `compare` would find no cell of an earlier run to compare with.
   if (c.repair_degenerate) j["repair_degenerate"] = true;
-  // The multigrid's fallback only where a multigrid runs, for the same reason: the config keys of
-  // the other solvers' cells stay those of versions without it.
+  // A solver's own options only where that solver runs, for the same reason: the config keys of
+  // the other solvers' cells stay those of versions without them.
   if (c.solver.name == "petsc") j["solver"]["petsc_options"] = c.solver.petsc_options;
   if (c.solver.name == "multigrid") {
     j["solver"]["stall_ratio"] = c.solver.stall_ratio;
