@@ -49,6 +49,12 @@ TEST(FlowConfig, ErrorsNameFileAndKey) {
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"flow", "wilmore"}}).find("flow: unknown value"),
             std::string::npos);
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"dt", -1.0}}).find("dt"), std::string::npos);
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"stall_ratio", 5}}}})
+                .find("cfg.json: solver.stall_ratio: value 5 out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"fallback_tolerance", 0}}}})
+                .find("solver.fallback_tolerance: value 0 out of range"),
+            std::string::npos);
   // Every solver with every basis: the hat basis builds a surface hierarchy for multigrid.
   EXPECT_EQ(error_of(json{{"mesh", "a"}, {"solver", {{"name", "multigrid"}}}}), "");
   EXPECT_EQ(
