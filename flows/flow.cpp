@@ -494,6 +494,8 @@ TriangleMesh FlowRun::finish() {
   if (!result_.contains("stop"))
     result_["stop"] = {{"step", int(steps_.size())}, {"reason", "completed"}};
   result_["steps"] = std::move(steps_);
+  // Again at the end: some settings are known only after the solves (PETSc's storage per rank).
+  for (const auto& [key, text] : solver_->settings()) result_["solver_settings"][key] = text;
   return TriangleMesh{V_, mesh_.faces};
 }
 

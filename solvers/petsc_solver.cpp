@@ -149,6 +149,50 @@ struct PetscSolver::Impl {
   VecScatter gather = nullptr;
   Vec all = nullptr;
 
+  // An AIJ matrix's storage on this rank: a value and a column index per stored entry, a row
+  // offset per local row (PETSc's AIJ layout; an MPIAIJ block counts its two parts together).
+  static double storage_bytes(Mat m) {
+    MatInfo info;
+    petsc_check(MatGetInfo(m, MAT_LOCAL, &info), "MatGetInfo");
+    PetscInt local_rows = 0, local_cols = 0;
+    petsc_check(MatGetLocalSize(m, &local_rows, &local_cols), "MatGetLocalSize");
+    return info.nz_used * double(sizeof(PetscScalar) + sizeof(PetscInt)) +
+           double(local_rows + 1) * double(sizeof(PetscInt));
+  }
+  double largest_over_ranks(double local) const {
+    double largest = local;
+    if (distributed) MPI_Allreduce(&local, &largest, 1, MPI_DOUBLE, MPI_MAX, comm);
+    return largest;
+  }
+  // The coarse levels' operators and the interpolations of a multigrid preconditioner, after its
+  // set-up; -1 where the PC is not PETSc's multigrid (hypre keeps its hierarchy to itself).
+  double hierarchy_bytes() const {
+    PC pc = nullptr;
+    petsc_check(KSPGetPC(ksp, &pc), "KSPGetPC");
+    PetscBool multigrid = PETSC_FALSE;
+    petsc_check(PetscObjectTypeCompareAny((PetscObject)pc, &multigrid, PCMG, PCGAMG, ""),
+                "PetscObjectTypeCompareAny");
+    if (!multigrid) return -1;
+    PetscInt levels = 0;
+    petsc_check(PCMGGetLevels(pc, &levels), "PCMGGetLevels");
+    double local = 0;
+    for (PetscInt l = 0; l < levels; ++l) {
+      if (l + 1 < levels) {  // the finest level's operator is A itself
+        KSP smoother = nullptr;
+        Mat op = nullptr;
+        petsc_check(PCMGGetSmoother(pc, l, &smoother), "PCMGGetSmoother");
+        petsc_check(KSPGetOperators(smoother, &op, nullptr), "KSPGetOperators");
+        if (op) local += storage_bytes(op);
+      }
+      if (l > 0) {
+        Mat p = nullptr;
+        petsc_check(PCMGGetInterpolation(pc, l, &p), "PCMGGetInterpolation");
+        if (p) local += storage_bytes(p);
+      }
+    }
+    return largest_over_ranks(local);
+  }
+
   KSP ksp = nullptr;
   Mat A = nullptr;
   Vec b = nullptr, x = nullptr, r = nullptr;
@@ -158,6 +202,10 @@ struct PetscSolver::Impl {
   bool have_matrix = false;
   std::string setup;  // what the next solve does with the preconditioner: new | refreshed | kept
   int setups = 0, patterns = 0;
+  // The storage of the matrix's block on the rank holding the largest one, and of the multigrid
+  // preconditioner's coarse operators and interpolations (PCMG and GAMG; -1 for other PCs),
+  // largest over the set-ups seen: what distributing the solve divides.
+  double matrix_bytes_per_rank = 0, preconditioner_bytes_per_rank = -1;
   std::vector<PetscReal> history;
 
   ~Impl() { destroy(); }
@@ -241,6 +289,7 @@ struct PetscSolver::Impl {
     petsc_check(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption");
     petsc_check(MatSetOption(A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE), "MatSetOption");
     petsc_check(MatSetOption(A, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE), "MatSetOption");
+    matrix_bytes_per_rank = std::max(matrix_bytes_per_rank, largest_over_ranks(storage_bytes(A)));
     MatInfo info;
     petsc_check(MatGetInfo(A, MAT_GLOBAL_SUM, &info), "MatGetInfo");
     // The value array is then Eigen's, entry for entry (refresh() relies on it).
@@ -512,6 +561,9 @@ SolveReport PetscSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
       petsc_check(VecRestoreArrayWrite(s.x, &v), "VecRestoreArrayWrite");
 
       petsc_check(KSPSolve(s.ksp, s.b, s.x), "KSPSolve");
+      if (c == 0 && rep.preconditioner_setup != "kept")
+        s.preconditioner_bytes_per_rank =
+            std::max(s.preconditioner_bytes_per_rank, s.hierarchy_bytes());
       PetscInt its = 0;
       KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
       petsc_check(KSPGetIterationNumber(s.ksp, &its), "KSPGetIterationNumber");
@@ -602,6 +654,9 @@ std::vector<std::pair<std::string, std::string>> PetscSolver::settings() const {
           {"preconditioner_reuse", reuse},
           {"version", version()},
           {"ranks", std::to_string(PetscRuntime::instance().size())},
+          {"matrix_bytes_per_rank", std::to_string(std::llround(s.matrix_bytes_per_rank))},
+          {"preconditioner_bytes_per_rank",
+           std::to_string(std::llround(s.preconditioner_bytes_per_rank))},
           {"distribution",
            s.distributed ? "every rank reads the mesh, assembles and holds the whole system and "
                            "runs the whole flow; PETSc holds a block of rows of the matrix, "

@@ -2,7 +2,8 @@
 # One flow's PETSc solves across two MPI ranks (docs/petsc.md, "Across MPI ranks"):
 # `mpirun -n 2 mcfbench flow ... --solver petsc` writes one result whose final surface matches the
 # same flow run without mpirun to 1e-8 of the bounding box's diagonal, records two ranks, and
-# leaves no second output; a solver other than petsc under mpirun is refused, writing nothing.
+# leaves no second output, and holds about half of the matrix and of GAMG's hierarchy on each rank; a
+# solver other than petsc under mpirun is refused, writing nothing.
 #
 # usage: test_mpi_flow.sh MCFBENCH
 #
@@ -37,8 +38,24 @@ a, b = read(sys.argv[1]), read(sys.argv[2])
 diag = np.linalg.norm(a.max(0) - a.min(0))
 dev = np.abs(a - b).max() / diag
 r = json.load(open(sys.argv[2] + "/result.json"))
+one = json.load(open(sys.argv[1] + "/result.json"))
 ranks = r["solver_settings"]["ranks"]
 ok = dev < 1e-8 and ranks == "2" and r["status"] == "ok"
+# The matrix's storage on one rank: a double and a 32- or 64-bit index per entry, an offset per
+# row. The hat basis on a closed genus-0 mesh has a row per vertex and an entry per vertex and per
+# edge end, n + 2 (3n - 6) (Euler). Two ranks hold about half of it each.
+n = one["system"]["dimension"]
+nnz = 7 * n - 12
+serial_bytes = int(one["solver_settings"]["matrix_bytes_per_rank"])
+layouts = [nnz * (8 + w) + (n + 1) * w for w in (4, 8)]
+ok = ok and serial_bytes in layouts
+ratio = int(r["solver_settings"]["matrix_bytes_per_rank"]) / serial_bytes
+ok = ok and 0.45 <= ratio <= 0.6
+pc_one = int(one["solver_settings"]["preconditioner_bytes_per_rank"])
+pc_ratio = int(r["solver_settings"]["preconditioner_bytes_per_rank"]) / pc_one
+ok = ok and pc_one > 0 and pc_ratio <= 0.75
+print("matrix storage per rank: %d bytes on one rank (layouts %s), 2 ranks %.3f of it; "
+      "GAMG's hierarchy per rank, 2 ranks %.3f of one's" % (serial_bytes, layouts, ratio, pc_ratio))
 for step in r["steps"]:
     ok = ok and step["solver"]["status"] == "converged" and step["solver"]["relative_residual"] <= 1e-10
 print("mpi vs serial: %.3g of the diagonal, ranks %s, status %s" % (dev, ranks, r["status"]))
