@@ -341,6 +341,32 @@ def time_text(result, seconds, spec="%.3g"):
     return fmt(seconds, spec) + (" (contended)" if contended(result) and finite(seconds) else "")
 
 
+def by_configuration(results):
+    """[(repetitions, quiet_timed)] per configuration (config_identity) of the newest commit:
+    its repetitions in order, and of those the ones to time: the uncontended ones, or all where
+    every one was contended."""
+    groups = group_by(newest_commits(results)[0], config_identity)
+    out = []
+    for _, reps in sorted(groups.items(), key=lambda kv: str(kv[0])):
+        reps = sorted(reps, key=lambda r: get(r, "cell.repetition", 0) or 0)
+        out.append((reps, quiet_or_all(reps)))
+    return out
+
+
+def median_of(results, path):
+    """The median of `path` over `results` where every one has it finite, else None."""
+    return median([get(r, path) for r in results])
+
+
+def median(values):
+    """The median of `values` where every one is finite, else None."""
+    if not values or not all(finite(v) for v in values):
+        return None
+    values = sorted(values)
+    mid = len(values) // 2
+    return values[mid] if len(values) % 2 else 0.5 * (values[mid - 1] + values[mid])
+
+
 def first_repetition(results):
     """One result per configuration (config_identity) and commit, its lowest repetition: curves
     are drawn once per variant. Of cells run by several commits only the newest commit's results

@@ -28,6 +28,8 @@ def solver_name(r):
         if pre == "multigrid":
             pre = "multigrid %s(%s,%s)" % (s.get("cycle"), s.get("smooth"), s.get("smooth"))
         name += " (%s)" % pre
+    elif name == "petsc":  # the KSP and PC as the run named them: petsc-cg-gamg, ...
+        name = r.get("solver_name") or name
     return "%s, %s" % (common.get(r, "config.basis", "?"), name)
 
 

@@ -11,7 +11,6 @@ contended`) is not a measurement: a point all of whose repetitions were contende
 hollow, and is neither on the front nor in the tables. A cell that stopped before its last step has
 no comparable error: it is listed, not plotted."""
 
-import statistics
 
 import matplotlib.pyplot as plt
 
@@ -124,15 +123,12 @@ def points_of(results):
     """One point per configuration: {family, knob, order, case, vertices, time, setup, flow_time,
     errors, contended, repetitions, status, result}. Time is the median over the uncontended
     repetitions (all repetitions, and `contended` set, where every one was contended)."""
-    by_config = common.group_by(common.newest_commits(results)[0], common.config_identity)
     points = []
-    for _, reps in sorted(by_config.items(), key=lambda kv: str(kv[0])):
-        reps = sorted(reps, key=lambda r: common.get(r, "cell.repetition", 0) or 0)
+    for reps, quiet_or_all in common.by_configuration(results):
         first = reps[0]
-        quiet = [r for r in reps if not common.get(r, "contention.contended", False)]
-        timed = [r for r in (quiet or reps) if common.finite(common.get(r, "timing.step_median_seconds"))]
-        med = lambda path: (statistics.median(common.get(r, path) for r in timed)  # noqa: E731
-                            if timed and all(common.finite(common.get(r, path)) for r in timed) else None)
+        quiet = [r for r in reps if not common.contended(r)]
+        timed = [r for r in quiet_or_all if common.finite(common.get(r, "timing.step_median_seconds"))]
+        med = lambda path: common.median_of(timed, path)  # noqa: E731
         family, knob, order = family_and_knob(first)
         points.append({
             "family": family, "knob": knob, "order": order, "case": case_of(first),
