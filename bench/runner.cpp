@@ -148,6 +148,35 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   return result;
 }
 
+namespace {
+
+/// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the
+/// one agreeing with the cell on most assigned keys, then the lowest index); nullptr if none or
+/// if the cell is a reference cell itself.
+const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
+                              const CellPlan& cell) {
+  const json& ref = e.metrics.reference;
+  if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
+  const CellPlan* best = nullptr;
+  std::pair<int, int> best_score{-1, -1};
+  for (const CellPlan& p : plans) {
+    if (!matches_assignment(p.cell, ref)) continue;
+    int agree = 0;
+    for (auto it = cell.cell.assignment.begin(); it != cell.cell.assignment.end(); ++it) {
+      const json* v = json_at_path(p.cell.config, it.key());
+      if (v && *v == *it) ++agree;
+    }
+    const std::pair<int, int> score{p.cell.repetition == cell.cell.repetition ? 1 : 0, agree};
+    if (score > best_score) {  // strict: ties keep the lowest index
+      best_score = score;
+      best = &p;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 /// Distances between this cell's frames and its reference cell's frames at the same steps.
 json reference_distances(const ExperimentConfig& e, const fs::path& out, const CellPlan& cell,
                          const CellPlan& ref) {
@@ -285,6 +314,14 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
   return plans;
 }
 
+namespace {
+
+/// The plan `run` writes into OUT before its first cell: the whole matrix it expanded (index,
+/// repetition, assignment of every cell; the hash of the cells it named), the study config, the
+/// commit and the shard, so `collect` knows which cells to expect even when a run was killed
+/// before finishing any. One file per study variant, commit and shard (one writer each):
+/// OUT/plans/<study>[-quick]@<commit>[.shard-<i>-of-<n>].json. Not a `*.json` file of OUT
+/// itself, so nothing that reads cell results sees it.
 nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
                         int shard_index, int shard_count) {
   json cells = json::array();
@@ -307,6 +344,8 @@ nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& 
           {"study_config", e.study_config}};
 }
 
+}  // namespace
+
 std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index,
                           int shard_count) {
   auto safe = [](std::string s) {
@@ -319,28 +358,6 @@ std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e,
   if (shard_count > 1)
     name += ".shard-" + std::to_string(shard_index) + "-of-" + std::to_string(shard_count);
   return (fs::path(out_dir) / kPlanFolder / (name + ".json")).string();
-}
-
-const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
-                              const CellPlan& cell) {
-  const json& ref = e.metrics.reference;
-  if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
-  const CellPlan* best = nullptr;
-  std::pair<int, int> best_score{-1, -1};
-  for (const CellPlan& p : plans) {
-    if (!matches_assignment(p.cell, ref)) continue;
-    int agree = 0;
-    for (auto it = cell.cell.assignment.begin(); it != cell.cell.assignment.end(); ++it) {
-      const json* v = json_at_path(p.cell.config, it.key());
-      if (v && *v == *it) ++agree;
-    }
-    const std::pair<int, int> score{p.cell.repetition == cell.cell.repetition ? 1 : 0, agree};
-    if (score > best_score) {  // strict: ties keep the lowest index
-      best_score = score;
-      best = &p;
-    }
-  }
-  return best;
 }
 
 std::vector<std::size_t> execution_order(const ExperimentConfig& e,
