@@ -20,7 +20,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-
 /// Finest-level functions whose support meets a boundary edge (or a boundary vertex): the corners
 /// of every finest cell a boundary edge passes through. Sorted, unique.
 std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices,

@@ -264,7 +264,6 @@ ResultFolders read_result_folders(const std::vector<std::string>& dirs) {
   return folders;
 }
 
-
 /// The index entry of one study: cells found, expected, missing, duplicated, errored, lacking
 /// their reference distance; prints its summary lines on stdout. `complete` is cleared when a
 /// cell is missing, duplicated or errored.

@@ -426,7 +426,6 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
   return md.str();
 }
 
-
 /// One line for the history file: {commit, date, study, dir, metric, machine (the first cell's
 /// identity), cells: {key: {label, median, repetitions}}}.
 json history_entry(const ResultSet& set, const std::string& metric) {

@@ -135,7 +135,6 @@ IoMesh half_edge_mesh(const std::string& path, const std::string& prefix, const 
   return om;
 }
 
-
 }  // namespace
 
 TriangleMesh read_mesh(const std::string& path, ReadReport* report) {

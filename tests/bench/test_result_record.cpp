@@ -30,7 +30,9 @@ json untimed(json step) {
 
 TEST(ResultRecord, FlowAndRunCellOfOneConfigHaveTheSameKeysAndValues) {
   const fs::path dir = fresh_dir("result_record");
-  const json flow = {{"mesh", "icosphere:level=2"}, {"basis", "octree"}, {"octree", {{"depth", 5}}},
+  const json flow = {{"mesh", "icosphere:level=2"},
+                     {"basis", "octree"},
+                     {"octree", {{"depth", 5}}},
                      {"steps", 3},
                      {"dt", 1e-3},
                      {"threads", 1}};
