@@ -25,6 +25,7 @@ std::set<std::string> keys_of(const json& j) {
 /// A step record without its clocks.
 json untimed(json step) {
   step.erase("seconds");
+  step.erase("setup_seconds");  // a rebuilt basis's step
   return step;
 }
 
