@@ -10,6 +10,9 @@
 
 namespace mcf {
 
+namespace {
+
+/// Cotangent weights of one triangle: cot of the angle at each corner (0 for a degenerate one).
 Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                   const Eigen::Vector3d& c) {
   // cot of the angle at p between edges to q and r = (e1·e2) / |e1×e2|. A collapsed triangle
@@ -20,6 +23,8 @@ Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3
   };
   return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
 }
+
+}  // namespace
 
 HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
                    std::optional<SurfaceHierarchyOptions> hierarchy, Eigen::Index output_vertices)

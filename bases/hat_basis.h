@@ -59,8 +59,4 @@ class HatBasis final : public Basis {
   BasisStats stats_;
 };
 
-/// Cotangent weights of one triangle: cot of the angle at each corner (0 for a degenerate one).
-Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                  const Eigen::Vector3d& c);
-
 }  // namespace mcf

@@ -20,8 +20,8 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-}  // namespace
-
+/// Finest-level functions whose support meets a boundary edge (or a boundary vertex): the corners
+/// of every finest cell a boundary edge passes through. Sorted, unique.
 std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices,
                                     const Triangles& faces) {
   const OctreeLevel& L = octree.finest();
@@ -61,6 +61,8 @@ std::vector<int> boundary_functions(const Octree& octree, const Positions& verti
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
+
+}  // namespace
 
 RebuiltOctreeBasis::RebuiltOctreeBasis(const TriangleMesh& mesh, OctreeOptions options)
     : options_(options) {

@@ -28,11 +28,6 @@ struct OctreeOptions {
   bool normal_gradient = false;
 };
 
-/// Finest-level functions whose support meets a boundary edge (or a boundary vertex): the corners
-/// of every finest cell a boundary edge passes through. Sorted, unique.
-std::vector<int> boundary_functions(const Octree& octree, const Positions& vertices,
-                                    const Triangles& faces);
-
 class RebuiltOctreeBasis : public Basis {
  public:
   /// Builds from the mesh's initial positions (faces are fixed from now on).

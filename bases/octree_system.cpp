@@ -337,6 +337,8 @@ std::vector<PointStencil> point_stencils(const Octree& octree, const Positions& 
   return out;
 }
 
+namespace {
+
 Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coefficients& x) {
   Positions out(static_cast<Eigen::Index>(stencils.size()), 3);
   tbb::parallel_for(std::size_t(0), stencils.size(), [&](std::size_t v) {
@@ -350,6 +352,8 @@ Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coe
   });
   return out;
 }
+
+}  // namespace
 
 VertexStencils vertex_stencils(const Octree& octree, const Positions& vertices,
                                const Triangles& faces) {

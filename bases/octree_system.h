@@ -215,7 +215,6 @@ struct PointStencil {
 std::vector<PointStencil> point_stencils(const Octree& octree, const Positions& points);
 /// Stencil of a point in a given level-`level` cell (local coordinates clamped to the cell).
 PointStencil cell_stencil(const Octree& octree, int level, int cell, const Eigen::Vector3d& p);
-Positions evaluate_stencils(const std::vector<PointStencil>& stencils, const Coefficients& x);
 
 /// A mesh's vertices as an octree basis evaluates them. A vertex no face uses (files may have
 /// them; `mesh-info` reports `unreferenced_vertices`) lies on no piece, so no active cell need

@@ -248,8 +248,9 @@ void print_study(const std::string& name, const StudyResults& g, const json& s, 
                 json(g.errored).dump().c_str());
 }
 
-}  // namespace
-
+/// Reads the plans and cell results of every folder (throws std::runtime_error for a path that
+/// is not a folder). Unreadable files and folders with nothing to collect are listed in the
+/// answer and named on stdout with what to do.
 ResultFolders read_result_folders(const std::vector<std::string>& dirs) {
   ResultFolders folders;
   for (const auto& dir : dirs) {
@@ -263,6 +264,9 @@ ResultFolders read_result_folders(const std::vector<std::string>& dirs) {
   return folders;
 }
 
+/// The index entry of one study: cells found, expected, missing, duplicated, errored, lacking
+/// their reference distance; prints its summary lines on stdout. `complete` is cleared when a
+/// cell is missing, duplicated or errored.
 json check_study(const std::string& name, const StudyResults& g, bool& complete) {
   json s = {{"study", g.study},
             {"quick", g.quick},
@@ -293,6 +297,8 @@ json check_study(const std::string& name, const StudyResults& g, bool& complete)
   print_study(name, g, s, missing, dup, expected);
   return s;
 }
+
+}  // namespace
 
 int collect_results(const std::vector<std::string>& dirs, const std::string& index_file) {
   const ResultFolders folders = read_result_folders(dirs);

@@ -35,16 +35,6 @@ struct ResultFolders {
   nlohmann::json empty_dirs = nlohmann::json::array();  ///< folders with nothing to collect
 };
 
-/// Reads the plans and cell results of every folder (throws std::runtime_error for a path that
-/// is not a folder). Unreadable files and folders with nothing to collect are listed in the
-/// answer and named on stdout with what to do.
-ResultFolders read_result_folders(const std::vector<std::string>& dirs);
-
-/// The index entry of one study: cells found, expected, missing, duplicated, errored, lacking
-/// their reference distance; prints its summary lines on stdout. `complete` is cleared when a
-/// cell is missing, duplicated or errored.
-nlohmann::json check_study(const std::string& name, const StudyResults& study, bool& complete);
-
 /// collect as a whole: reads `dirs`, checks every study, writes the index to `index_file`
 /// (default FIRST_DIR/index.json) and prints a summary. Returns 0 when every cell is there once,
 /// 1 otherwise.

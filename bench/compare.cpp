@@ -27,6 +27,11 @@ double median(std::vector<double> v) {
   return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + long(n)));
 }
 
+namespace {
+
+/// The fields of a result's `environment` that its timings depend on besides the code: `cpu`,
+/// `cores`, `threads`, `blas_threads`, `build` and `libraries` (not the host name: identical
+/// machines of a CI pool have different names). Absent fields are left out.
 json machine_identity(const json& result) {
   json id = json::object();
   if (!result.is_object() || !result.contains("environment") || !result["environment"].is_object())
@@ -37,12 +42,16 @@ json machine_identity(const json& result) {
   return id;
 }
 
+/// The first field that two identities both have and disagree on, as "threads: 2 vs 1"; empty
+/// when they agree on every field they share.
 std::string identity_difference(const json& a, const json& b) {
   for (auto it = a.begin(); it != a.end(); ++it)
     if (b.contains(it.key()) && b[it.key()] != *it)
       return it.key() + ": " + it->dump() + " vs " + b[it.key()].dump();
   return "";
 }
+
+}  // namespace
 
 double smallest_mann_whitney_p(int n1, int n2) {
   if (n1 <= 0 || n2 <= 0) return 1.0;
@@ -200,6 +209,13 @@ double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b
   return std::erfc(z / std::sqrt(2.0));
 }
 
+namespace {
+
+/// Reads DIR[@COMMIT]: every cell result (*.json with a "cell" object) in DIR, keeping only
+/// those of COMMIT (a prefix) when given. A folder holding several commits without @COMMIT is
+/// an error listing them (timings of different code must not be pooled). `metric` is the
+/// dotted path of the per-step value ("seconds.total", "radial_error.rms", ...).
+/// When cells have steps but none of them has `metric` (a misspelt --metric), that is an error.
 ResultSet load_result_set(const std::string& dir_at_commit, const std::string& metric) {
   ResultSet set;
   std::string commit_filter;
@@ -244,6 +260,8 @@ ResultSet load_result_set(const std::string& dir_at_commit, const std::string& m
   return set;
 }
 
+/// Throws (naming the cell and the field) when a matched cell's identity differs between the
+/// sets, or within one set, unless o.allow_cross_machine.
 CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set,
                               const CompareOptions& o) {
   CompareReport rep;
@@ -408,6 +426,8 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
   return md.str();
 }
 
+/// One line for the history file: {commit, date, study, dir, metric, machine (the first cell's
+/// identity), cells: {key: {label, median, repetitions}}}.
 json history_entry(const ResultSet& set, const std::string& metric) {
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   char date[32];
@@ -420,6 +440,8 @@ json history_entry(const ResultSet& set, const std::string& metric) {
   return {{"commit", set.commit}, {"date", date},       {"study", set.study}, {"dir", set.dir},
           {"metric", metric},     {"machine", machine}, {"cells", cells}};
 }
+
+}  // namespace
 
 int compare_and_record(const CompareRequest& request) {
   const CompareOptions& o = request.options;

@@ -45,13 +45,6 @@ struct ResultSet {
   int contention_recorded = 0, contended = 0;
 };
 
-/// Reads DIR[@COMMIT]: every cell result (*.json with a "cell" object) in DIR, keeping only
-/// those of COMMIT (a prefix) when given. A folder holding several commits without @COMMIT is
-/// an error listing them (timings of different code must not be pooled). `metric` is the
-/// dotted path of the per-step value ("seconds.total", "radial_error.rms", ...).
-/// When cells have steps but none of them has `metric` (a misspelt --metric), that is an error.
-ResultSet load_result_set(const std::string& dir_at_commit, const std::string& metric);
-
 struct CompareOptions {
   double threshold = 0.1, alpha = 0.05;
   std::string metric = "seconds.total";
@@ -60,15 +53,6 @@ struct CompareOptions {
   /// refusing to.
   bool allow_cross_machine = false;
 };
-
-/// The fields of a result's `environment` that its timings depend on besides the code: `cpu`,
-/// `cores`, `threads`, `blas_threads`, `build` and `libraries` (not the host name: identical
-/// machines of a CI pool have different names). Absent fields are left out.
-nlohmann::json machine_identity(const nlohmann::json& result);
-
-/// The first field that two identities both have and disagree on, as "threads: 2 vs 1"; empty
-/// when they agree on every field they share.
-std::string identity_difference(const nlohmann::json& a, const nlohmann::json& b);
 
 /// The smallest two-sided p-value the U test can give with n1 and n2 samples (all of one sample
 /// below all of the other): when it is not below alpha, no difference can be significant.
@@ -105,16 +89,6 @@ struct CompareReport {
   /// With allow_cross_machine: the matched cells whose identities differ ("label: difference").
   std::vector<std::string> cross_machine;
 };
-
-/// Throws (naming the cell and the field) when a matched cell's identity differs between the
-/// sets, or within one set, unless o.allow_cross_machine.
-CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set,
-                              const CompareOptions& o);
-std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
-                             const ResultSet& new_set, const CompareOptions& o);
-/// One line for the history file: {commit, date, study, dir, metric, machine (the first cell's
-/// identity), cells: {key: {label, median, repetitions}}}.
-nlohmann::json history_entry(const ResultSet& set, const std::string& metric);
 
 struct CompareRequest {
   std::string old_dir, new_dir;  ///< DIR[@COMMIT] each

@@ -3,10 +3,10 @@
 #include "flows/registry.h"
 #include "solvers/petsc_runtime.h"
 
-#include "bench/environment.h"
 #include "bench/experiment_config.h"
 #include "bench/memory_budget.h"
 #include "bench/progress.h"
+#include "bench/result_record.h"
 #include "bench/stop_signals.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
@@ -147,7 +147,8 @@ int run_flow_into_folder(const FlowRequest& request) {
   }
   std::set<std::string> frames;
   FlowOutcome outcome;
-  const double steal_before = cpu_steal_seconds();
+  // The process runs this one flow: its peak is the flow's (with the mesh's loading).
+  const ResultRecorder recorder(/*peak_of_this_flow=*/false);
   // SIGINT and SIGTERM stop the flow after the running step, as they stop `run`: the staging
   // folder goes as on any failure, and OUT keeps what it held.
   const StopSignals signals;
@@ -155,12 +156,7 @@ int run_flow_into_folder(const FlowRequest& request) {
   // disk) leaves OUT as it was, whatever it held.
   try {
     outcome = run_staged(config, mesh, staging, line_seconds, frames);
-    outcome.result["environment"] = environment_json(config.threads, outcome.result);
-    outcome.result["peak_memory_bytes"] = peak_memory_bytes();
-    outcome.result["memory_estimate"] = memory.to_json();
-    outcome.result["memory_budget"] = budget.to_json();
-    if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
-      outcome.result["steal_seconds"] = steal;
+    recorder.complete(outcome.result, config.threads, memory.to_json(), budget);
     write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
     write_file_atomic((staging / "result.json").string(), outcome.result.dump(1) + "\n");
   } catch (const FlowInterrupted& stop) {

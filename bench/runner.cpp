@@ -1,11 +1,10 @@
 #include "bench/runner.h"
 
 #include "bench/cell_hash.h"
-#include "bench/contention.h"
 #include "bench/environment.h"
 #include "bench/memory_budget.h"
 #include "bench/metrics.h"
-#include "bench/timing_summary.h"
+#include "bench/result_record.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "flows/config_reader.h"
@@ -32,25 +31,6 @@ std::string frame_name(int step) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%05d.ply", step);
   return name;
-}
-
-/// Peak memory of one cell, not of the whole process: Linux resets the high-water mark
-/// (VmHWM) when "5" is written to /proc/self/clear_refs. Where that fails the process peak
-/// (getrusage) is recorded and said so.
-bool reset_peak_memory() {
-  std::ofstream f("/proc/self/clear_refs");
-  if (!f) return false;
-  f << "5";
-  f.flush();
-  return bool(f);
-}
-
-long long cell_peak_memory_bytes() {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stoll(line.substr(6)) * 1024;  // kB
-  return peak_memory_bytes();
 }
 
 /// A stop request met between two steps of a cell: not a std::exception, so the cell's own
@@ -88,8 +68,7 @@ json cell_json(const ExperimentConfig& e, const CellPlan& p) {
 }
 
 json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, const fs::path& out,
-              const std::function<void(int step)>& on_step) {
-  const auto start = std::chrono::steady_clock::now();
+              const MemoryBudget& budget, const std::function<void(int step)>& on_step) {
   const MetricsConfig& m = e.metrics;
   const FlowConfig& config = p.cell.flow;
   const std::set<int> frames(m.frames.begin(), m.frames.end());
@@ -97,9 +76,7 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
   std::vector<int> written;
   std::map<int, json> step_metrics;
   const bool per_step = m.quasi_conformal || m.sphericity;
-  const bool peak_per_cell = reset_peak_memory();
-  const double steal_before = cpu_steal_seconds();
-  const CpuCounters counters_before = read_cpu_counters();
+  const ResultRecorder recorder(/*peak_of_this_flow=*/true);
 
   json result;
   json memory;
@@ -164,22 +141,41 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
               {"config", p.cell.config},
               {"steps", json::array()}};
   }
-  result["environment"] = environment_json(config.threads, result);
-  result["peak_memory_bytes"] = peak_per_cell ? cell_peak_memory_bytes() : peak_memory_bytes();
-  result["peak_memory_scope"] = peak_per_cell ? "cell" : "process";
-  if (!memory.is_null()) result["memory_estimate"] = std::move(memory);
+  recorder.complete(result, config.threads, memory, budget);
   result["cell"] = cell_json(e, p);
   result["study_config"] = e.study_config;
   if (!written.empty()) result["frames"] = {{"dir", "frames/" + p.hash}, {"steps", written}};
-  result["run_seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (const double steal = cpu_steal_seconds_since(steal_before); steal >= 0)
-    result["steal_seconds"] = steal;
-  result["contention"] = contention_json(counters_before, read_cpu_counters(),
-                                         result["environment"].value("cores", 0));
-  if (json t = timing_summary(result); !t.empty()) result["timing"] = std::move(t);
   return result;
 }
+
+namespace {
+
+/// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the
+/// one agreeing with the cell on most assigned keys, then the lowest index); nullptr if none or
+/// if the cell is a reference cell itself.
+const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
+                              const CellPlan& cell) {
+  const json& ref = e.metrics.reference;
+  if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
+  const CellPlan* best = nullptr;
+  std::pair<int, int> best_score{-1, -1};
+  for (const CellPlan& p : plans) {
+    if (!matches_assignment(p.cell, ref)) continue;
+    int agree = 0;
+    for (auto it = cell.cell.assignment.begin(); it != cell.cell.assignment.end(); ++it) {
+      const json* v = json_at_path(p.cell.config, it.key());
+      if (v && *v == *it) ++agree;
+    }
+    const std::pair<int, int> score{p.cell.repetition == cell.cell.repetition ? 1 : 0, agree};
+    if (score > best_score) {  // strict: ties keep the lowest index
+      best_score = score;
+      best = &p;
+    }
+  }
+  return best;
+}
+
+}  // namespace
 
 /// Distances between this cell's frames and its reference cell's frames at the same steps.
 json reference_distances(const ExperimentConfig& e, const fs::path& out, const CellPlan& cell,
@@ -318,6 +314,14 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
   return plans;
 }
 
+namespace {
+
+/// The plan `run` writes into OUT before its first cell: the whole matrix it expanded (index,
+/// repetition, assignment of every cell; the hash of the cells it named), the study config, the
+/// commit and the shard, so `collect` knows which cells to expect even when a run was killed
+/// before finishing any. One file per study variant, commit and shard (one writer each):
+/// OUT/plans/<study>[-quick]@<commit>[.shard-<i>-of-<n>].json. Not a `*.json` file of OUT
+/// itself, so nothing that reads cell results sees it.
 nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
                         int shard_index, int shard_count) {
   json cells = json::array();
@@ -340,6 +344,8 @@ nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& 
           {"study_config", e.study_config}};
 }
 
+}  // namespace
+
 std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index,
                           int shard_count) {
   auto safe = [](std::string s) {
@@ -352,28 +358,6 @@ std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e,
   if (shard_count > 1)
     name += ".shard-" + std::to_string(shard_index) + "-of-" + std::to_string(shard_count);
   return (fs::path(out_dir) / kPlanFolder / (name + ".json")).string();
-}
-
-const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
-                              const CellPlan& cell) {
-  const json& ref = e.metrics.reference;
-  if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
-  const CellPlan* best = nullptr;
-  std::pair<int, int> best_score{-1, -1};
-  for (const CellPlan& p : plans) {
-    if (!matches_assignment(p.cell, ref)) continue;
-    int agree = 0;
-    for (auto it = cell.cell.assignment.begin(); it != cell.cell.assignment.end(); ++it) {
-      const json* v = json_at_path(p.cell.config, it.key());
-      if (v && *v == *it) ++agree;
-    }
-    const std::pair<int, int> score{p.cell.repetition == cell.cell.repetition ? 1 : 0, agree};
-    if (score > best_score) {  // strict: ties keep the lowest index
-      best_score = score;
-      best = &p;
-    }
-  }
-  return best;
 }
 
 std::vector<std::size_t> execution_order(const ExperimentConfig& e,
@@ -488,7 +472,7 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
         if (!had_frames) fs::remove_all(frame_dir, ec);
       };
       try {
-        const json result = run_cell(e, p, meshes, out, [&](int step) {
+        const json result = run_cell(e, p, meshes, out, budget, [&](int step) {
           if (o.on_step) o.on_step(StepReport{done + 1, s.in_shard, &p, step, p.cell.flow.steps});
           if (const int signal = stop_requested()) throw Interrupt{signal};
         });

@@ -99,14 +99,6 @@ std::vector<CellPlan> plan_cells(const ExperimentConfig& e, const std::string& o
                                  MeshCache& meshes, int threads = -1,
                                  const std::function<bool(const Cell&)>& wanted = {});
 
-/// The plan `run` writes into OUT before its first cell: the whole matrix it expanded (index,
-/// repetition, assignment of every cell; the hash of the cells it named), the study config, the
-/// commit and the shard, so `collect` knows which cells to expect even when a run was killed
-/// before finishing any. One file per study variant, commit and shard (one writer each):
-/// OUT/plans/<study>[-quick]@<commit>[.shard-<i>-of-<n>].json. Not a `*.json` file of OUT
-/// itself, so nothing that reads cell results sees it.
-nlohmann::json run_plan(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
-                        int shard_index, int shard_count);
 std::string run_plan_path(const std::string& out_dir, const ExperimentConfig& e, int shard_index,
                           int shard_count);
 inline constexpr const char* kPlanFolder = "plans";
@@ -136,11 +128,5 @@ std::vector<std::size_t> execution_order(const ExperimentConfig& e,
 /// folder) stops the run with std::runtime_error naming the file and the cause: the running cell
 /// is dropped as for RunStopped, finished cells stay.
 RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& options);
-
-/// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the
-/// one agreeing with the cell on most assigned keys, then the lowest index); nullptr if none or
-/// if the cell is a reference cell itself.
-const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
-                              const CellPlan& cell);
 
 }  // namespace mcf

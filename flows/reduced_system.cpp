@@ -121,7 +121,8 @@ ReducedSystem::Anchors ReducedSystem::hold_in_place(const std::vector<int>& empt
   // the system without it, while the pattern, and so the solver's symbolic work (Galerkin
   // pattern, CHOLMOD's analysis), stays that of every other step. Eliminating the row instead
   // changes the pattern whenever the set of empty rows does, which through a pinch or with
-  // the 1-point rule is nearly every step (a 4x slower solve, measured). d is the mean
+  // the 1-point rule is nearly every step (docs/benchmarks.md, "Measurements behind
+  // implementation choices"). d is the mean
   // diagonal of the other rows, so the coarse operators the row feeds stay of the usual scale.
   // One pass over the columns: each empty row's diagonal position, and the mean of the others'
   // positive diagonal entries. Rows without a stored diagonal cannot be held in place: they are

@@ -31,13 +31,14 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import common  # noqa: E402
 import index  # noqa: E402
+import study_manifest  # noqa: E402
 
 # Hidden (index.md links nothing in it), and removed by the next report into OUT_DIR when a killed
 # report left it.
 STAGING_FOLDER = ".report-staging"
 
-STUDIES = ["table1", "sphere_error", "model_error", "depth_cycles", "cubature", "cmcf", "time_order",
-           "hat_multigrid", "hat_scaling", "work_precision"]
+# The studies with a report module of their name, in the report's order (bench/configs/studies.json).
+STUDIES = study_manifest.names()
 
 
 def parse_args(argv):

@@ -1,28 +1,48 @@
 #!/usr/bin/env bash
-# Fails if a layer, or its tests (tests/LAYER), includes a header of a layer above it (docs/design.md
-# "Layers"). core is the bottom layer: it includes no other layer, and every layer may include it.
+# Fails if a layer, or its tests (tests/LAYER), includes a header of a layer it does not link,
+# directly or through the layers it links (cmake/layers.txt, docs/design.md "Layers"): a layer above
+# it, or one beside it. core is the bottom layer: it includes no other layer, and every layer may
+# include it.
 root=${1:-$(dirname "$0")/..}
-order=(core datasets bases solvers flows bench benchmarks tools fuzz)
-# solvers sits beside bases (neither may include the other), and beside datasets; the
-# micro-benchmarks (benchmarks/), the executable (tools/) and the fuzz targets (fuzz/) sit beside
-# each other on top.
-declare -A forbidden=(
-  [core]="datasets bases solvers flows bench benchmarks tools"
-  [datasets]="bases solvers flows bench benchmarks tools"
-  [bases]="solvers flows bench benchmarks tools"
-  [solvers]="datasets bases flows bench benchmarks tools"
-  [flows]="bench benchmarks tools"
-  [bench]="benchmarks tools"
-  [benchmarks]="tools"
-  [tools]="benchmarks fuzz"
-  [fuzz]="benchmarks tools"
-)
+order=()
+declare -A links=()
+while IFS= read -r line; do
+  line=${line%%#*}
+  [[ $line == *:* ]] || continue
+  layer=${line%%:*}
+  layer=${layer// /}
+  order+=("$layer")
+  links[$layer]=${line#*:}
+done <"$root/cmake/layers.txt"
+if [ ${#order[@]} -eq 0 ]; then
+  echo "$root/cmake/layers.txt: no layers"
+  exit 1
+fi
+
+# The layers `layer` reaches through its links, itself included.
+reach() {
+  local layer=$1 seen=" $1 " todo=($1)
+  while [ ${#todo[@]} -gt 0 ]; do
+    local next=${todo[0]}
+    todo=("${todo[@]:1}")
+    for dep in ${links[$next]}; do
+      if [[ $seen != *" $dep "* ]]; then
+        seen+="$dep "
+        todo+=("$dep")
+      fi
+    done
+  done
+  echo "$seen"
+}
+
 bad=0
 for layer in "${order[@]}"; do
-  for up in ${forbidden[$layer]}; do
-    if hits=$(grep -rnE "#include +\"(\.\./)*$up/" "$root/$layer" "$root/tests/$layer" \
+  allowed=$(reach "$layer")
+  for other in "${order[@]}"; do
+    [[ $allowed == *" $other "* ]] && continue
+    if hits=$(grep -rnE "#include +\"(\.\./)*$other/" "$root/$layer" "$root/tests/$layer" \
                 --include='*.h' --include='*.cpp' 2>/dev/null); then
-      echo "layering violation: $layer includes $up:"; echo "$hits"; bad=1
+      echo "layering violation: $layer includes $other:"; echo "$hits"; bad=1
     fi
   done
 done

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs studies of bench/configs (all by default) and regenerates their report.
+# Runs studies of bench/configs (by default those bench/configs/studies.json marks run_by_default)
+# and regenerates their report.
 #   scripts/run_studies.sh [--quick] [--out DIR] [STUDY ...]
 # Results: DIR/results/<study>/ (one JSON per cell; reruns skip finished cells),
 # report: DIR/report/index.md, of every study under DIR/results (also those run earlier).
@@ -18,7 +19,10 @@ while [ $# -gt 0 ]; do
 done
 [ -n "$out" ] || out="$root/out/studies${quick:+-quick}"
 if [ ${#studies[@]} -eq 0 ]; then
-  studies=(table1 sphere_error model_error depth_cycles cubature cmcf time_order work_precision)
+  # The studies bench/configs/studies.json marks run_by_default, in its order.
+  listed=$(/usr/bin/python3 "$root/reports/study_manifest.py" --default)
+  [ -n "$listed" ] || { echo "run_studies.sh: bench/configs/studies.json marks no study run_by_default" >&2; exit 1; }
+  mapfile -t studies <<<"$listed"
 fi
 status=0
 dirs=()

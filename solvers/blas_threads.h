@@ -25,9 +25,8 @@ int blas_threads();
 /// The BLAS threads for CHOLMOD's factorization of a system of `dimension` unknowns when `threads`
 /// may run: at most four, however many cores there are, and one below kBlasThreadsFromDimension
 /// unknowns. The supernodal updates of a surface's factor are small; OpenBLAS's threads spin on
-/// them, and beyond a few threads the factorization got slower, not faster: on a 16-core Xeon the
-/// armadillo at 832k faces took 1.41-1.45 s a step with 2, 4 or 8 threads and 2.44 s with 16, at
-/// 3.3M faces 4.14 s with 4 and 24.8 s with 16 (docs/benchmarks.md, "BLAS threads").
+/// them, and beyond a few threads the factorization gets slower, not faster (the measurements are
+/// in docs/benchmarks.md, "BLAS threads").
 int auto_blas_threads(int threads, long long dimension);
 inline constexpr long long kBlasThreadsFromDimension = 20000;
 inline constexpr int kMaxAutoBlasThreads = 4;

@@ -36,8 +36,9 @@ using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 /// (J, I): A_c is exactly symmetric, the intermediate A P is never stored, and only half of the
 /// dot products are formed. Every entry is computed by one task in a fixed order: deterministic.
 /// Columns are visited in `column_order` (internal column of the caller's column jj; empty:
-/// identity), i.e. in grid order, so consecutive columns share most of their fine support:
-/// visiting them colour-major measured 1.3x slower.
+/// identity), i.e. in grid order, so consecutive columns share most of their fine support and
+/// their accumulators stay in cache (a colour-major visit is slower: docs/benchmarks.md,
+/// "Measurements behind implementation choices").
 void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatrix& Cm,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
                      Spa& spa);

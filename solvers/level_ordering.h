@@ -28,10 +28,10 @@ namespace mcf::multigrid_detail {
 // Each coloured level is stored in tiles of kTile consecutive caller indices, colour-major inside
 // each tile (colour 0's functions of the tile first, each colour in index order). A colour pass of
 // Gauss-Seidel then streams one contiguous segment per tile instead of every eighth row of the
-// whole matrix (the interleaved rows defeated the hardware prefetchers: a sweep on the armadillo
-// at depth 9 took 2.1x as long in the solver, 3.5x in a stand-alone kernel benchmark), and the
-// rows a coarse function's support touches stay within a few tiles, which keeps the Galerkin
-// product's accumulators in cache (a global colour-major order made it 1.6x slower). The parity
+// whole matrix (interleaved rows defeat the hardware prefetchers), and the rows a coarse
+// function's support touches stay within a few tiles, which keeps the Galerkin product's
+// accumulators in cache (a global colour-major order does not; docs/benchmarks.md, "Measurements
+// behind implementation choices"). The parity
 // 8-colour ordering and its iterates are unchanged. `perm[r]` is the caller's index of internal
 // row r, `inv` its inverse; both are empty for the identity.
 

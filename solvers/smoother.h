@@ -29,7 +29,8 @@ namespace mcf::multigrid_detail {
 // The kernels below cost a few instructions per matrix entry and run at full speed only when
 // inlined into their loops: out of line, the two accumulators passed by reference go through
 // memory on every entry. GCC stopped inlining gather_sub and gather_sub_compact once they had a
-// few more call sites (a fine sweep then took up to 1.5x as long), so they are forced.
+// few more call sites (docs/benchmarks.md, "Measurements behind implementation choices"), so they
+// are forced.
 #define MCF_KERNEL_INLINE inline __attribute__((always_inline))
 
 // The kernels below hold four right-hand-side columns of one row in one vector (core/vec4.h).
@@ -45,9 +46,8 @@ using vec4::v4;
 // vector, columns o..o+3: one load of a neighbour's iterate instead of three, one vector multiply-
 // add instead of three. A row's terms are summed alternately into two vector accumulators (even
 // and odd positions of each run of entries), which halves the chain of dependent multiply-adds.
-// In a stand-alone Gauss-Seidel kernel on cached data (AMD EPYC guest) this took an entry from
-// 3.4 to 2.1 cycles; on the depth-9 levels the sweeps are bound by memory traffic instead
-// (SmootherRows, relaxation blocks).
+// That shortens the time per entry on cached data; on the finest levels the sweeps are bound by
+// memory traffic instead (SmootherRows, relaxation blocks).
 
 /// Σ_p val[p] x[inner[p]] over p in [begin, end), into acc0 (even p - begin) and acc1 (odd).
 MCF_KERNEL_INLINE void gather_sub(const Csc& A, const double* x, std::size_t s, int o, int begin,
