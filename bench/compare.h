@@ -112,20 +112,21 @@ CompareReport compare_results(const ResultSet& old_set, const ResultSet& new_set
                               const CompareOptions& o);
 std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
                              const ResultSet& new_set, const CompareOptions& o);
-/// One line for the history file: {commit, date, study, dir, metric, machine (the first cell's
-/// identity), cells: {key: {label, median, repetitions}}}.
-nlohmann::json history_entry(const ResultSet& set, const std::string& metric);
+/// Stores `set` (its folder, its commit's results only) in the performance history `store` as
+/// the entry of its commit under its machine and study (`mcfbench history add`,
+/// reports/perf_history.py). Throws when the history tool refuses it (e.g. uncommitted code, a
+/// commit not in the current folder's git repository; its message is on stderr).
+void store_in_history(const ResultSet& set, const std::string& store);
 
 struct CompareRequest {
   std::string old_dir, new_dir;  ///< DIR[@COMMIT] each
   CompareOptions options;
-  bool append_history = false;  ///< append history_entry(NEW) as one line to `history`
-  std::string history;          ///< empty: results/history.jsonl
+  bool store_history = false;  ///< store NEW in the history `history` (store_in_history)
+  std::string history;         ///< empty: benchmarks/history
 };
 
-/// compare as a whole: loads both sets, prints the Markdown comparison on stdout, appends NEW's
-/// history line when asked (creating its folder; throws if it cannot). Returns 1 on a
-/// regression, else 0.
+/// compare as a whole: loads both sets, prints the Markdown comparison on stdout, stores NEW in
+/// the history when asked (throws if it cannot). Returns 1 on a regression, else 0.
 int compare_and_record(const CompareRequest& request);
 
 /// Two-sided p-value of the Mann–Whitney U test (normal approximation, tie-corrected, with
