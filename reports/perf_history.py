@@ -235,6 +235,14 @@ def read_results_of(folder, commit):
     return results
 
 
+def refuse_planted(path, environment):
+    """A run slowed on purpose ($MCFBENCH_PLANTED_SLOWDOWN, scripts/history_aa_ab.sh) measured
+    the plant, not the commit: it never enters a history."""
+    if environment.get("planted_slowdown"):
+        fail("%s: ran with a planted slowdown of %s (MCFBENCH_PLANTED_SLOWDOWN); not stored" %
+             (path, environment["planted_slowdown"]))
+
+
 def store_result_set(store, config_name, results_dir, info, commit=""):
     """Stores the cell results of `results_dir` (only those of `commit` when given) as the entry
     of commit info['commit']; returns the entry. All cells must share one machine identity
@@ -245,6 +253,7 @@ def store_result_set(store, config_name, results_dir, info, commit=""):
     identity = machine_identity(results[0][1])
     benchmarks = {}
     for name, r in results:
+        refuse_planted(os.path.join(results_dir, name), r.get("environment") or {})
         if machine_identity(r) != identity:
             fail("%s: cells of different machines, threads or builds in one set" % results_dir)
         cell = r["cell"]
@@ -322,7 +331,9 @@ def store_micro_set(store, config_name, path, info):
             data = json.load(f)
     except (OSError, ValueError) as e:
         fail("%s: %s" % (path, e))
-    identity = {k: v for k, v in micro_environment(path, data).items() if k in IDENTITY_KEYS}
+    env = micro_environment(path, data)
+    refuse_planted(path, env)
+    identity = {k: v for k, v in env.items() if k in IDENTITY_KEYS}
     benchmarks = {}
     for b in data.get("benchmarks") or []:
         if b.get("run_type", "iteration") != "iteration" or b.get("error_occurred"):

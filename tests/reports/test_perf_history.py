@@ -276,11 +276,13 @@ def test_bisect_skips(work):
                   "the planted commit not building: the answer is it and the next, exit 3")
 
 
-def micro_json(path, commit, benchmarks, context=True):
+def micro_json(path, commit, benchmarks, context=True, planted=0):
     """A Google Benchmark JSON file as mcfbench_micro writes it: three repetitions of each
     benchmark (times in ms) with their aggregates, and the mcfbench environment in its context."""
     env = {"commit": commit[:12], "cpu": "Synthetic CPU", "cores": 2, "threads": 2,
            "blas_threads": 2, "hostname": "h", "build": {"type": "Release"}}
+    if planted:
+        env["planted_slowdown"] = planted
     rows = []
     for name, ms in benchmarks.items():
         for r in range(3):
@@ -327,6 +329,9 @@ def test_micro(work):
     steps = json.load(open(os.path.join(work, "micro_steps.json")))
     check([(s["benchmark"], s["commit"]) for s in steps] == [("BM_Step/8", commits[4])],
           "detect finds the micro step at its commit")
+    micro_json(path, commits[3], {"BM_Step/8": 1.0}, planted=0.3)
+    r = tool(work, "add", "micro", path, "--store", "store_micro", "--repo", repo, expect=2)
+    check("planted slowdown" in r.stderr, "a run with a planted slowdown is not stored")
     micro_json(path, commits[3], {"BM_Step/8": 1.0}, context=False)
     r = tool(work, "add", "micro", path, "--store", "store_micro", "--repo", repo, expect=2)
     check("micro_extra.json" in r.stderr and "mcfbench_environment" in r.stderr,
