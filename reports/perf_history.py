@@ -493,7 +493,8 @@ def run_commit(args, commit, log):
 def cmd_ab(args):
     """BASE and HEAD alternately on this machine, one repetition each per round, the order
     swapped every round (BASE HEAD, HEAD BASE, ...) so that a slow spell of the machine falls
-    on both; then `COMPARE OUT/base OUT/head` decides: exit 0 no regression, 1 a regression.
+    on both; then `COMPARE OUT/base OUT/head` decides: exit 0 no regression, 1 a regression,
+    2 when it gave no verdict (it refuses sets of different machines, threads or builds).
     When any repetition of either side shared the machine with other work
     (`contention.contended`), its timings measured the machine as much as the code: the answer
     is then inconclusive (exit 3), whatever the comparison said."""
@@ -530,9 +531,17 @@ def cmd_ab(args):
                                       shlex_quote(os.path.join(args.out, "head")),
                                       args.threshold)
     print("history ab: " + cmd, file=sys.stderr)
-    status = subprocess.run(cmd, shell=True).returncode
-    if status not in (0, 1):
-        return status  # the comparison itself failed (e.g. the sets' machines differ)
+    r = subprocess.run(cmd, shell=True, stdout=subprocess.PIPE, text=True)
+    sys.stdout.write(r.stdout)
+    sys.stdout.flush()
+    verdict = r.stdout.strip().split("\n")[-1] if r.stdout.strip() else ""
+    if r.returncode not in (0, 1) or (r.returncode == 1 and verdict != "REGRESSION"):
+        # The comparison gave no verdict (e.g. it refused sets whose machine, threads or build
+        # differ): an error, never a regression.
+        print("history ab: the comparison failed (exit %d) without a verdict" % r.returncode,
+              file=sys.stderr)
+        return 2
+    status = r.returncode
     contended = contended_repetitions(args.out)
     if contended:
         print("INCONCLUSIVE: %d repetitions shared the machine with other work (%s); the "

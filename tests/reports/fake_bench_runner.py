@@ -5,7 +5,8 @@ OUT`, run in a worktree of a scratch repository. Writes cell results of two cell
 $MCFBENCH_HISTORY_REPETITIONS repetitions and a deterministic +-1% jitter drawn from the commit
 and repetition, and appends the commit to $FAKE_RUNNER_LOG, so a test counts the runs. A commit
 whose tree holds broken.txt fails as one that does not build would (exit 3, after logging the
-run); with $FAKE_RUNNER_CONTENDED=1 every repetition says it shared the machine."""
+run); with $FAKE_RUNNER_CONTENDED=1 every repetition says it shared the machine; with
+$FAKE_RUNNER_HEAD_THREADS=N the head side of `history ab` ($MCFBENCH_HISTORY_SIDE) ran N threads."""
 
 import hashlib
 import json
@@ -26,7 +27,10 @@ contended = os.environ.get("FAKE_RUNNER_CONTENDED") == "1"
 # its machine folder before it runs anything.
 cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
             if line.startswith("model name")), "unknown")
-env = {"commit": commit[:12], "cpu": cpu, "cores": os.cpu_count(), "threads": 2,
+threads = 2
+if os.environ.get("MCFBENCH_HISTORY_SIDE") == "head" and os.environ.get("FAKE_RUNNER_HEAD_THREADS"):
+    threads = int(os.environ["FAKE_RUNNER_HEAD_THREADS"])
+env = {"commit": commit[:12], "cpu": cpu, "cores": os.cpu_count(), "threads": threads,
        "blas_threads": 2, "build": {"type": "Release", "compiler": "fake"}, "hostname": "h"}
 for cell, base in (("slowed", speed), ("steady", 1.0)):
     for r in range(reps):

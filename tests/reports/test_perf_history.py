@@ -247,6 +247,11 @@ def test_repository(work, mcfbench):
                  "ab_contended_same", *common, *cmp, expect=3,
                  env={"FAKE_RUNNER_CONTENDED": "1"})
         check("INCONCLUSIVE" in r.stdout, "also where the timings agree")
+        # Sides that ran differently (threads, machine, build): an error, never a regression.
+        r = tool(work, "ab", config, commits[0], commits[-1], "--rounds", "5", "--out",
+                 "ab_threads", *common, *cmp, expect=2, env={"FAKE_RUNNER_HEAD_THREADS": "1"})
+        check("without a verdict" in r.stderr and "threads" in r.stderr,
+              "ab of sides with different thread counts is an error (exit 2), not a regression")
         runs(work)
 
 
