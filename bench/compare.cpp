@@ -412,14 +412,13 @@ void store_in_history(const ResultSet& set, const std::string& store) {
   // The history store keys the set by machine, commit and config (reports/perf_history.py
   // `add`), as `history run` does; the commit's date and parents come from the git repository of
   // the current folder.
-  const ProgramResult r =
-      run_program({"/usr/bin/python3", history_script(), "add",
-                   set.study.empty() ? std::string("compare") : set.study, set.dir, "--store",
-                   store, "--commit", set.commit});
+  const ProgramResult r = run_program({"/usr/bin/python3", history_script(), "add",
+                                       set.study.empty() ? std::string("compare") : set.study,
+                                       set.dir, "--store", store, "--commit", set.commit});
   std::printf("%s", r.out.c_str());
   if (!r.ok())
-    throw std::runtime_error("--history: storing " + set.dir + " (" + set.commit + ") in " +
-                             store + " failed" +
+    throw std::runtime_error("--history: storing " + set.dir + " (" + set.commit + ") in " + store +
+                             " failed" +
                              (r.start_error.empty() ? " (exit " + std::to_string(r.status) + ")"
                                                     : ": " + r.start_error));
 }

@@ -1,7 +1,7 @@
 // Regression comparison: the Mann–Whitney test, a 2x slowdown flagged (synthetic and on a real
 // run's copy), a set compared with itself or with tiny noise stays quiet, accuracy losses are
-// flagged, NEW is stored in the history under its machine and commit; samples are per-repetition medians of steps 2..N, and
-// sets of different machines, threads or builds are refused.
+// flagged, NEW is stored in the history under its machine and commit; samples are per-repetition
+// medians of steps 2..N, and sets of different machines, threads or builds are refused.
 
 #include "bench/compare.h"
 
@@ -402,8 +402,7 @@ TEST(CompareCli, HistoryStoresNewUnderItsMachineAndCommit) {
                           "' && GIT_CONFIG_GLOBAL=/dev/null GIT_CONFIG_NOSYSTEM=1 git -c "
                           "user.name=t -c user.email=t@t ";
   ASSERT_EQ(std::system((git + "init -q && " + git + "commit -q --allow-empty -m one && " + git +
-                         "commit -q --allow-empty -m two && " + git +
-                         "rev-parse HEAD > head.txt")
+                         "commit -q --allow-empty -m two && " + git + "rev-parse HEAD > head.txt")
                             .c_str()),
             0);
   std::string head = slurp(dir / "head.txt");

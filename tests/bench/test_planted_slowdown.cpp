@@ -12,7 +12,8 @@ TEST(PlantedSlowdown, StepsLastOnePlusFTimesTheirWorkAndTheResultSaysSo) {
   const fs::path dir = fresh_dir("planted_slowdown");
   Command c = mcfbench("flow --mesh icosphere:level=2 --steps 3 --out plain", dir);
   ASSERT_EQ(c.status, 0) << c.err;
-  EXPECT_FALSE(read_json(dir / "plain" / "result.json")["environment"].contains("planted_slowdown"));
+  EXPECT_FALSE(
+      read_json(dir / "plain" / "result.json")["environment"].contains("planted_slowdown"));
   c = mcfbench("flow --mesh icosphere:level=2 --steps 3 --out slowed", dir,
                "MCFBENCH_PLANTED_SLOWDOWN=1 ");
   ASSERT_EQ(c.status, 0) << c.err;
@@ -23,8 +24,8 @@ TEST(PlantedSlowdown, StepsLastOnePlusFTimesTheirWorkAndTheResultSaysSo) {
     // The phases are timed inside the step's own work, which the delay then doubles: an
     // inequality that holds whatever the machine's speed.
     const auto& t = s["seconds"];
-    const double work = t["update"].get<double>() + t["solve"].get<double>() +
-                        t["evaluate"].get<double>();
+    const double work =
+        t["update"].get<double>() + t["solve"].get<double>() + t["evaluate"].get<double>();
     EXPECT_GE(t["total"].get<double>(), 2 * work) << s.dump();
   }
   c = mcfbench("flow --mesh icosphere:level=2 --steps 3 --out bad", dir,
