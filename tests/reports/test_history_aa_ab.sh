@@ -8,16 +8,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$1
-head=$(git -C "$root" rev-parse HEAD 2>/dev/null) || { echo "SKIP: not a git checkout"; exit 77; }
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-mkdir -p "$work/builds/$head"
-ln -s "$bin" "$work/builds/$head/mcfbench"
-cat >"$work/tiny.json" <<'JSON'
-{"name": "tiny", "defaults": {"mesh": "icosphere:level=2", "steps": 3, "dt": 1e-4, "threads": 1},
- "axes": {"solver.name": ["cholmod", "pcg"]},
- "quick": {"defaults": {"steps": 3}}}
-JSON
+. "$(dirname "$0")/history_head_setup.sh"
 status=0
 AA_TRIALS=1 AB_TRIALS=1 MCFBENCH_GATE_ROUNDS=2 AA_AB_OUT=$work/out MCFBENCH_GATE_REPO=$root \
   MCFBENCH_HISTORY_BUILDS=$work/builds MCFBENCH_GATE_COMPARE="$bin compare" \
