@@ -32,7 +32,7 @@ import json, sys
 try:
     print(json.loads(json.load(open(sys.argv[1]))["context"]["mcfbench_environment"])["commit"])
 except (KeyError, ValueError, TypeError):
-    sys.exit("run_micro.sh: %s records no mcfbench_environment: rebuild mcfbench_micro" % sys.argv[2])
+    sys.exit("run_micro.sh: %s wrote no mcfbench_environment: no benchmark ran, or it was built before it recorded one" % sys.argv[2])
 ' "$tmp" "$bin")
 out="$out_dir/$commit.json"
 mv "$tmp" "$out"  # a killed run leaves no half-written file under the commit's name

@@ -10,7 +10,7 @@ bin=$1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 MCFBENCH_BUILD=$(dirname "$bin") MCFBENCH_MICRO_OUT=$work/micro MCFBENCH_HISTORY_STORE=$work/store \
-  MCFBENCH_STREAM_MB=1 bash "$root/benchmarks/run_micro.sh" --benchmark_filter='BM_StreamCopy/1$' \
+  MCFBENCH_STREAM_MB=1 bash "$root/benchmarks/run_micro.sh" --benchmark_filter='BM_StreamCopy/1/' \
   --benchmark_repetitions=3 --benchmark_min_time=0.01 >"$work/log" 2>&1 \
   || { cat "$work/log"; echo "FAIL: run_micro.sh"; exit 1; }
 file=$(ls "$work"/micro/*.json)
