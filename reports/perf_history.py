@@ -649,7 +649,8 @@ def cmd_add(args):
         e = store_micro_set(args.store, name, args.results, info)
     else:
         e = store_result_set(args.store, name, args.results, info, args.commit)
-    print("history: stored %s under %s" % (commit, os.path.join(args.store, e["machine"], name)))
+    print("history: stored %s under %s" % (info["commit"],
+                                            os.path.join(args.store, e["machine"], name)))
     return 0
 
 
