@@ -24,6 +24,7 @@ aa=${AA_TRIALS:-20}
 ab=${AB_TRIALS:-5}
 planted=${PLANTED_SLOWDOWN:-0.3}
 out=$(realpath -m "${AA_AB_OUT:-out/history-aa-ab}")
+unset MCFBENCH_PLANTED_SLOWDOWN  # only the A/B head side is slowed, by the runner below
 rm -rf "$out"
 mkdir -p "$out"
 
