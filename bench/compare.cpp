@@ -1,13 +1,13 @@
 #include "bench/compare.h"
 
 #include "bench/experiment_config.h"
+#include "bench/history_tool.h"
+#include "bench/subprocess.h"
 #include "bench/timing_summary.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -426,19 +426,19 @@ std::string compare_markdown(const CompareReport& r, const ResultSet& old_set,
   return md.str();
 }
 
-/// One line for the history file: {commit, date, study, dir, metric, machine (the first cell's
-/// identity), cells: {key: {label, median, repetitions}}}.
-json history_entry(const ResultSet& set, const std::string& metric) {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  char date[32];
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  json cells = json::object();
-  for (const auto& [key, c] : set.cells)
-    cells[key] = {
-        {"label", c.label}, {"median", median(c.values)}, {"repetitions", c.values.size()}};
-  const json machine = set.cells.empty() ? json::object() : set.cells.begin()->second.identity;
-  return {{"commit", set.commit}, {"date", date},       {"study", set.study}, {"dir", set.dir},
-          {"metric", metric},     {"machine", machine}, {"cells", cells}};
+void store_in_history(const ResultSet& set, const std::string& store) {
+  // The history store keys the set by machine, commit and config (reports/perf_history.py
+  // `add`), as `history run` does; the commit's date and parents come from the git repository of
+  // the current folder.
+  const ProgramResult r = run_program({"/usr/bin/python3", history_script(), "add",
+                                       set.study.empty() ? std::string("compare") : set.study,
+                                       set.dir, "--store", store, "--commit", set.commit});
+  std::printf("%s", r.out.c_str());
+  if (!r.ok())
+    throw std::runtime_error("--history: storing " + set.dir + " (" + set.commit + ") in " + store +
+                             " failed" +
+                             (r.start_error.empty() ? " (exit " + std::to_string(r.status) + ")"
+                                                    : ": " + r.start_error));
 }
 
 }  // namespace
@@ -449,14 +449,8 @@ int compare_and_record(const CompareRequest& request) {
   const ResultSet new_set = load_result_set(request.new_dir, o.metric);
   const CompareReport r = compare_results(old_set, new_set, o);
   std::printf("%s", compare_markdown(r, old_set, new_set, o).c_str());
-  if (request.append_history) {
-    const std::string file = request.history.empty() ? "results/history.jsonl" : request.history;
-    const fs::path p(file);
-    if (p.has_parent_path()) fs::create_directories(p.parent_path());
-    std::ofstream out(file, std::ios::app);
-    out << history_entry(new_set, o.metric).dump() << "\n";
-    if (!out) throw std::runtime_error(file + ": cannot append");
-  }
+  if (request.store_history)
+    store_in_history(new_set, request.history.empty() ? "benchmarks/history" : request.history);
   return r.regression ? 1 : 0;
 }
 

@@ -93,13 +93,12 @@ struct CompareReport {
 struct CompareRequest {
   std::string old_dir, new_dir;  ///< DIR[@COMMIT] each
   CompareOptions options;
-  bool append_history = false;  ///< append history_entry(NEW) as one line to `history`
-  std::string history;          ///< empty: results/history.jsonl
+  bool store_history = false;  ///< store NEW in the history `history` (store_in_history)
+  std::string history;         ///< empty: benchmarks/history
 };
 
-/// compare as a whole: loads both sets, prints the Markdown comparison on stdout, appends NEW's
-/// history line when asked (creating its folder; throws if it cannot). Returns 1 on a
-/// regression, else 0.
+/// compare as a whole: loads both sets, prints the Markdown comparison on stdout, stores NEW in
+/// the history when asked (throws if it cannot). Returns 1 on a regression, else 0.
 int compare_and_record(const CompareRequest& request);
 
 /// Two-sided p-value of the Mann–Whitney U test (normal approximation, tie-corrected, with

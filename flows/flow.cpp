@@ -5,6 +5,7 @@
 #include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
 #include "flows/integrator.h"
+#include "flows/planted_slowdown.h"
 #include "flows/predicted_start.h"
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
@@ -482,6 +483,7 @@ bool FlowRun::advance(int step) {
   }
   x_ = std::move(x_new);  // for a one-step scheme this frees X_{n-1}
   V_ = std::move(V_new);
+  plant_slowdown(step_start);  // a no-op unless $MCFBENCH_PLANTED_SLOWDOWN is set
   record["seconds"] = {{"update", ctx_->update_seconds_},
                        {"solve", ctx_->solve_seconds_},
                        {"evaluate", evaluate_seconds},

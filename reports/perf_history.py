@@ -5,7 +5,8 @@ step detection, bisection and a static dashboard.
 usage: /usr/bin/python3 reports/perf_history.py COMMAND ...   (scripts/history.sh wraps it)
 
   run CONFIG (A..B|C|--last N)   build and run the commits, store each result set
-  add CONFIG RESULTS_DIR         store a result set measured elsewhere (`mcfbench run` output)
+  add CONFIG RESULTS             store a result set measured elsewhere (`mcfbench run` output,
+                                 or mcfbench_micro's JSON: benchmarks/run_micro.sh does this)
   detect                         step changes per (benchmark, machine) series
   bisect CONFIG --good A --bad B the first commit of A..B that is slower than A
   ab CONFIG BASE HEAD --out DIR  BASE and HEAD alternated over rounds, then `mcfbench compare`
@@ -22,8 +23,9 @@ after the first (the cell's timing.step_median_seconds), so a commit has as many
 repetitions. Series are ordered by git (parents, then commit date), never by arrival.
 
 The runner of a commit is pluggable (--runner CMD): it is run as `CMD CONFIG OUT` in a git
-worktree checked out at the commit, with MCFBENCH_HISTORY_COMMIT (40 hex) and
-MCFBENCH_HISTORY_REPETITIONS set, and must leave the cell results (JSON files with "cell",
+worktree checked out at the commit, with MCFBENCH_HISTORY_COMMIT (40 hex),
+MCFBENCH_HISTORY_REPETITIONS and MCFBENCH_HISTORY_SIDE (base or head under `ab`, else empty)
+set, and must leave the cell results (JSON files with "cell",
 "environment" and "steps" or "timing") in OUT. The default, scripts/history_runner.sh, builds the
 commit (a build folder cached per commit) and runs the config's --quick variant.
 """
@@ -223,15 +225,35 @@ def read_results(folder):
     return out
 
 
-def store_result_set(store, config_name, results_dir, info):
-    """Stores the cell results of `results_dir` as the entry of commit info['commit']; returns
-    the entry. All cells must share one machine identity (else they are not one series)."""
-    results = read_results(results_dir)
+def read_results_of(folder, commit):
+    """read_results(folder), only the results of `commit` (a prefix of either way) when given."""
+    results = read_results(folder)
+    if commit:
+        results = [(n, r) for n, r in results
+                   if str((r.get("environment") or {}).get("commit", "")).startswith(commit[:12])
+                   or commit.startswith(str((r.get("environment") or {}).get("commit", "-")))]
+    return results
+
+
+def refuse_planted(path, environment):
+    """A run slowed on purpose ($MCFBENCH_PLANTED_SLOWDOWN, scripts/history_aa_ab.sh) measured
+    the plant, not the commit: it never enters a history."""
+    if environment.get("planted_slowdown"):
+        fail("%s: ran with a planted slowdown of %s (MCFBENCH_PLANTED_SLOWDOWN); not stored" %
+             (path, environment["planted_slowdown"]))
+
+
+def store_result_set(store, config_name, results_dir, info, commit=""):
+    """Stores the cell results of `results_dir` (only those of `commit` when given) as the entry
+    of commit info['commit']; returns the entry. All cells must share one machine identity
+    (else they are not one series)."""
+    results = read_results_of(results_dir, commit)
     if not results:
-        fail("%s: no cell results" % results_dir)
+        fail("%s: no cell results%s" % (results_dir, " of " + commit if commit else ""))
     identity = machine_identity(results[0][1])
     benchmarks = {}
     for name, r in results:
+        refuse_planted(os.path.join(results_dir, name), r.get("environment") or {})
         if machine_identity(r) != identity:
             fail("%s: cells of different machines, threads or builds in one set" % results_dir)
         cell = r["cell"]
@@ -244,6 +266,21 @@ def store_result_set(store, config_name, results_dir, info):
         if s is not None:
             b["samples"].append(s)
             b["contended"].append(bool((r.get("contention") or {}).get("contended")))
+
+    def copy(target):
+        if os.path.abspath(target) == os.path.abspath(results_dir):
+            return
+        shutil.rmtree(target, ignore_errors=True)
+        os.makedirs(target)
+        for name, _ in results:
+            shutil.copy(os.path.join(results_dir, name), os.path.join(target, name))
+
+    return write_entry(store, config_name, identity, benchmarks, info, copy)
+
+
+def write_entry(store, config_name, identity, benchmarks, info, copy, metric="seconds.total"):
+    """Writes STORE/<machine>/machine.json, the raw results (`copy(folder)`) and the entry
+    STORE/<machine>/<config>/<commit>.json (atomically, last); returns the entry."""
     for b in benchmarks.values():
         # Repetitions that shared the machine with other work measured the machine as much as
         # the code: the median leaves them out while any repetition ran alone.
@@ -254,13 +291,8 @@ def store_result_set(store, config_name, results_dir, info):
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(store, mid, "machine.json"), "w") as f:
         json.dump(identity, f, indent=1, sort_keys=True)
-    target = os.path.join(folder, info["commit"])
-    if os.path.abspath(target) != os.path.abspath(results_dir):
-        shutil.rmtree(target, ignore_errors=True)
-        os.makedirs(target)
-        for name, _ in results:
-            shutil.copy(os.path.join(results_dir, name), os.path.join(target, name))
-    entry = dict(info, schema=1, config=config_name, machine=mid, metric="seconds.total",
+    copy(os.path.join(folder, info["commit"]))
+    entry = dict(info, schema=1, config=config_name, machine=mid, metric=metric,
                  repetitions=max((len(b["samples"]) for b in benchmarks.values()), default=0),
                  benchmarks=benchmarks)
     tmp = os.path.join(folder, info["commit"] + ".json.tmp")
@@ -268,6 +300,65 @@ def store_result_set(store, config_name, results_dir, info):
         json.dump(entry, f, indent=1, sort_keys=True)
     os.replace(tmp, os.path.join(folder, info["commit"] + ".json"))
     return entry
+
+
+# Google Benchmark's time units in seconds.
+TIME_UNITS = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}
+
+
+def micro_environment(path, data):
+    """The mcfbench environment that mcfbench_micro writes into its context
+    (benchmarks/micro_context.cpp): the same machine identity and commit as a result.json."""
+    text = (data.get("context") or {}).get("mcfbench_environment")
+    try:
+        env = json.loads(text) if isinstance(text, str) else None
+    except ValueError:
+        env = None
+    if not isinstance(env, dict):
+        fail("%s: no context.mcfbench_environment (not mcfbench_micro's output, or a "
+             "mcfbench_micro built before it recorded its machine)" % path)
+    return env
+
+
+def store_micro_set(store, config_name, path, info):
+    """Stores a Google Benchmark JSON file of mcfbench_micro (benchmarks/run_micro.sh) as the
+    entry of info['commit']: one benchmark per run name, one sample per repetition (its real
+    time in seconds; aggregates are left out, they are functions of the repetitions). Benchmarks
+    of an earlier entry of the same commit that this file did not run (another
+    --benchmark_filter) are kept."""
+    try:
+        with open(path) as f:
+            data = json.load(f)
+    except (OSError, ValueError) as e:
+        fail("%s: %s" % (path, e))
+    env = micro_environment(path, data)
+    refuse_planted(path, env)
+    identity = {k: v for k, v in env.items() if k in IDENTITY_KEYS}
+    benchmarks = {}
+    for b in data.get("benchmarks") or []:
+        if b.get("run_type", "iteration") != "iteration" or b.get("error_occurred"):
+            continue
+        unit = TIME_UNITS.get(b.get("time_unit", "ns"))
+        if unit is None or not isinstance(b.get("real_time"), (int, float)):
+            fail("%s: benchmark %s: no real_time in a known unit" % (path, b.get("name")))
+        e = benchmarks.setdefault(b.get("run_name") or b["name"],
+                                  {"key": b.get("run_name") or b["name"], "samples": [],
+                                   "contended": [], "failed": 0})
+        e["samples"].append(b["real_time"] * unit)
+        e["contended"].append(False)
+    if not benchmarks:
+        fail("%s: no benchmark results" % path)
+    earlier = find_entry(store, config_name, info["commit"], machine_id(identity))
+    for name, b in ((earlier or {}).get("benchmarks") or {}).items():
+        benchmarks.setdefault(name, b)
+
+    def copy(target):
+        os.makedirs(target, exist_ok=True)
+        if os.path.abspath(os.path.dirname(path)) != os.path.abspath(target):
+            shutil.copy(path, os.path.join(target, os.path.basename(path)))
+
+    return write_entry(store, config_name, identity, benchmarks, info, copy,
+                       metric="real_time")
 
 
 def load_store(store):
@@ -369,10 +460,11 @@ class RunnerFailed(Exception):
     pass
 
 
-def run_in(args, worktree, commit, out, repetitions):
-    """Runs the runner in `worktree` (checked out at `commit`) into the folder `out`."""
+def run_in(args, worktree, commit, out, repetitions, side=""):
+    """Runs the runner in `worktree` (checked out at `commit`) into the folder `out`; `side`
+    (base or head, for `ab`) goes to it as $MCFBENCH_HISTORY_SIDE."""
     env = dict(os.environ, MCFBENCH_HISTORY_COMMIT=commit,
-               MCFBENCH_HISTORY_REPETITIONS=str(repetitions))
+               MCFBENCH_HISTORY_REPETITIONS=str(repetitions), MCFBENCH_HISTORY_SIDE=side)
     cmd = args.runner + " " + " ".join(shlex_quote(x) for x in (os.path.abspath(args.config),
                                                                 os.path.abspath(out)))
     r = subprocess.run(cmd, shell=True, cwd=worktree, env=env)
@@ -401,7 +493,11 @@ def run_commit(args, commit, log):
 def cmd_ab(args):
     """BASE and HEAD alternately on this machine, one repetition each per round, the order
     swapped every round (BASE HEAD, HEAD BASE, ...) so that a slow spell of the machine falls
-    on both; then `COMPARE OUT/base OUT/head` decides (exit 1: a regression)."""
+    on both; then `COMPARE OUT/base OUT/head` decides: exit 0 no regression, 1 a regression,
+    2 when it gave no verdict (it refuses sets of different machines, threads or builds).
+    When any repetition of either side shared the machine with other work
+    (`contention.contended`), its timings measured the machine as much as the code: the answer
+    is then inconclusive (exit 3), whatever the comparison said."""
     commits = [git(args.repo, "rev-parse", c + "^{commit}") for c in (args.base, args.head)]
     work = tempfile.mkdtemp(prefix="mcfbench-ab-")
     trees = []
@@ -420,7 +516,7 @@ def cmd_ab(args):
                 os.makedirs(tmp)
                 print("history ab: round %d/%d, %s %s" % (r + 1, args.rounds, side,
                                                           commits[k][:12]), file=sys.stderr)
-                run_in(args, trees[k], commits[k], tmp, 1)
+                run_in(args, trees[k], commits[k], tmp, 1, side)
                 # Each round's cells become one more repetition of the same cell keys.
                 for name, res in read_results(tmp):
                     res["cell"]["repetition"] = r
@@ -435,7 +531,40 @@ def cmd_ab(args):
                                       shlex_quote(os.path.join(args.out, "head")),
                                       args.threshold)
     print("history ab: " + cmd, file=sys.stderr)
-    return subprocess.run(cmd, shell=True).returncode
+    r = subprocess.run(cmd, shell=True, stdout=subprocess.PIPE, text=True)
+    sys.stdout.write(r.stdout)
+    sys.stdout.flush()
+    verdict = r.stdout.strip().split("\n")[-1] if r.stdout.strip() else ""
+    if r.returncode not in (0, 1) or (r.returncode == 1 and verdict != "REGRESSION"):
+        # The comparison gave no verdict (e.g. it refused sets whose machine, threads or build
+        # differ): an error, never a regression.
+        print("history ab: the comparison failed (exit %d) without a verdict" % r.returncode,
+              file=sys.stderr)
+        return 2
+    status = r.returncode
+    contended = contended_repetitions(args.out)
+    if contended:
+        print("INCONCLUSIVE: %d repetitions shared the machine with other work (%s); the "
+              "comparison above is not a verdict on the code. Rerun on a quiet machine." %
+              (len(contended), ", ".join(contended[:4]) + (" ..." if len(contended) > 4 else "")))
+        return INCONCLUSIVE
+    return status
+
+
+# Exit status of `ab` (and of scripts/perf_gate.sh) when the machine was not quiet enough to
+# judge: distinct from 0 (no regression), 1 (a regression) and 2 (usage or run errors).
+INCONCLUSIVE = 3
+
+
+def contended_repetitions(out):
+    """'side/file' of each cell result under OUT/base and OUT/head whose contention.contended
+    is true."""
+    found = []
+    for side in ("base", "head"):
+        for name, r in read_results(os.path.join(out, side)):
+            if (r.get("contention") or {}).get("contended"):
+                found.append("%s/%s" % (side, name))
+    return found
 
 
 def shlex_quote(s):
@@ -488,32 +617,63 @@ def cmd_run(args):
 
 
 def cmd_add(args):
-    commits = {machine_identity(r).get("commit") or (r.get("environment") or {}).get("commit")
-               for _, r in read_results(args.results)}
+    """Stores a result folder of `mcfbench run` (its cells; --commit picks one commit's of a
+    shared folder), or a JSON file of mcfbench_micro, as the entry of the commit it measured."""
+    if os.path.isfile(args.results):
+        with open(args.results) as f:
+            try:
+                env = micro_environment(args.results, json.load(f))
+            except ValueError as e:
+                fail("%s: %s" % (args.results, e))
+        commits = {env.get("commit")}
+    elif os.path.isdir(args.results):
+        commits = {(r.get("environment") or {}).get("commit")
+                   for _, r in read_results_of(args.results, args.commit)}
+    else:
+        fail("%s: no such result folder or file" % args.results)
     commits.discard(None)
     if len(commits) != 1:
-        fail("%s: results of %d commits (%s); one set per commit" %
+        fail("%s: results of %d commits (%s); one set per commit (--commit C picks one)" %
              (args.results, len(commits), " ".join(sorted(commits))))
     commit = commits.pop()
     if "dirty" in commit:
         fail("%s: results of uncommitted code (%s) have no place in a commit history" %
              (args.results, commit))
-    info = commit_info(args.repo, commit)
-    e = store_result_set(args.store, args.name or config_name_of(args.config), args.results, info)
-    print("history: stored %s under %s" % (commit, os.path.join(args.store, e["machine"])))
+    try:
+        info = commit_info(args.repo, commit)
+    except subprocess.CalledProcessError:
+        fail("%s: commit %s is not in the repository %s (--repo)" % (args.results, commit,
+                                                                     args.repo))
+    name = args.name or config_name_of(args.config)
+    if os.path.isfile(args.results):
+        e = store_micro_set(args.store, name, args.results, info)
+    else:
+        e = store_result_set(args.store, name, args.results, info, args.commit)
+    print("history: stored %s under %s" % (info["commit"],
+                                            os.path.join(args.store, e["machine"], name)))
     return 0
 
 
 def cmd_bisect(args):
     """Binary search for the first commit of good..bad slower than `good` by more than half the
     threshold (or, when `bad` is in the store, than the geometric middle of the two). Runs good
-    (unless stored) and one commit per halving: at most 1 + ceil(log2(len(good..bad)))."""
+    (unless stored) and one commit per halving: at most 1 + ceil(log2(len(good..bad))) when
+    every commit runs.
+
+    A commit whose runner fails (it does not build, or its run errors) is skipped, as
+    `git bisect skip` does: the untested commit of the range nearest the middle is tried
+    instead. When only skipped commits are left between the last good and the first bad one,
+    the answer is that range (exit 3), not a guess."""
     candidates = commit_range(args.repo, args.good + ".." + args.bad)
     if not candidates:
         fail("%s..%s holds no commit" % (args.good, args.bad))
     good = git(args.repo, "rev-parse", args.good + "^{commit}")
     state, log = {"machine": guess_machine(args)}, []
-    g = measure(args, good, state, log)
+    try:
+        g = measure(args, good, state, log)
+    except RunnerFailed as e:
+        fail("the good end %s does not run, so nothing can be compared with it: %s" %
+             (good[:12], e))
     names = [n for n, b in g["benchmarks"].items() if b["median"] and args.benchmark in n]
     if not names:
         fail("no benchmark of %s matches %r" % (good[:12], args.benchmark))
@@ -528,11 +688,23 @@ def cmd_bisect(args):
         return any(((entry["benchmarks"].get(n) or {}).get("median") or 0) > cut[n]
                    for n in names)
 
-    lo, hi = 0, len(candidates) - 1  # the first bad one lies in candidates[lo..hi]
-    verdicts = []
+    # The first bad commit lies in candidates[lo..hi]: candidates[hi] is bad (the bad end is
+    # taken to be), everything before lo is good.
+    lo, hi = 0, len(candidates) - 1
+    verdicts, skipped = [], set()
     while lo < hi:
-        mid = (lo + hi) // 2
-        e = measure(args, candidates[mid], state, log)
+        untested = [i for i in range(lo, hi) if i not in skipped]
+        if not untested:
+            break
+        middle = (lo + hi) // 2
+        mid = min(untested, key=lambda i: (abs(i - middle), i))
+        try:
+            e = measure(args, candidates[mid], state, log)
+        except RunnerFailed as err:
+            print("history: skipped %s: %s" % (candidates[mid][:12], err), file=sys.stderr)
+            skipped.add(mid)
+            verdicts.append({"commit": candidates[mid], "skipped": True})
+            continue
         bad = is_bad(e)
         verdicts.append({"commit": candidates[mid], "bad": bad,
                          "medians": {n: e["benchmarks"].get(n, {}).get("median") for n in names}})
@@ -540,16 +712,30 @@ def cmd_bisect(args):
             hi = mid
         else:
             lo = mid + 1
-    first = candidates[lo]
-    info = commit_info(args.repo, first)
-    report = {"first_bad": first, "subject": info["subject"], "runs": len(log),
-              "run_commits": log, "good": good, "verdicts": verdicts, "cut": cut}
+    report = {"runs": len(log), "run_commits": log, "good": good, "verdicts": verdicts,
+              "cut": cut, "skipped": [candidates[i] for i in sorted(skipped)]}
+    if lo == hi:
+        first = candidates[lo]
+        info = commit_info(args.repo, first)
+        report.update(first_bad=first, subject=info["subject"], candidates=[first])
+        print("first bad commit: %s %s" % (first, info["subject"]))
+        status = 0
+    else:
+        # Only skipped commits lie before candidates[hi]: any of lo..hi can be the first bad.
+        ambiguous = candidates[lo:hi + 1]
+        report.update(first_bad=None, candidates=ambiguous)
+        print("the first bad commit is one of %d (the commits before the last could not be "
+              "run):" % len(ambiguous))
+        for c in ambiguous:
+            print("  %s %s%s" % (c, commit_info(args.repo, c)["subject"],
+                                 "  (skipped)" if candidates.index(c) in skipped else ""))
+        status = 3
     if args.json:
         with open(args.json, "w") as f:
             json.dump(report, f, indent=1)
-    print("first bad commit: %s %s" % (first, info["subject"]))
-    print("%d runs (of %d commits in the range)" % (len(log), len(candidates)))
-    return 0
+    print("%d runs (of %d commits in the range), %d skipped" % (len(log), len(candidates),
+                                                                len(skipped)))
+    return status
 
 
 # ----------------------------------------------------------------------------- detection
@@ -784,10 +970,13 @@ def dispatch(argv):
     p.add_argument("--last", type=int, default=0)
     common(p)
     runner(p)
-    p = sub.add_parser("add", help="store a result folder measured elsewhere")
-    p.add_argument("config")
-    p.add_argument("results")
+    p = sub.add_parser("add", help="store a result folder measured elsewhere, or a JSON file of "
+                       "mcfbench_micro")
+    p.add_argument("config", help="the config (its file name names the series) or a name")
+    p.add_argument("results", help="a result folder of `mcfbench run`, or mcfbench_micro's JSON")
     p.add_argument("--name", default="", help="config name (default: CONFIG's file name)")
+    p.add_argument("--commit", default="",
+                   help="store only the results of this commit (a folder holding several)")
     common(p)
     p = sub.add_parser("detect", help="step changes of every stored series")
     common(p)
@@ -795,7 +984,9 @@ def dispatch(argv):
     p.add_argument("--json", default="", help="also write the steps to this file")
     p.add_argument("--fail-on-regression", action="store_true",
                    help="exit 1 when a step is a slowdown")
-    p = sub.add_parser("bisect", help="first commit of GOOD..BAD slower than GOOD")
+    p = sub.add_parser("bisect", help="first commit of GOOD..BAD slower than GOOD; commits that "
+                       "do not build or run are skipped (exit 3 when only skipped ones are left "
+                       "and the answer is a range)")
     p.add_argument("config")
     p.add_argument("--good", required=True)
     p.add_argument("--bad", required=True)
@@ -805,7 +996,8 @@ def dispatch(argv):
     p.add_argument("--json", default="", help="also write the outcome to this file")
     common(p)
     runner(p)
-    p = sub.add_parser("ab", help="BASE and HEAD alternated over rounds, then compared")
+    p = sub.add_parser("ab", help="BASE and HEAD alternated over rounds, then compared (exit 0 "
+                       "pass, 1 regression, 3 inconclusive: a repetition shared the machine)")
     p.add_argument("config")
     p.add_argument("base")
     p.add_argument("head")

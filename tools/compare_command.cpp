@@ -1,7 +1,7 @@
 // `mcfbench compare OLD NEW`: the flags of the regression check between two result sets
 // (bench/compare.h: exit 1 when a cell got significantly slower or less accurate; sets of
-// different machines refused unless --allow-cross-machine), optionally appended to a history
-// file.
+// different machines refused unless --allow-cross-machine), NEW optionally stored in the
+// performance history (`mcfbench history`).
 
 #include "bench/compare.h"
 #include "tools/commands.h"
@@ -35,11 +35,12 @@ void add_compare_command(CLI::App& app, std::function<int()>& run) {
                 "Compare cells that ran on different machines, thread counts or builds (refused "
                 "otherwise)");
   cmd->add_option("--history", a->history,
-                  "Append one JSON line for NEW to this file (no value: results/history.jsonl)")
+                  "Store NEW in this history store, keyed by machine, commit and study (no "
+                  "value: benchmarks/history; see `mcfbench history`)")
       ->expected(0, 1);
   cmd->callback([cmd, a, &run] {
     run = [cmd, a]() -> int {
-      a->append_history = cmd->count("--history") > 0;
+      a->store_history = cmd->count("--history") > 0;
       return compare_and_record(*a);
     };
   });

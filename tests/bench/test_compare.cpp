@@ -1,7 +1,7 @@
 // Regression comparison: the Mann–Whitney test, a 2x slowdown flagged (synthetic and on a real
 // run's copy), a set compared with itself or with tiny noise stays quiet, accuracy losses are
-// flagged, history lines are appended; samples are per-repetition medians of steps 2..N, and
-// sets of different machines, threads or builds are refused.
+// flagged, NEW is stored in the history under its machine and commit; samples are per-repetition
+// medians of steps 2..N, and sets of different machines, threads or builds are refused.
 
 #include "bench/compare.h"
 
@@ -102,7 +102,7 @@ TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
   EXPECT_NE(c.out.find("same |"), std::string::npos)
       << "unchanged rows are listed with --all: " << c.out;
   EXPECT_NE(c.out.find("| solver.name=solver2 |"), std::string::npos) << c.out;
-  c = mcfbench("compare old slow --history hist/h.jsonl", dir);
+  c = mcfbench("compare old slow", dir);
   EXPECT_EQ(c.status, 1) << c.out << c.err;
   EXPECT_NE(c.out.find("solver.name=solver1"), std::string::npos) << c.out;
   EXPECT_NE(c.out.find("**slower**"), std::string::npos) << c.out;
@@ -113,13 +113,6 @@ TEST(CompareCli, FlagsSlowdownAndAccuracyLossOnly) {
   c = mcfbench("compare old worse --threshold 0.2", dir);
   EXPECT_EQ(c.status, 1) << c.out;
   EXPECT_NE(c.out.find("less accurate"), std::string::npos) << c.out;
-  c = mcfbench("compare old same --history hist/h.jsonl", dir);
-  const std::string hist = slurp(dir / "hist" / "h.jsonl");
-  ASSERT_EQ(std::count(hist.begin(), hist.end(), '\n'), 2);
-  const json line = json::parse(hist.substr(hist.find('\n') + 1));
-  EXPECT_EQ(line["commit"], "bbbb");
-  EXPECT_EQ(line["cells"].size(), 3u);
-  EXPECT_TRUE(line.contains("date"));
   // A folder holding two commits needs DIR@COMMIT.
   for (const auto& f : result_files(dir / "slow")) fs::copy_file(f, dir / "same" / f.filename());
   c = mcfbench("compare old same", dir);
@@ -397,11 +390,49 @@ TEST(CompareCli, RefusesDifferentMachinesThreadsOrBuilds) {
   c = mcfbench("compare old mixed", dir);
   EXPECT_NE(c.status, 0);
   EXPECT_NE(c.err.find("different machines"), std::string::npos) << c.err;
-  // The history line records the machine.
-  c = mcfbench("compare old old --history h.jsonl", dir);
-  const json line = json::parse(slurp(dir / "h.jsonl"));
-  EXPECT_EQ(line["machine"]["cpu"], "AMD EPYC");
-  EXPECT_EQ(line["machine"].contains("hostname"), false);
+}
+
+TEST(CompareCli, HistoryStoresNewUnderItsMachineAndCommit) {
+  // --history stores NEW in the history store (`mcfbench history add`): under its machine (the
+  // identity, not the host name), its study and its commit, with the commit's parents from the
+  // git repository of the current folder, one sample per repetition. A commit that the
+  // repository does not have is refused, naming the store.
+  const fs::path dir = fresh_dir("compare_history");
+  const std::string git = "cd '" + dir.string() +
+                          "' && GIT_CONFIG_GLOBAL=/dev/null GIT_CONFIG_NOSYSTEM=1 git -c "
+                          "user.name=t -c user.email=t@t ";
+  ASSERT_EQ(std::system((git + "init -q && " + git + "commit -q --allow-empty -m one && " + git +
+                         "commit -q --allow-empty -m two && " + git + "rev-parse HEAD > head.txt")
+                            .c_str()),
+            0);
+  std::string head = slurp(dir / "head.txt");
+  head = head.substr(0, head.find('\n'));
+  make_set(dir / "raw", head.substr(0, 12), 1.0, 0.03, 1.0, 1);
+  const json env = {{"cpu", "AMD EPYC"}, {"cores", 2}, {"threads", 2}, {"hostname", "a"}};
+  copy_set(dir / "raw", dir / "new", head.substr(0, 12), [&](json& r, int) {
+    const std::string commit = r["environment"]["commit"];
+    r["environment"] = env;
+    r["environment"]["commit"] = commit;
+  });
+  copy_set(dir / "new", dir / "old", "aaaa", [](json&, int) {});
+  Command c = mcfbench("compare old new --history store", dir);
+  ASSERT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("history: stored " + head), std::string::npos) << c.out;
+  std::vector<fs::path> entries;
+  for (const auto& m : fs::directory_iterator(dir / "store"))
+    if (fs::exists(m.path() / "synthetic" / (head + ".json")))
+      entries.push_back(m.path() / "synthetic" / (head + ".json"));
+  ASSERT_EQ(entries.size(), 1u);
+  const json entry = read_json(entries[0]);
+  EXPECT_EQ(entry["parents"].size(), 1u);
+  EXPECT_EQ(entry["benchmarks"]["solver.name=solver0"]["samples"].size(), size_t(kReps));
+  const json machine = read_json(entries[0].parent_path().parent_path() / "machine.json");
+  EXPECT_EQ(machine["cpu"], "AMD EPYC");
+  EXPECT_FALSE(machine.contains("hostname"));
+  c = mcfbench("compare new old --history store", dir);  // "aaaa" is no commit of the repository
+  EXPECT_NE(c.status, 0);
+  EXPECT_NE(c.err.find("--history: storing old (aaaa) in store failed"), std::string::npos)
+      << c.err;
 }
 
 }  // namespace

@@ -3,7 +3,10 @@
 OUT`, run in a worktree of a scratch repository. Writes cell results of two cells, "slowed"
 (its step time is the number in the worktree's speed.txt) and "steady" (always 1), with
 $MCFBENCH_HISTORY_REPETITIONS repetitions and a deterministic +-1% jitter drawn from the commit
-and repetition, and appends the commit to $FAKE_RUNNER_LOG, so a test counts the runs."""
+and repetition, and appends the commit to $FAKE_RUNNER_LOG, so a test counts the runs. A commit
+whose tree holds broken.txt fails as one that does not build would (exit 3, after logging the
+run); with $FAKE_RUNNER_CONTENDED=1 every repetition says it shared the machine; with
+$FAKE_RUNNER_HEAD_THREADS=N the head side of `history ab` ($MCFBENCH_HISTORY_SIDE) ran N threads."""
 
 import hashlib
 import json
@@ -16,11 +19,18 @@ reps = int(os.environ.get("MCFBENCH_HISTORY_REPETITIONS", "1"))
 speed = float(open("speed.txt").read())
 with open(os.environ["FAKE_RUNNER_LOG"], "a") as f:
     f.write(commit + "\n")
+if os.path.exists("broken.txt"):
+    print("fake_bench_runner: %s does not build" % commit[:12], file=sys.stderr)
+    sys.exit(3)
+contended = os.environ.get("FAKE_RUNNER_CONTENDED") == "1"
 # This computer's CPU model and core count, as mcfbench records them, so that the history finds
 # its machine folder before it runs anything.
 cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
             if line.startswith("model name")), "unknown")
-env = {"commit": commit[:12], "cpu": cpu, "cores": os.cpu_count(), "threads": 2,
+threads = 2
+if os.environ.get("MCFBENCH_HISTORY_SIDE") == "head" and os.environ.get("FAKE_RUNNER_HEAD_THREADS"):
+    threads = int(os.environ["FAKE_RUNNER_HEAD_THREADS"])
+env = {"commit": commit[:12], "cpu": cpu, "cores": os.cpu_count(), "threads": threads,
        "blas_threads": 2, "build": {"type": "Release", "compiler": "fake"}, "hostname": "h"}
 for cell, base in (("slowed", speed), ("steady", 1.0)):
     for r in range(reps):
@@ -32,6 +42,7 @@ for cell, base in (("slowed", speed), ("steady", 1.0)):
                "environment": env,
                "cell": {"key": "%s-%d" % (cell, r), "config_key": cell, "repetition": r,
                         "study": "fake", "assignment": {"solver.name": cell}},
-               "steps": steps, "timing": {"step_median_seconds": v}}
+               "steps": steps, "timing": {"step_median_seconds": v},
+               "contention": {"contended": contended}}
         with open(os.path.join(out, "%s-%d.json" % (cell, r)), "w") as f:
             json.dump(res, f)

@@ -7,16 +7,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$1
-head=$(git -C "$root" rev-parse HEAD 2>/dev/null) || { echo "SKIP: not a git checkout"; exit 77; }
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-mkdir -p "$work/builds/$head"
-ln -s "$bin" "$work/builds/$head/mcfbench"
-cat >"$work/tiny.json" <<'JSON'
-{"name": "tiny", "defaults": {"mesh": "icosphere:level=2", "steps": 3, "dt": 1e-4, "threads": 1},
- "axes": {"solver.name": ["cholmod", "pcg"]},
- "quick": {"defaults": {"steps": 3}}}
-JSON
+. "$(dirname "$0")/history_head_setup.sh"
 MCFBENCH_HISTORY_BUILDS=$work/builds bash "$root/scripts/history.sh" run "$work/tiny.json" HEAD \
   --repo "$root" --store "$work/store" --repetitions 3 >"$work/log" 2>&1 || { cat "$work/log"; echo "FAIL: history run"; exit 1; }
 entry=$(ls "$work"/store/*/tiny/"$head".json 2>/dev/null) || { cat "$work/log"; echo "FAIL: no entry for HEAD"; exit 1; }

@@ -90,8 +90,10 @@ def git(repo, *args):
                           text=True, env=GIT_ENV).stdout.strip()
 
 
-def scratch_repo(path):
-    """16 commits; commit PLANTED makes the 'slowed' benchmark 30% slower. Dates increase."""
+def scratch_repo(path, broken=()):
+    """16 commits; commit PLANTED makes the 'slowed' benchmark 30% slower. Dates increase. The
+    commits numbered in `broken` hold broken.txt: the stand-in runner fails on them as on a
+    commit that does not build."""
     os.makedirs(path)
     git(path, "init", "-q", "-b", "main")
     commits = []
@@ -100,6 +102,10 @@ def scratch_repo(path):
             f.write("1.3" if i >= PLANTED else "1.0")
         with open(os.path.join(path, "notes.txt"), "a") as f:
             f.write("change %d\n" % i)
+        if i in broken:
+            open(os.path.join(path, "broken.txt"), "w").close()
+        elif os.path.exists(os.path.join(path, "broken.txt")):
+            os.remove(os.path.join(path, "broken.txt"))
         git(path, "add", "-A")
         env = dict(GIT_ENV, GIT_AUTHOR_DATE="2026-01-%02dT12:00:00Z" % (i + 1),
                    GIT_COMMITTER_DATE="2026-01-%02dT12:00:00Z" % (i + 1),
@@ -111,8 +117,8 @@ def scratch_repo(path):
     return commits
 
 
-def tool(work, *args, expect=0):
-    env = dict(os.environ, FAKE_RUNNER_LOG=os.path.join(work, "runs.log"))
+def tool(work, *args, expect=0, env=None):
+    env = dict(os.environ, FAKE_RUNNER_LOG=os.path.join(work, "runs.log"), **(env or {}))
     r = subprocess.run(TOOL + list(args), cwd=work, env=env, capture_output=True, text=True)
     if r.returncode != expect:
         print(r.stdout + r.stderr)
@@ -233,6 +239,108 @@ def test_repository(work, mcfbench):
               "perf_gate.sh fails on the slowdown (exit %d)" % gate.returncode)
         if gate.returncode != 1:
             print(gate.stdout + gate.stderr)
+        # Repetitions that shared the machine make the answer inconclusive, not a regression.
+        r = tool(work, "ab", config, commits[0], commits[-1], "--rounds", "5", "--out",
+                 "ab_contended", *common, *cmp, expect=3, env={"FAKE_RUNNER_CONTENDED": "1"})
+        check("INCONCLUSIVE" in r.stdout, "ab on a contended machine says inconclusive")
+        r = tool(work, "ab", config, commits[PLANTED], commits[-1], "--rounds", "5", "--out",
+                 "ab_contended_same", *common, *cmp, expect=3,
+                 env={"FAKE_RUNNER_CONTENDED": "1"})
+        check("INCONCLUSIVE" in r.stdout, "also where the timings agree")
+        # Sides that ran differently (threads, machine, build): an error, never a regression.
+        r = tool(work, "ab", config, commits[0], commits[-1], "--rounds", "5", "--out",
+                 "ab_threads", *common, *cmp, expect=2, env={"FAKE_RUNNER_HEAD_THREADS": "1"})
+        check("without a verdict" in r.stderr and "threads" in r.stderr,
+              "ab of sides with different thread counts is an error (exit 2), not a regression")
+        runs(work)
+
+
+def test_bisect_skips(work):
+    """Commits that do not build are skipped as `git bisect skip` skips them: away from the step
+    the planted commit is still named; when the planted commit itself does not build, the answer
+    is the range of it and the next (exit 3), not a guess."""
+    config = os.path.join(work, "fake.json")
+    for broken, expect in (({12}, 0), ({PLANTED}, 3)):
+        repo = os.path.join(work, "repo_broken_%d" % min(broken))
+        commits = scratch_repo(repo, broken)
+        out = os.path.join(work, "bisect_broken_%d.json" % min(broken))
+        r = tool(work, "bisect", config, "--good", commits[0], "--bad", commits[-1], "--store",
+                 "store_broken_%d" % min(broken), "--repetitions", "3", "--json", out,
+                 "--repo", repo, "--runner", RUNNER, expect=expect)
+        o = json.load(open(out))
+        n = runs(work)
+        check(o["skipped"] == [commits[i] for i in sorted(broken)],
+              "bisect with commit %s not building skips it" % sorted(broken))
+        if expect == 0:
+            check(o["first_bad"] == commits[PLANTED] and n == 6,
+                  "one commit skipped away from the step: the planted commit named in 6 runs "
+                  "(%d)" % n)
+        else:
+            check(o["first_bad"] is None and o["candidates"] == commits[PLANTED:PLANTED + 2] and
+                  all(c in r.stdout for c in commits[PLANTED:PLANTED + 2]),
+                  "the planted commit not building: the answer is it and the next, exit 3")
+
+
+def micro_json(path, commit, benchmarks, context=True, planted=0):
+    """A Google Benchmark JSON file as mcfbench_micro writes it: three repetitions of each
+    benchmark (times in ms) with their aggregates, and the mcfbench environment in its context."""
+    env = {"commit": commit[:12], "cpu": "Synthetic CPU", "cores": 2, "threads": 2,
+           "blas_threads": 2, "hostname": "h", "build": {"type": "Release"}}
+    if planted:
+        env["planted_slowdown"] = planted
+    rows = []
+    for name, ms in benchmarks.items():
+        for r in range(3):
+            rows.append({"name": name, "run_name": name, "run_type": "iteration",
+                         "repetitions": 3, "repetition_index": r, "iterations": 10,
+                         "real_time": ms * (1 + 0.01 * (r - 1)), "cpu_time": ms,
+                         "time_unit": "ms"})
+        rows.append({"name": name + "_mean", "run_name": name, "run_type": "aggregate",
+                     "aggregate_name": "mean", "real_time": 99 * ms, "time_unit": "ms"})
+    ctx = {"host_name": "h", "num_cpus": 2}
+    if context:
+        ctx["mcfbench_environment"] = json.dumps(env)
+    with open(path, "w") as f:
+        json.dump({"context": ctx, "benchmarks": rows}, f)
+
+
+def test_micro(work):
+    """mcfbench_micro's JSON (benchmarks/run_micro.sh) stored by `add`: one series per
+    benchmark keyed by the machine in its context, samples are repetitions in seconds,
+    aggregates left out, a commit's earlier benchmarks kept when another filter ran, and
+    `detect` finds a planted step in it."""
+    repo = os.path.join(work, "repo")  # test_repository's scratch repository
+    commits = git(repo, "rev-list", "--reverse", "HEAD").split()
+    for i, c in enumerate(commits[:8]):
+        path = os.path.join(work, "micro_%d.json" % i)
+        micro_json(path, c, {"BM_Step/8": 2.0 * (1.3 if i >= 4 else 1.0), "BM_Update": 1.0})
+        tool(work, "add", "micro", path, "--store", "store_micro", "--repo", repo)
+    path = os.path.join(work, "micro_extra.json")
+    micro_json(path, commits[7], {"BM_Other": 5.0})
+    tool(work, "add", "micro", path, "--store", "store_micro", "--repo", repo)
+    series = ph.load_store(os.path.join(work, "store_micro"))
+    check(list(k[1] for k in series) == ["micro"] and
+          list(series.values())[0][0]["machine"].startswith("Synthetic-CPU-2c-2t-"),
+          "micro results form the series (machine, micro)")
+    entries = list(series.values())[0]
+    b = entries[0]["benchmarks"]["BM_Step/8"]
+    check([round(v, 9) for v in b["samples"]] == [0.00198, 0.002, 0.00202] and
+          abs(b["median"] - 0.002) < 1e-12,
+          "samples are the repetitions in seconds, aggregates left out")
+    check(sorted(entries[-1]["benchmarks"]) == ["BM_Other", "BM_Step/8", "BM_Update"],
+          "a second file of the same commit adds its benchmarks to the entry")
+    check([e["commit"] for e in entries] == commits[:8], "micro entries in git order")
+    tool(work, "detect", "--store", "store_micro", "--json", "micro_steps.json", "--alpha", "0.05")
+    steps = json.load(open(os.path.join(work, "micro_steps.json")))
+    check([(s["benchmark"], s["commit"]) for s in steps] == [("BM_Step/8", commits[4])],
+          "detect finds the micro step at its commit")
+    micro_json(path, commits[3], {"BM_Step/8": 1.0}, planted=0.3)
+    r = tool(work, "add", "micro", path, "--store", "store_micro", "--repo", repo, expect=2)
+    check("planted slowdown" in r.stderr, "a run with a planted slowdown is not stored")
+    micro_json(path, commits[3], {"BM_Step/8": 1.0}, context=False)
+    r = tool(work, "add", "micro", path, "--store", "store_micro", "--repo", repo, expect=2)
+    check("micro_extra.json" in r.stderr and "mcfbench_environment" in r.stderr,
+          "a file without the machine is refused, naming it")
 
 
 def main():
@@ -249,6 +357,8 @@ def main():
     try:
         test_contended_repetitions(work)
         test_repository(work, a.mcfbench)
+        test_bisect_skips(work)
+        test_micro(work)
     finally:
         if not a.keep:
             shutil.rmtree(work, ignore_errors=True)

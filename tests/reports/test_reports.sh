@@ -233,12 +233,5 @@ grep -q '^frames: cmcf: 21 cells saved frames, strips for 8 of them (at most 8, 
 grep '^Frame strips for 8 of the 21 cells that saved frames' "$work/strips/index.md" | grep -o 'cell [0-9]*' | tr '\n' ' ' |
   grep -qx 'cell 1 cell 2 cell 4 cell 5 cell 9 cell 10 cell 12 cell 13 cell 14 cell 15 cell 17 cell 18 cell 20 ' ||
   { grep '^Frame strips' "$work/strips/index.md"; echo "FAIL: index.md does not list the cells without a strip"; fail=1; }
-# Performance over commits: the history of two measured commits plots and tabulates a 2x change.
-printf '%s\n' '{"commit":"c1","benchmarks":{"BM_X":{"real_time":10}}}' '{"commit":"c2","benchmarks":{"BM_X":{"real_time":20}}}' \
-  >"$work/history.jsonl"
-"$py" "$root/reports/history.py" "$work/history.jsonl" "$work/hist" >"$work/hist_log" 2>&1 \
-  || { cat "$work/hist_log"; echo "FAIL: history.py"; fail=1; }
-ls "$work"/hist/history_*.png >/dev/null 2>&1 || { echo "FAIL: no history plot"; fail=1; }
-grep -q "| BM_X | 10 (c1) | 20 (c2) | 2.00 |" "$work/hist/history.md" || { echo "FAIL: history table lacks the 2x change"; fail=1; }
 [ $fail = 0 ] && echo "reports test passed: $(ls "$work"/out/*.png | wc -l) figures, $(ls "$work"/out/*.md | wc -l) Markdown files"
 exit $fail

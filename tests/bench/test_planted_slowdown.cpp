@@ -1,0 +1,38 @@
+// $MCFBENCH_PLANTED_SLOWDOWN (flows/planted_slowdown.h): each step lasts (1 + f) times its own
+// work, the result records f, and a malformed value stops the flow naming the variable.
+
+#include "bench_test_util.h"
+
+namespace mcf {
+namespace {
+
+using namespace mcf::test;
+
+TEST(PlantedSlowdown, StepsLastOnePlusFTimesTheirWorkAndTheResultSaysSo) {
+  const fs::path dir = fresh_dir("planted_slowdown");
+  Command c = mcfbench("flow --mesh icosphere:level=2 --steps 3 --out plain", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_FALSE(
+      read_json(dir / "plain" / "result.json")["environment"].contains("planted_slowdown"));
+  c = mcfbench("flow --mesh icosphere:level=2 --steps 3 --out slowed", dir,
+               "MCFBENCH_PLANTED_SLOWDOWN=1 ");
+  ASSERT_EQ(c.status, 0) << c.err;
+  const nlohmann::json r = read_json(dir / "slowed" / "result.json");
+  EXPECT_EQ(r["environment"]["planted_slowdown"], 1.0);
+  ASSERT_EQ(r["steps"].size(), 3u);
+  for (const auto& s : r["steps"]) {
+    // The phases are timed inside the step's own work, which the delay then doubles: an
+    // inequality that holds whatever the machine's speed.
+    const auto& t = s["seconds"];
+    const double work =
+        t["update"].get<double>() + t["solve"].get<double>() + t["evaluate"].get<double>();
+    EXPECT_GE(t["total"].get<double>(), 2 * work) << s.dump();
+  }
+  c = mcfbench("flow --mesh icosphere:level=2 --steps 3 --out bad", dir,
+               "MCFBENCH_PLANTED_SLOWDOWN=lots ");
+  EXPECT_NE(c.status, 0);
+  EXPECT_NE(c.err.find("MCFBENCH_PLANTED_SLOWDOWN=lots"), std::string::npos) << c.err;
+}
+
+}  // namespace
+}  // namespace mcf

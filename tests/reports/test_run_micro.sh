@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# benchmarks/run_micro.sh feeds the history store: one short micro-benchmark (STREAM copy on a
+# 1 MB array) is run, kept under the binary's commit and stored as the series (machine, micro)
+# with one sample per repetition; a binary built from uncommitted code keeps its file and is
+# not stored (a history holds commits).
+# usage: test_run_micro.sh MCFBENCH_MICRO
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+bin=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+MCFBENCH_BUILD=$(dirname "$bin") MCFBENCH_MICRO_OUT=$work/micro MCFBENCH_HISTORY_STORE=$work/store \
+  MCFBENCH_STREAM_MB=1 bash "$root/benchmarks/run_micro.sh" --benchmark_filter='BM_StreamCopy/1/' \
+  --benchmark_repetitions=3 --benchmark_min_time=0.01 >"$work/log" 2>&1 \
+  || { cat "$work/log"; echo "FAIL: run_micro.sh"; exit 1; }
+file=$(ls "$work"/micro/*.json)
+commit=$(basename "$file" .json)
+case $commit in
+  *dirty*)
+    grep -q "not stored" "$work/log" || { cat "$work/log"; echo "FAIL: a dirty build stored"; exit 1; }
+    [ ! -e "$work/store" ] || { echo "FAIL: a dirty build left a store"; exit 1; }
+    echo "ok: $commit (uncommitted code) kept in $file, not stored"; exit 0 ;;
+esac
+/usr/bin/python3 - "$work/store" "$commit" <<'PY'
+import glob, json, sys
+store, commit = sys.argv[1], sys.argv[2]
+entries = glob.glob("%s/*/micro/%s*.json" % (store, commit))
+assert len(entries) == 1, entries
+e = json.load(open(entries[0]))
+b = e["benchmarks"]["BM_StreamCopy/1/real_time"]
+assert len(b["samples"]) == 3 and b["median"] > 0 and e["metric"] == "real_time", b
+assert e["commit"].startswith(commit) and e["parents"], e
+m = json.load(open(glob.glob("%s/*/machine.json" % store)[0]))
+assert {"cpu", "cores", "threads", "build", "libraries"} <= set(m), m
+print("ok: %s stored with 3 samples on %s" % (commit, e["machine"]))
+PY
