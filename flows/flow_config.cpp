@@ -1,7 +1,11 @@
 #include "flows/flow_config.h"
 
+#include "flows/basis_registry.h"
 #include "flows/config_reader.h"
+#include "flows/flow_registry.h"
 #include "flows/integrator.h"
+#include "flows/preconditioner_registry.h"
+#include "flows/solver_registry.h"
 
 namespace mcf {
 
@@ -10,12 +14,12 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   FlowConfig c;
   c.mesh = r.get_string("mesh", "");
   if (c.mesh.empty()) r.fail("mesh", "missing (a mesh spec such as \"sphere:vertices=2000\")");
-  c.flow = r.get_string("flow", c.flow, {"mcf", "cmcf", "heat"});
-  c.basis = r.get_string("basis", c.basis, {"hat", "octree"});
+  c.flow = r.get_string("flow", c.flow, flow_table().names());
+  c.basis = r.get_string("basis", c.basis, basis_table().names());
   c.mass = r.get_string("mass", c.mass, {"consistent", "lumped"});
   {
     auto o = r.child("octree");
-    c.octree.tracking = o.get_string("tracking", c.octree.tracking, {"tracked", "rebuilt"});
+    c.octree.tracking = o.get_string("tracking", c.octree.tracking, tracking_table().names());
     c.octree.depth = int(o.get_integer("depth", c.octree.depth, 4, 10));
     c.octree.cubature = int(o.get_integer("cubature", c.octree.cubature, 1, 6));
     if (c.octree.cubature != 1 && c.octree.cubature != 3 && c.octree.cubature != 6)
@@ -30,23 +34,21 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   }
   {
     auto s = r.child("solver");
-    c.solver.name =
-        s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "petsc", "dense"});
-    // PETSc's default cap is the paper's baseline's: CG + AMG stopped at 3000 iterations.
-    if (c.solver.name == "petsc") c.solver.max_iterations = 3000;
+    c.solver.name = s.get_string("name", c.solver.name, solver_table().names());
+    c.solver.max_iterations = solver_row(c.solver.name).default_max_iterations;
     c.solver.tolerance =
         s.get_number("tolerance", c.solver.tolerance, 0, 1);  // absent: -1, the solver's default
     c.solver.max_iterations =
         int(s.get_integer("max_iterations", c.solver.max_iterations, 1, 100000000));
-    c.solver.preconditioner = s.get_string("preconditioner", c.solver.preconditioner,
-                                           {"none", "jacobi", "ichol", "multigrid"});
+    c.solver.preconditioner =
+        s.get_string("preconditioner", c.solver.preconditioner, preconditioner_table().names());
     c.solver.cycle = s.get_string("cycle", c.solver.cycle, {"V", "W"});
     c.solver.cycles = int(s.get_integer("cycles", c.solver.cycles, 1, 10000));
     c.solver.smooth = int(s.get_integer("smooth", c.solver.smooth, 0, 1000));
-    c.solver.stall_ratio = s.get_number("stall_ratio", c.solver.stall_ratio, 0, 1);
-    c.solver.fallback_tolerance =
-        s.get_number("fallback_tolerance", c.solver.fallback_tolerance, 1e-300, 1);
-    c.solver.petsc_options = s.get_string("petsc_options", c.solver.petsc_options);
+    // Each solver's own options, read whichever solver runs (validate_flow_config refuses those
+    // set for another solver where their row says so).
+    for (const SolverRow& row : solver_table().rows())
+      for (const OptionSpec& o : row.options) read_option(s, o, c);
     s.finish();
   }
   c.integrator = r.get_string("integrator", c.integrator, integrator_names());
@@ -60,7 +62,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   c.save_every = int(r.get_integer("save_every", c.save_every, 0, 100000000));
   c.repair_degenerate = r.get_bool("repair_degenerate", c.repair_degenerate);
   r.finish();
-  if (c.solver.tolerance < 0) c.solver.tolerance = c.solver.name == "multigrid" ? 0.0 : 1e-10;
+  if (c.solver.tolerance < 0) c.solver.tolerance = solver_row(c.solver.name).default_tolerance;
   validate_flow_config(c, source);
   return c;
 }
@@ -99,11 +101,7 @@ nlohmann::json to_json(const FlowConfig& c) {
   if (c.repair_degenerate) j["repair_degenerate"] = true;
   // A solver's own options only where that solver runs, for the same reason: the config keys of
   // the other solvers' cells stay those of versions without them.
-  if (c.solver.name == "petsc") j["solver"]["petsc_options"] = c.solver.petsc_options;
-  if (c.solver.name == "multigrid") {
-    j["solver"]["stall_ratio"] = c.solver.stall_ratio;
-    j["solver"]["fallback_tolerance"] = c.solver.fallback_tolerance;
-  }
+  for (const OptionSpec& o : solver_row(c.solver.name).options) j["solver"][o.key] = o.get(c);
   return j;
 }
 
@@ -111,25 +109,23 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   auto fail = [&](const std::string& key, const std::string& what) {
     throw ConfigError(source + ": " + key + ": " + what);
   };
-  const bool rebuilt = c.basis == "octree" && c.octree.tracking == "rebuilt";
+  const BasisRow& basis = basis_row(c.basis);
+  const bool fixed = !basis.fixed_functions || basis.fixed_functions(c);
   // Options no solver reads would be recorded as if they had shaped the run.
-  if (c.solver.name != "petsc" && !c.solver.petsc_options.empty())
-    fail("solver.petsc_options",
-         "applies to solver \"petsc\" only, the solver is \"" + c.solver.name + "\"");
+  for (const SolverRow& row : solver_table().rows())
+    if (row.name != c.solver.name)
+      for (const OptionSpec& o : row.options)
+        if (o.refused_elsewhere && o.get(c) != o.fallback)
+          fail("solver." + o.key, "applies to solver \"" + row.name + "\" only, the solver is \"" +
+                                      c.solver.name + "\"");
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
-  if (c.basis != "hat" && c.mass != "consistent")
+  if (!basis.takes_mass && c.mass != "consistent")
     fail("mass", "\"" + c.mass +
                      "\" applies to the hat basis only; the octree basis integrates its "
                      "consistent mass matrix by cubature");
-  if (rebuilt && c.flow == "cmcf")
-    fail("flow",
-         "cmcf keeps the stiffness of t=0, which needs a fixed basis; the rebuilt octree "
-         "changes its functions every step (use octree.tracking \"tracked\" or basis \"hat\")");
-  if (rebuilt && c.flow == "heat")
-    fail("flow",
-         "heat flow keeps the operators of t=0, which needs a fixed basis; the rebuilt "
-         "octree changes its functions every step");
-  if (rebuilt && (c.integrator == "bdf2" || c.integrator == "crank-nicolson"))
+  if (!fixed && !flow_row(c.flow).fixed_basis_reason.empty())
+    fail("flow", flow_row(c.flow).fixed_basis_reason);
+  if (!fixed && make_integrator(c.integrator, c.extrapolate)->uses_previous())
     fail("integrator",
          "two-step schemes need coefficients in one fixed basis; the rebuilt octree "
          "changes its functions every step");
@@ -154,7 +150,7 @@ MeshLoadOptions mesh_load_options(const FlowConfig& c) {
   MeshLoadOptions o;
   if (c.repair_degenerate) {
     o.degenerate = DegenerateFaces::repair;
-  } else if (c.basis == "octree") {
+  } else if (basis_row(c.basis).keeps_degenerate_faces) {
     // The octree basis integrates over the surface by cubature on clipped pieces, and a
     // zero-area face leaves no piece: it changes nothing there.
     o.degenerate = DegenerateFaces::keep;
