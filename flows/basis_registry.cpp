@@ -5,6 +5,7 @@
 #include "bases/tracked_octree_basis.h"
 #include "datasets/subdivide.h"
 #include "datasets/validate.h"
+#include "flows/config_reader.h"
 #include "flows/memory_estimate.h"
 
 #include <stdexcept>
@@ -38,8 +39,7 @@ std::unique_ptr<Basis> make_hat(const FlowConfig& config, const TriangleMesh& me
   if (hierarchy) levels = SurfaceHierarchyOptions{};
   const MassKind mass = config.mass == "lumped" ? MassKind::lumped : MassKind::consistent;
   if (config.octree.refine_input)  // the 1-to-4 split flows; the input's vertices are output
-    return std::make_unique<HatBasis>(subdivide_midpoint(mesh), mass, levels,
-                                      mesh.num_vertices());
+    return std::make_unique<HatBasis>(subdivide_midpoint(mesh), mass, levels, mesh.num_vertices());
   return std::make_unique<HatBasis>(mesh, mass, levels);
 }
 
@@ -58,24 +58,88 @@ BasisRow hat_row() {
   return hat;
 }
 
+std::vector<OptionSpec> octree_row_options() {
+  OptionSpec tracking = bind(
+      option("octree.tracking", OptionType::string, "tracked", "--tracking",
+             "Octree: how the basis follows the surface"),
+      [](auto& c) -> auto& { return c.octree.tracking; });
+  tracking.choices = [] {
+    std::vector<Choice> c;
+    for (const TrackingRow& row : tracking_table().rows()) c.emplace_back(row.name, row.help);
+    return c;
+  };
+  OptionSpec depth = ranged(bind(
+                                option("octree.depth", OptionType::integer, 8, "--depth",
+                                       "Octree depth (the finest level)"),
+                                [](auto& c) -> auto& { return c.octree.depth; }),
+                            4, 10);
+  OptionSpec cubature = ranged(
+      bind(
+          option("octree.cubature", OptionType::integer, 3, "--cubature",
+                 "Octree cubature rule per split triangle: the centroid, the paper's 3-point "
+                 "rule or Dunavant's degree-6 rule"),
+          [](auto& c) -> auto& { return c.octree.cubature; }),
+      1, 6);
+  cubature.values_text = "1 | 3 | 6";
+  cubature.after = [](FlowConfig& c, const ConfigReader& r, const std::string& leaf) {
+    const int n = c.octree.cubature;
+    if (n != 1 && n != 3 && n != 6) r.fail(leaf, "must be 1, 3 or 6, got " + std::to_string(n));
+  };
+  OptionSpec cube = bind(
+      option("octree.cube", OptionType::string, "auto", "--cube", "Octree bounding cube"),
+      [](auto& c) -> auto& { return c.octree.cube; });
+  cube.choices = [] {
+    return std::vector<Choice>{
+        {"auto", "the unit cube if the mesh fits in it, else the tight cube"},
+        {"unit", "the unit cube; a mesh outside it is refused"},
+        {"tight", "the cube around the mesh"}};
+  };
+  OptionSpec refine = bind(
+      option("octree.refine_input", OptionType::boolean, false, "--refine-input",
+             "Split the input mesh 1-to-4 once first (octree and hat basis); "
+             "only its vertices are output"),
+      [](auto& c) -> auto& { return c.octree.refine_input; });
+  refine.flag_kind = FlagKind::set_true;
+  OptionSpec stabilization = bind(
+      option("octree.stabilization", OptionType::string, "normal-gradient", "--stabilization",
+             "Octree system (docs/octree-multigrid.md)"),
+      [](auto& c) -> auto& { return c.octree.stabilization; });
+  stabilization.choices = [] {
+    return std::vector<Choice>{
+        {"none", "the paper's system"},
+        {"normal-gradient",
+         "solve each step's increment with the band's normal-gradient term added, so that "
+         "multigrid converges"}};
+  };
+  OptionSpec weight = ranged(
+      bind(
+          option("octree.stabilization_weight", OptionType::number, 0.5, "--stabilization-weight",
+                 "Octree: c, the normal-gradient term's diagonal over the system's"),
+          [](auto& c) -> auto& { return c.octree.stabilization_weight; }),
+      0, 1e6);
+  return {tracking, depth, cubature, cube, refine, stabilization, weight};
+}
+
 BasisRow octree_row() {
-  BasisRow octree{
-      "octree", "trilinear B-splines on an octree around the surface",
-      [](const FlowConfig& config, const TriangleMesh& mesh, bool analytic, bool) {
-        return tracking_row(config.octree.tracking).make(mesh, octree_options(config.octree, analytic));
-      },
-      [](const FlowConfig& config, const FlowSizes& s) {
-        const TrackingRow& t = tracking_row(config.octree.tracking);
-        BasisMemory m;
-        m.mesh_bytes = t.bytes_per_vertex * s.vertices;
-        if (s.area_over_side2 < 0) {
-          m.lower_bound = true;
-          return m;
-        }
-        m.dimension = estimated_octree_dimension(s.area_over_side2, config.octree.depth);
-        m.basis_bytes = t.bytes_per_function * m.dimension;
-        return m;
-      }};
+  BasisRow octree{"octree", "trilinear B-splines on an octree around the surface",
+                  [](const FlowConfig& config, const TriangleMesh& mesh, bool analytic, bool) {
+                    return tracking_row(config.octree.tracking)
+                        .make(mesh, octree_options(config.octree, analytic));
+                  },
+                  [](const FlowConfig& config, const FlowSizes& s) {
+                    const TrackingRow& t = tracking_row(config.octree.tracking);
+                    BasisMemory m;
+                    m.mesh_bytes = t.bytes_per_vertex * s.vertices;
+                    if (s.area_over_side2 < 0) {
+                      m.lower_bound = true;
+                      return m;
+                    }
+                    m.dimension =
+                        estimated_octree_dimension(s.area_over_side2, config.octree.depth);
+                    m.basis_bytes = t.bytes_per_function * m.dimension;
+                    return m;
+                  }};
+  octree.options = octree_row_options();
   octree.system.nonzeros_per_row = kOctreeNonzerosPerRow;
   octree.system.factor_bytes_per_unknown = kOctreeCholmodPerFunction;
   // The octree's hierarchy is its own (in bytes_per_function).
@@ -139,7 +203,7 @@ const BasisRow& basis_row(const std::string& name) {
 const NamedTable<TrackingRow>& tracking_table() {
   static const NamedTable<TrackingRow> t = [] {
     NamedTable<TrackingRow> r("octree tracking");
-    r.add({"tracked", "built once, its metric re-integrated every step (default)",
+    r.add({"tracked", "built once, its metric re-integrated every step",
            [](const TriangleMesh& mesh, const OctreeOptions& o) -> std::unique_ptr<Basis> {
              return std::make_unique<TrackedOctreeBasis>(mesh, o);
            },

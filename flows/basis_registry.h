@@ -9,6 +9,7 @@
 #include "flows/flow_config.h"
 #include "flows/memory_model.h"
 #include "flows/named_table.h"
+#include "flows/option_spec.h"
 
 #include <functional>
 #include <memory>
@@ -27,6 +28,9 @@ struct BasisRow {
       make;
   /// Its share of the flow's memory and its unknowns for a mesh of `sizes`. Required.
   std::function<BasisMemory(const FlowConfig&, const FlowSizes&)> memory;
+  /// Its options, keyed from the top ("octree.depth"). Every config reads them and result.json
+  /// records them for every basis (the configs of earlier results have them).
+  std::vector<OptionSpec> options{};
   /// Its system matrix as the solvers' memory models read it (dimension left 0).
   SystemFigures system{};
   /// Optional: fills what the basis's size depends on beyond the mesh's counts (the octree's

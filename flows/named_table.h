@@ -26,8 +26,7 @@ class NamedTable {
   /// found when the program starts.
   const Row& add(Row row) {
     if (row.name.empty()) throw std::logic_error(axis_ + " registered without a name");
-    if (find(row.name))
-      throw std::logic_error(axis_ + " \"" + row.name + "\" registered twice");
+    if (find(row.name)) throw std::logic_error(axis_ + " \"" + row.name + "\" registered twice");
     rows_.push_back(std::move(row));
     return rows_.back();
   }

@@ -39,7 +39,7 @@ NamedTable<PreconditionerRow> built_in() {
   multigrid.needs_hierarchy = true;
   for (PreconditionerRow row :
        {built_in_pcg("none", "plain CG", PcgPreconditioner::none),
-        built_in_pcg("jacobi", "the inverse diagonal (default)", PcgPreconditioner::jacobi),
+        built_in_pcg("jacobi", "the inverse diagonal", PcgPreconditioner::jacobi),
         built_in_pcg("ichol", "incomplete Cholesky", PcgPreconditioner::incomplete_cholesky),
         multigrid}) {
     check(row);

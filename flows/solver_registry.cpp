@@ -1,5 +1,6 @@
 #include "flows/solver_registry.h"
 
+#include "flows/config_reader.h"
 #include "flows/preconditioner_registry.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/dense_reference.h"
@@ -56,7 +57,7 @@ void check(const SolverRow& row) {
 
 NamedTable<SolverRow> built_in() {
   NamedTable<SolverRow> t("solver");
-  SolverRow cholmod{"cholmod", "CHOLMOD's supernodal Cholesky factorization (default)",
+  SolverRow cholmod{"cholmod", "CHOLMOD's supernodal Cholesky factorization",
                     [](const SolverConfig&) { return std::make_unique<CholmodSolver>(); },
                     [](const SolverConfig&, const SystemFigures& s) {
                       return s.factor_bytes_per_unknown * s.dimension;
@@ -72,19 +73,18 @@ NamedTable<SolverRow> built_in() {
                         return s.hierarchy_bytes_per_unknown * s.dimension;
                       }};
   multigrid.options = {
-      {"stall_ratio", OptionType::number, 0.2, 0, 1,
-       "Multigrid: where the cycles reduce the residual by less than this per cycle, CG "
-       "preconditioned by the cycle takes over until they have reached what this ratio promises "
-       "(default 0.2; 0 = never)",
-       "--stall-ratio", [](const FlowConfig& c) { return nlohmann::json(c.solver.stall_ratio); },
-       [](FlowConfig& c, const nlohmann::json& v) { c.solver.stall_ratio = v.get<double>(); }},
-      {"fallback_tolerance", OptionType::number, 1e-10, 1e-300, 1,
-       "Multigrid: the fallback CG never stops below this relative residual (default 1e-10)",
-       "--fallback-tolerance",
-       [](const FlowConfig& c) { return nlohmann::json(c.solver.fallback_tolerance); },
-       [](FlowConfig& c, const nlohmann::json& v) {
-         c.solver.fallback_tolerance = v.get<double>();
-       }}};
+      ranged(bind(
+                 option("stall_ratio", OptionType::number, 0.2, "--stall-ratio",
+                        "Multigrid: where the cycles reduce the residual by less than this per "
+                        "cycle, CG preconditioned by the cycle takes over until they have reached "
+                        "what this ratio promises; 0 = never"),
+                 [](auto& c) -> auto& { return c.solver.stall_ratio; }),
+             0, 1),
+      ranged(bind(
+                 option("fallback_tolerance", OptionType::number, 1e-10, "--fallback-tolerance",
+                        "Multigrid: the fallback CG never stops below this relative residual"),
+                 [](auto& c) -> auto& { return c.solver.fallback_tolerance; }),
+             1e-300, 1)};
   multigrid.iterative = multigrid.needs_hierarchy = true;
   multigrid.default_tolerance = 0;  // run `cycles` cycles
   SolverRow petsc{"petsc", "PETSc's KSP, default CG + GAMG (docs/petsc.md)", make_petsc,
@@ -93,15 +93,13 @@ NamedTable<SolverRow> built_in() {
                             kPetscVectorBytesPerUnknown) *
                            s.dimension;
                   }};
-  petsc.options = {{"petsc_options", OptionType::string, "", 0, 0,
-                    "petsc: PETSc options over the defaults, e.g. \"-pc_type hypre "
-                    "-pc_hypre_type boomeramg\" (docs/petsc.md)",
-                    "--petsc-options",
-                    [](const FlowConfig& c) { return nlohmann::json(c.solver.petsc_options); },
-                    [](FlowConfig& c, const nlohmann::json& v) {
-                      c.solver.petsc_options = v.get<std::string>();
-                    },
-                    true}};
+  OptionSpec petsc_options = bind(
+      option("petsc_options", OptionType::string, "", "--petsc-options",
+             "petsc: PETSc options over the defaults, e.g. \"-pc_type hypre -pc_hypre_type "
+             "boomeramg\" (docs/petsc.md)"),
+      [](auto& c) -> auto& { return c.solver.petsc_options; });
+  petsc_options.refused_elsewhere = true;
+  petsc.options = {petsc_options};
   petsc.iterative = petsc.distributed = true;
   petsc.default_max_iterations = 3000;  // the paper's baseline: CG + AMG stopped at 3000
   SolverRow dense{"dense", "LLT of the dense matrix: a reference for small meshes",
@@ -114,6 +112,61 @@ NamedTable<SolverRow> built_in() {
     t.add(std::move(*row));
   }
   return t;
+}
+
+std::vector<OptionSpec> shared_options() {
+  OptionSpec name = bind(
+      option("solver.name", OptionType::string, "cholmod", "--solver", "Linear solver"),
+      [](auto& c) -> auto& { return c.solver.name; });
+  name.choices = [] {
+    std::vector<Choice> c;
+    for (const SolverRow& row : solver_table().rows()) c.emplace_back(row.name, row.help);
+    return c;
+  };
+  // The solver's own default iteration cap, unless the config sets one.
+  name.after = [](FlowConfig& c, const ConfigReader&, const std::string&) {
+    c.solver.max_iterations = solver_row(c.solver.name).default_max_iterations;
+  };
+  OptionSpec tolerance = ranged(bind(
+                                    option("solver.tolerance", OptionType::number, -1,
+                                           "--tolerance", "Relative residual to stop at"),
+                                    [](auto& c) -> auto& { return c.solver.tolerance; }),
+                                0, 1);
+  tolerance.default_text = "the solver's (1e-10; multigrid 0 = run --cycles)";
+  OptionSpec max_iterations =
+      ranged(bind(
+                 option("solver.max_iterations", OptionType::integer, 1000, "--max-iterations",
+                        "PCG, PETSc and the multigrid fallback's iteration cap"),
+                 [](auto& c) -> auto& { return c.solver.max_iterations; }),
+             1, 100000000);
+  max_iterations.default_text = "the solver's (1000; petsc 3000)";
+  OptionSpec preconditioner = bind(
+      option("solver.preconditioner", OptionType::string, "jacobi", "--preconditioner",
+             "PCG preconditioner"),
+      [](auto& c) -> auto& { return c.solver.preconditioner; });
+  preconditioner.choices = [] {
+    std::vector<Choice> c;
+    for (const PreconditionerRow& row : preconditioner_table().rows())
+      c.emplace_back(row.name, row.help);
+    return c;
+  };
+  OptionSpec cycle = bind(
+      option("solver.cycle", OptionType::string, "W", "--cycle",
+             "Multigrid cycle (solver and preconditioner)"),
+      [](auto& c) -> auto& { return c.solver.cycle; });
+  cycle.choices = [] { return std::vector<Choice>{{"V", ""}, {"W", ""}}; };
+  OptionSpec cycles = ranged(
+      bind(
+          option("solver.cycles", OptionType::integer, 1, "--cycles", "Multigrid cycles per solve"),
+          [](auto& c) -> auto& { return c.solver.cycles; }),
+      1, 10000);
+  OptionSpec smooth =
+      ranged(bind(
+                 option("solver.smooth", OptionType::integer, 5, "--smooth",
+                        "Gauss-Seidel sweeps before and after each coarse correction"),
+                 [](auto& c) -> auto& { return c.solver.smooth; }),
+             0, 1000);
+  return {name, tolerance, max_iterations, preconditioner, cycle, cycles, smooth};
 }
 
 NamedTable<SolverRow>& table() {
@@ -134,6 +187,11 @@ void register_solver(SolverRow row) {
 
 const SolverRow& solver_row(const std::string& name) {
   return table().at(name);
+}
+
+const std::vector<OptionSpec>& solver_options() {
+  static const std::vector<OptionSpec> options = shared_options();
+  return options;
 }
 
 bool needs_hierarchy(const SolverConfig& config) {

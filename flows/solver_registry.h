@@ -25,10 +25,10 @@ struct SolverRow {
   /// Bytes the solver adds beyond the basis's system matrix (a factor's fill, a hierarchy, a dense
   /// copy). Required: an estimate must never count a solver as free by omission.
   std::function<double(const SolverConfig&, const SystemFigures&)> memory;
-  /// The options only this solver reads, under "solver" (after the shared ones: tolerance,
-  /// max_iterations, preconditioner, cycle, cycles, smooth). Every config reads them; result.json
-  /// records them only where this solver runs, so that the other solvers' cells keep the config
-  /// keys (bench/cell_hash.h) they had before the option existed.
+  /// The options only this solver reads, keyed within "solver" ("stall_ratio"), read after the
+  /// shared ones (solver_options()). Every config reads them; result.json records them only
+  /// where this solver runs, so that the other solvers' cells keep the config keys
+  /// (bench/cell_hash.h) they had before the option existed.
   std::vector<OptionSpec> options{};
   /// Starts from the warm start (the integrator's prediction) instead of solving exactly.
   bool iterative = false;
@@ -40,7 +40,7 @@ struct SolverRow {
   bool uses_blas_threads = false;
   /// Runs on every MPI rank the harness was launched on (the others run on rank 0 alone).
   bool distributed = false;
-  double default_tolerance = 1e-10;  ///< solver.tolerance when the config leaves it out
+  double default_tolerance = 1e-10;   ///< solver.tolerance when the config leaves it out
   int default_max_iterations = 1000;  ///< solver.max_iterations when the config leaves it out
 };
 
@@ -52,6 +52,10 @@ void register_solver(SolverRow row);
 /// The row of `name`; std::invalid_argument ("unknown solver \"x\"") if there is none.
 const SolverRow& solver_row(const std::string& name);
 
+/// The options every solver shares, keyed from the top ("solver.name", "solver.tolerance",
+/// "solver.max_iterations", "solver.preconditioner", "solver.cycle", "solver.cycles",
+/// "solver.smooth"); result.json records them for every solver.
+const std::vector<OptionSpec>& solver_options();
 /// Whether the config's solver (or its preconditioner) needs the basis's geometric hierarchy.
 bool needs_hierarchy(const SolverConfig& config);
 /// The multigrid cycle the config describes (the multigrid solver's and preconditioner's).
