@@ -63,11 +63,7 @@ std::vector<OptionSpec> octree_row_options() {
       option("octree.tracking", OptionType::string, "tracked", "--tracking",
              "Octree: how the basis follows the surface"),
       [](auto& c) -> auto& { return c.octree.tracking; });
-  tracking.choices = [] {
-    std::vector<Choice> c;
-    for (const TrackingRow& row : tracking_table().rows()) c.emplace_back(row.name, row.help);
-    return c;
-  };
+  tracking.choices = [] { return tracking_table().choices(); };
   OptionSpec depth = ranged(bind(
                                 option("octree.depth", OptionType::integer, 8, "--depth",
                                        "Octree depth (the finest level)"),
@@ -175,11 +171,8 @@ void check(const BasisRow& row) {
 
 NamedTable<BasisRow>& table() {
   static NamedTable<BasisRow> t = [] {
-    NamedTable<BasisRow> b("basis");
-    for (BasisRow row : {hat_row(), octree_row()}) {
-      check(row);
-      b.add(std::move(row));
-    }
+    NamedTable<BasisRow> b("basis", check);
+    for (BasisRow row : {hat_row(), octree_row()}) b.add(std::move(row));
     return b;
   }();
   return t;
@@ -192,7 +185,6 @@ const NamedTable<BasisRow>& basis_table() {
 }
 
 void register_basis(BasisRow row) {
-  check(row);
   table().add(std::move(row));
 }
 

@@ -12,33 +12,29 @@
 namespace mcf {
 namespace {
 
-template <class Table>
-std::vector<Choice> choices_of(const Table& table) {
-  std::vector<Choice> c;
-  for (const auto& row : table.rows()) c.emplace_back(row.name, row.help);
-  return c;
-}
-
 /// The flow's own keys before the components' (mesh, flow, basis, mass).
 std::vector<OptionSpec> head_options() {
-  OptionSpec mesh = bind(option("mesh", OptionType::string, "", "--mesh", "The input surface"),
-                         [](auto& c) -> auto& { return c.mesh; });
+  OptionSpec mesh = bind(
+      option("mesh", OptionType::string, "", "--mesh", "The input surface"),
+      [](auto& c) -> auto& { return c.mesh; });
   mesh.default_text = "required";
   mesh.values_text = "a mesh spec: generator, cgal:MODEL[@faces=N] or a file path";
   mesh.after = [](FlowConfig& c, const ConfigReader& r, const std::string& leaf) {
     if (c.mesh.empty()) r.fail(leaf, "missing (a mesh spec such as \"sphere:vertices=2000\")");
   };
-  OptionSpec flow = bind(option("flow", OptionType::string, "mcf", "--flow", "The flow"),
-                         [](auto& c) -> auto& { return c.flow; });
-  flow.choices = [] { return choices_of(flow_table()); };
-  OptionSpec basis =
-      bind(option("basis", OptionType::string, "hat", "--basis", "The finite-element basis"),
-           [](auto& c) -> auto& { return c.basis; });
-  basis.choices = [] { return choices_of(basis_table()); };
-  OptionSpec mass = bind(option("mass", OptionType::string, "consistent", "--mass",
-                                "Hat basis mass matrix (the octree basis integrates its "
-                                "consistent mass by cubature and refuses lumped)"),
-                         [](auto& c) -> auto& { return c.mass; });
+  OptionSpec flow = bind(
+      option("flow", OptionType::string, "mcf", "--flow", "The flow"),
+      [](auto& c) -> auto& { return c.flow; });
+  flow.choices = [] { return flow_table().choices(); };
+  OptionSpec basis = bind(
+      option("basis", OptionType::string, "hat", "--basis", "The finite-element basis"),
+      [](auto& c) -> auto& { return c.basis; });
+  basis.choices = [] { return basis_table().choices(); };
+  OptionSpec mass = bind(
+      option("mass", OptionType::string, "consistent", "--mass",
+             "Hat basis mass matrix (the octree basis integrates its "
+             "consistent mass by cubature and refuses lumped)"),
+      [](auto& c) -> auto& { return c.mass; });
   mass.choices = [] {
     return std::vector<Choice>{{"consistent", "the consistent mass matrix"},
                                {"lumped", "the lumped (diagonal) mass matrix"}};
@@ -62,60 +58,67 @@ nlohmann::json blas_threads_of_flag(const std::string& text) {
 
 /// The flow's own keys after the components' (time stepping, threads, output).
 std::vector<OptionSpec> tail_options() {
-  OptionSpec integrator = bind(option("integrator", OptionType::string, "semi-implicit",
-                                      "--integrator", "Time integrator (docs/design.md)"),
-                               [](auto& c) -> auto& { return c.integrator; });
+  OptionSpec integrator = bind(
+      option("integrator", OptionType::string, "semi-implicit", "--integrator",
+             "Time integrator (docs/design.md)"),
+      [](auto& c) -> auto& { return c.integrator; });
   integrator.choices = [] {
     std::vector<Choice> c;
     for (const std::string& name : integrator_names()) c.emplace_back(name, "");
     return c;
   };
-  OptionSpec extrapolate = bind(option("extrapolate", OptionType::boolean, true, "--frozen",
-                                       "CN/BDF2: operators at the extrapolated X*; --frozen "
-                                       "evaluates them at X_n instead (first order)"),
-                                [](auto& c) -> auto& { return c.extrapolate; });
+  OptionSpec extrapolate = bind(
+      option("extrapolate", OptionType::boolean, true, "--frozen",
+             "CN/BDF2: operators at the extrapolated X*; --frozen "
+             "evaluates them at X_n instead (first order)"),
+      [](auto& c) -> auto& { return c.extrapolate; });
   extrapolate.flag_kind = FlagKind::set_false;
-  OptionSpec dt = ranged(bind(option("dt", OptionType::number, 1e-3, "--dt", "Time step"),
-                              [](auto& c) -> auto& { return c.dt; }),
+  OptionSpec dt = ranged(bind(
+                             option("dt", OptionType::number, 1e-3, "--dt", "Time step"),
+                             [](auto& c) -> auto& { return c.dt; }),
                          1e-300, 1e6);
   dt.values_text = "> 0";
   dt.after = [](FlowConfig& c, const ConfigReader& r, const std::string& leaf) {
     if (c.dt <= 0) r.fail(leaf, "must be > 0");
   };
   OptionSpec steps =
-      ranged(bind(option("steps", OptionType::integer, 10, "--steps", "Number of steps"),
-                  [](auto& c) -> auto& { return c.steps; }),
+      ranged(bind(
+                 option("steps", OptionType::integer, 10, "--steps", "Number of steps"),
+                 [](auto& c) -> auto& { return c.steps; }),
              0, 100000000);
-  OptionSpec normalize = bind(option("normalize_area", OptionType::boolean, false,
-                                     "--normalize-area",
-                                     "Unit total area, centroid at the origin, before and after "
-                                     "every step (refused on an open surface)"),
-                              [](auto& c) -> auto& { return c.normalize_area; });
+  OptionSpec normalize = bind(
+      option("normalize_area", OptionType::boolean, false, "--normalize-area",
+             "Unit total area, centroid at the origin, before and after "
+             "every step (refused on an open surface)"),
+      [](auto& c) -> auto& { return c.normalize_area; });
   normalize.flag_kind = FlagKind::set_true;
-  OptionSpec threads = ranged(bind(option("threads", OptionType::integer, 0, "--threads",
-                                          "Worker threads, and the most OpenBLAS may use under "
-                                          "CHOLMOD"),
-                                   [](auto& c) -> auto& { return c.threads; }),
+  OptionSpec threads = ranged(bind(
+                                  option("threads", OptionType::integer, 0, "--threads",
+                                         "Worker threads, and the most OpenBLAS may use under "
+                                         "CHOLMOD"),
+                                  [](auto& c) -> auto& { return c.threads; }),
                               0, 4096);
   threads.default_text = "0 = all cores";
-  OptionSpec blas = ranged(bind(option("blas_threads", OptionType::integer, 0, "--blas-threads",
-                                       "OpenBLAS threads under CHOLMOD: auto (one below 20000 "
-                                       "unknowns, else up to 4) or a count, at most --threads"),
-                                [](auto& c) -> auto& { return c.blas_threads; }),
+  OptionSpec blas = ranged(bind(
+                               option("blas_threads", OptionType::integer, 0, "--blas-threads",
+                                      "OpenBLAS threads under CHOLMOD: auto (one below 20000 "
+                                      "unknowns, else up to 4) or a count, at most --threads"),
+                               [](auto& c) -> auto& { return c.blas_threads; }),
                            0, 4096);
   blas.default_text = "auto (0 in the config)";
   blas.values_text = "auto | 1..4096";
   blas.parse_flag = blas_threads_of_flag;
-  OptionSpec save = ranged(bind(option("save_every", OptionType::integer, 0, "--save-every",
-                                       "Write OUT/frame_NNNNN.ply every K steps"),
-                                [](auto& c) -> auto& { return c.save_every; }),
+  OptionSpec save = ranged(bind(
+                               option("save_every", OptionType::integer, 0, "--save-every",
+                                      "Write OUT/frame_NNNNN.ply every K steps"),
+                               [](auto& c) -> auto& { return c.save_every; }),
                            0, 100000000);
   save.default_text = "0 = never";
-  OptionSpec repair = bind(option("repair_degenerate", OptionType::boolean, false,
-                                  "--repair-degenerate",
-                                  "Collapse the mesh's zero-area faces first (the hat basis "
-                                  "refuses them; the octree basis takes them as they are)"),
-                           [](auto& c) -> auto& { return c.repair_degenerate; });
+  OptionSpec repair = bind(
+      option("repair_degenerate", OptionType::boolean, false, "--repair-degenerate",
+             "Collapse the mesh's zero-area faces first (the hat basis "
+             "refuses them; the octree basis takes them as they are)"),
+      [](auto& c) -> auto& { return c.repair_degenerate; });
   repair.flag_kind = FlagKind::set_true;
   repair.recorded = Recorded::when_set;
   return {integrator, extrapolate, dt, steps, normalize, threads, blas, save, repair};

@@ -10,8 +10,10 @@
 // finds it constructed.
 
 #include <deque>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mcf {
@@ -19,13 +21,16 @@ namespace mcf {
 template <class Row>
 class NamedTable {
  public:
-  /// `axis` names the table in messages ("solver", "basis").
-  explicit NamedTable(std::string axis) : axis_(std::move(axis)) {}
+  /// `axis` names the table in messages ("solver", "basis"); `check` throws std::logic_error for
+  /// a row that lacks what the axis requires (a factory, a memory model).
+  explicit NamedTable(std::string axis, std::function<void(const Row&)> check = {})
+      : axis_(std::move(axis)), check_(std::move(check)) {}
 
-  /// Adds a row. Throws std::logic_error for an empty or repeated name: a registration bug,
-  /// found when the program starts.
+  /// Adds a row. Throws std::logic_error for an empty or repeated name or a row `check` refuses:
+  /// a registration bug, found when the program starts.
   const Row& add(Row row) {
     if (row.name.empty()) throw std::logic_error(axis_ + " registered without a name");
+    if (check_) check_(row);
     if (find(row.name)) throw std::logic_error(axis_ + " \"" + row.name + "\" registered twice");
     rows_.push_back(std::move(row));
     return rows_.back();
@@ -47,10 +52,17 @@ class NamedTable {
     for (const Row& r : rows_) n.push_back(r.name);
     return n;
   }
+  /// Each row's name and help, in registration order (an option's allowed values).
+  std::vector<std::pair<std::string, std::string>> choices() const {
+    std::vector<std::pair<std::string, std::string>> c;
+    for (const Row& r : rows_) c.emplace_back(r.name, r.help);
+    return c;
+  }
   const std::deque<Row>& rows() const { return rows_; }
 
  private:
   std::string axis_;
+  std::function<void(const Row&)> check_;
   std::deque<Row> rows_;  // a deque: references to rows stay valid as rows are added
 };
 

@@ -26,7 +26,7 @@ PreconditionerRow built_in_pcg(std::string name, std::string help, PcgPreconditi
 }
 
 NamedTable<PreconditionerRow> built_in() {
-  NamedTable<PreconditionerRow> t("preconditioner");
+  NamedTable<PreconditionerRow> t("preconditioner", check);
   PreconditionerRow multigrid{
       "multigrid", "one cycle of the basis's geometric multigrid",
       [](const SolverConfig& c, PcgOptions o) -> std::unique_ptr<LinearSolver> {
@@ -41,10 +41,8 @@ NamedTable<PreconditionerRow> built_in() {
        {built_in_pcg("none", "plain CG", PcgPreconditioner::none),
         built_in_pcg("jacobi", "the inverse diagonal", PcgPreconditioner::jacobi),
         built_in_pcg("ichol", "incomplete Cholesky", PcgPreconditioner::incomplete_cholesky),
-        multigrid}) {
-    check(row);
+        multigrid})
     t.add(std::move(row));
-  }
   return t;
 }
 
@@ -60,7 +58,6 @@ const NamedTable<PreconditionerRow>& preconditioner_table() {
 }
 
 void register_preconditioner(PreconditionerRow row) {
-  check(row);
   table().add(std::move(row));
 }
 

@@ -56,7 +56,7 @@ void check(const SolverRow& row) {
 }
 
 NamedTable<SolverRow> built_in() {
-  NamedTable<SolverRow> t("solver");
+  NamedTable<SolverRow> t("solver", check);
   SolverRow cholmod{"cholmod", "CHOLMOD's supernodal Cholesky factorization",
                     [](const SolverConfig&) { return std::make_unique<CholmodSolver>(); },
                     [](const SolverConfig&, const SystemFigures& s) {
@@ -107,10 +107,7 @@ NamedTable<SolverRow> built_in() {
                   [](const SolverConfig&, const SystemFigures& s) {
                     return kDensePerUnknown2 * s.dimension * s.dimension;
                   }};
-  for (SolverRow* row : {&cholmod, &pcg, &multigrid, &petsc, &dense}) {
-    check(*row);
-    t.add(std::move(*row));
-  }
+  for (SolverRow* row : {&cholmod, &pcg, &multigrid, &petsc, &dense}) t.add(std::move(*row));
   return t;
 }
 
@@ -118,11 +115,7 @@ std::vector<OptionSpec> shared_options() {
   OptionSpec name = bind(
       option("solver.name", OptionType::string, "cholmod", "--solver", "Linear solver"),
       [](auto& c) -> auto& { return c.solver.name; });
-  name.choices = [] {
-    std::vector<Choice> c;
-    for (const SolverRow& row : solver_table().rows()) c.emplace_back(row.name, row.help);
-    return c;
-  };
+  name.choices = [] { return solver_table().choices(); };
   // The solver's own default iteration cap, unless the config sets one.
   name.after = [](FlowConfig& c, const ConfigReader&, const std::string&) {
     c.solver.max_iterations = solver_row(c.solver.name).default_max_iterations;
@@ -144,12 +137,7 @@ std::vector<OptionSpec> shared_options() {
       option("solver.preconditioner", OptionType::string, "jacobi", "--preconditioner",
              "PCG preconditioner"),
       [](auto& c) -> auto& { return c.solver.preconditioner; });
-  preconditioner.choices = [] {
-    std::vector<Choice> c;
-    for (const PreconditionerRow& row : preconditioner_table().rows())
-      c.emplace_back(row.name, row.help);
-    return c;
-  };
+  preconditioner.choices = [] { return preconditioner_table().choices(); };
   OptionSpec cycle = bind(
       option("solver.cycle", OptionType::string, "W", "--cycle",
              "Multigrid cycle (solver and preconditioner)"),
@@ -181,7 +169,6 @@ const NamedTable<SolverRow>& solver_table() {
 }
 
 void register_solver(SolverRow row) {
-  check(row);
   table().add(std::move(row));
 }
 

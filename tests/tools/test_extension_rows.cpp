@@ -32,8 +32,8 @@ fs::path temp_dir() {
 
 /// Runs `mcfbench ARGS`, stdout into `out`; the exit status.
 int mcfbench(const std::string& args, const fs::path& out) {
-  const std::string cmd = std::string(MCFBENCH_BINARY) + " " + args + " >" + out.string() +
-                          " 2>" + (temp_dir() / "stderr.txt").string();
+  const std::string cmd = std::string(MCFBENCH_BINARY) + " " + args + " >" + out.string() + " 2>" +
+                          (temp_dir() / "stderr.txt").string();
   const int raw = std::system(cmd.c_str());
   return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
 }
@@ -123,8 +123,9 @@ TEST(FlowOptions, TheReaderTakesEveryKeyAndRecordsOnlySchemaKeys) {
 TEST(FlowOptions, DocsTableIsTheSchemas) {
   // docs/flow.md holds the table between two markers; MCFBENCH_UPDATE_DOCS=1 rewrites it.
   const fs::path page = fs::path(MCFBENCH_SOURCE_DIR) / "docs" / "flow.md";
-  const std::string begin = "<!-- flow options: generated from the rows (tests/tools/"
-                            "test_extension_rows.cpp rewrites it with MCFBENCH_UPDATE_DOCS=1) -->\n";
+  const std::string begin =
+      "<!-- flow options: generated from the rows (tests/tools/"
+      "test_extension_rows.cpp rewrites it with MCFBENCH_UPDATE_DOCS=1) -->\n";
   const std::string end = "<!-- end of flow options -->\n";
   std::string text = text_of(page);
   const std::size_t a = text.find(begin), b = text.find(end);
