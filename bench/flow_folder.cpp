@@ -1,6 +1,7 @@
 #include "bench/flow_folder.h"
 
 #include "flows/registry.h"
+#include "flows/solver_registry.h"
 #include "solvers/petsc_runtime.h"
 
 #include "bench/experiment_config.h"
@@ -102,18 +103,19 @@ int run_flow_into_folder(const FlowRequest& request) {
   const FlowConfig config = flow_config_of(request);
   // PETSc's options are checked (a trial solve, solvers/petsc_solver.h), and a build without
   // PETSc refuses, before anything is read or written.
-  if (config.solver.name == "petsc") make_solver(config.solver);
+  const bool distributed = solver_row(config.solver.name).distributed;
+  if (distributed) make_solver(config.solver);
   // Under mpirun every rank runs the whole flow and only PETSc's solves are shared
   // (docs/petsc.md, "Across MPI ranks"); any other solver would run the same flow P times into
   // one folder.
-  if (config.solver.name != "petsc" && launched_ranks() > 1)
+  if (!distributed && launched_ranks() > 1)
     throw ConfigError("solver.name: \"" + config.solver.name +
                       "\" runs in one process; only "
                       "\"petsc\" runs across the " +
                       std::to_string(launched_ranks()) + " ranks mpirun started");
   // Ranks other than 0 run the same flow, so that every collective solve has all its ranks,
   // and write nothing.
-  if (config.solver.name == "petsc" && PetscRuntime::instance().rank() != 0) {
+  if (distributed && PetscRuntime::instance().rank() != 0) {
     const MeshSource mesh = load_mesh_spec(config.mesh, mesh_load_options(config));
     run_flow(config, mesh);
     return 0;

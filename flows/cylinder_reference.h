@@ -13,19 +13,20 @@
 
 #include <cmath>
 #include <limits>
-#include <string>
 #include <vector>
 
 namespace mcf {
 
 struct CylinderReference {
   double r0 = 1.0;
-  std::string flow;                ///< "mcf", "cmcf" or "heat"
+  bool keeps_mass = false;         ///< M_0 for every step (heat flow)
+  bool keeps_stiffness = false;    ///< K_0 for every step (cMCF, heat flow)
   double discrete = 1.0;           ///< semi-implicit recursion after the steps so far
   std::vector<Eigen::Index> ring;  ///< the input's vertices nearest to half height
 
-  CylinderReference(double radius, std::string flow_name, const Positions& X0)
-      : r0(radius), flow(std::move(flow_name)), discrete(radius) {
+  /// The flow is given by the operators of t = 0 it keeps (flows/flow_registry.h).
+  CylinderReference(double radius, bool kept_mass, bool kept_stiffness, const Positions& X0)
+      : r0(radius), keeps_mass(kept_mass), keeps_stiffness(kept_stiffness), discrete(radius) {
     const double zmid = 0.5 * (X0.col(2).minCoeff() + X0.col(2).maxCoeff());
     double nearest = std::numeric_limits<double>::infinity();
     for (Eigen::Index i = 0; i < X0.rows(); ++i)
@@ -34,16 +35,16 @@ struct CylinderReference {
       if (std::abs(X0(i, 2) - zmid) <= nearest + 1e-9 * r0) ring.push_back(i);
   }
   void advance(double dt) {
-    if (flow == "heat")
+    if (keeps_mass)
       discrete = discrete / (1.0 + dt / (r0 * r0));
-    else if (flow == "cmcf")
+    else if (keeps_stiffness)
       discrete = discrete * discrete / (discrete + dt / r0);
     else
       discrete = discrete * discrete * discrete / (discrete * discrete + dt);
   }
   double continuous(double t) const {
-    if (flow == "heat") return r0 * std::exp(-t / (r0 * r0));
-    if (flow == "cmcf") return r0 - t / r0;
+    if (keeps_mass) return r0 * std::exp(-t / (r0 * r0));
+    if (keeps_stiffness) return r0 - t / r0;
     const double s = r0 * r0 - 2.0 * t;
     return s > 0 ? std::sqrt(s) : 0.0;
   }

@@ -4,11 +4,13 @@
 #include "datasets/validate.h"
 #include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
+#include "flows/flow_registry.h"
 #include "flows/integrator.h"
 #include "flows/planted_slowdown.h"
 #include "flows/predicted_start.h"
 #include "flows/reduced_system.h"
 #include "flows/registry.h"
+#include "flows/solver_registry.h"
 #include "flows/sphere_reference.h"
 #include "flows/stabilization.h"
 #include "solvers/blas_threads.h"
@@ -43,13 +45,28 @@ int severity(SolveStatus s) {
   }
 }
 
-// The StepContext of a flow: which operators are re-assembled (MCF both, cMCF mass only,
-// heat neither after the first step), the reduced solve, and per-step timing.
+/// What one step's solves did, for the step's record in result.json.
+struct StepTally {
+  double update_seconds = 0, solve_seconds = 0;
+  int solves = 0, iterations = 0;
+  double contraction = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
+  int fallbacks = 0, fallback_iterations = 0;  ///< solves whose stalled cycles CG took over
+  SolveReport worst;
+  // Every solve's residuals, in order (Taylor-2 and Neumann-2 solve twice a step).
+  std::vector<std::vector<double>> residuals_per_solve;
+  // Per solve, per right-hand side (PETSc): iterations, true residual, the KSP's reason.
+  nlohmann::json columns_per_solve = nlohmann::json::array();
+  // Per solve (PETSc): what it did with its preconditioner (new | refreshed | kept).
+  std::vector<std::string> preconditioner_setups;
+};
+
+// The StepContext of a flow: which operators are re-assembled (the flow's row: MCF both, cMCF
+// mass only, heat neither after the first step), the reduced solve, and per-step timing.
 class FlowStepContext final : public StepContext {
  public:
   /// stabilization_weight > 0: every solve is one for the increment over its held values, with
   /// the basis's normal-gradient term added (solve()).
-  FlowStepContext(Basis& basis, LinearSolver& solver, const std::string& flow, double dt,
+  FlowStepContext(Basis& basis, LinearSolver& solver, const FlowRow& flow, double dt,
                   bool iterative, double stabilization_weight = 0.0)
       : basis_(basis),
         solver_(solver),
@@ -66,11 +83,9 @@ class FlowStepContext final : public StepContext {
   void evaluate_operators(const Coefficients& X) override {
     const auto t0 = Clock::now();
     const bool first = !assembled_;
-    const bool mass = flow_ != "heat" || first;
-    const bool stiffness = flow_ == "mcf" || first;
-    basis_.update(X, mass, stiffness);
+    basis_.update(X, !flow_.keeps_mass || first, !flow_.keeps_stiffness || first);
     assembled_ = true;
-    update_seconds_ += seconds_since(t0);
+    tally_.update_seconds += seconds_since(t0);
   }
   // M and K are symmetric: a parallel, thread-count independent gather instead of Eigen's serial
   // scatter (solvers/symmetric_multiply.h).
@@ -95,15 +110,16 @@ class FlowStepContext final : public StepContext {
     } else {
       Y = system_->solve(a, b, R, fixed, warm);
     }
-    solve_seconds_ += seconds_since(t0);
+    StepTally& t = tally_;
+    t.solve_seconds += seconds_since(t0);
     const SolveReport& r = system_->report();
-    ++solves_;
-    iterations_ += r.iterations;
-    residuals_per_solve_.push_back(r.residuals);
-    contraction_ = std::max(contraction_, r.contraction);
+    ++t.solves;
+    t.iterations += r.iterations;
+    t.residuals_per_solve.push_back(r.residuals);
+    t.contraction = std::max(t.contraction, r.contraction);
     if (r.fallback_iterations > 0) {
-      ++fallbacks_;
-      fallback_iterations_ += r.fallback_iterations;
+      ++t.fallbacks;
+      t.fallback_iterations += r.fallback_iterations;
     }
     if (!r.columns.empty()) {
       nlohmann::json columns = nlohmann::json::array();
@@ -111,10 +127,10 @@ class FlowStepContext final : public StepContext {
         columns.push_back({{"iterations", c.iterations},
                            {"relative_residual", c.relative_residual},
                            {"reason", c.reason}});
-      columns_per_solve_.push_back(std::move(columns));
+      t.columns_per_solve.push_back(std::move(columns));
     }
-    if (!r.preconditioner_setup.empty()) preconditioner_setups_.push_back(r.preconditioner_setup);
-    if (severity(r.status) >= severity(worst_.status)) worst_ = r;
+    if (!r.preconditioner_setup.empty()) t.preconditioner_setups.push_back(r.preconditioner_setup);
+    if (severity(r.status) >= severity(t.worst.status)) t.worst = r;
     return Y;
   }
 
@@ -122,42 +138,27 @@ class FlowStepContext final : public StepContext {
   void begin_step(const Coefficients& x, const Coefficients* prev) {
     x_ = &x;
     x_prev_ = prev;
-    update_seconds_ = solve_seconds_ = 0;
-    solves_ = iterations_ = fallbacks_ = fallback_iterations_ = 0;
-    contraction_ = -1;
-    residuals_per_solve_.clear();
-    columns_per_solve_ = nlohmann::json::array();
-    preconditioner_setups_.clear();
-    worst_ = SolveReport{};
+    tally_ = StepTally{};
   }
   void rebuilt() {
     // A rebuilt basis has new functions: forget the reduction and assemble afresh.
     system_ = std::make_unique<ReducedSystem>(basis_, solver_);
     assembled_ = false;
   }
-  void add_update_seconds(double s) { update_seconds_ += s; }
+  void add_update_seconds(double s) { tally_.update_seconds += s; }
   /// ρ of the last stabilized solve (0 without stabilization).
   double stabilization_rho() const { return rho_; }
-
-  double update_seconds_ = 0, solve_seconds_ = 0;
-  int solves_ = 0, iterations_ = 0;
-  double contraction_ = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
-  int fallbacks_ = 0, fallback_iterations_ = 0;  ///< solves whose stalled cycles CG took over
-  SolveReport worst_;
-  // Every solve's residuals, in order (Taylor-2 and Neumann-2 solve twice a step).
-  std::vector<std::vector<double>> residuals_per_solve_;
-  // Per solve, per right-hand side (PETSc): iterations, true residual, the KSP's reason.
-  nlohmann::json columns_per_solve_ = nlohmann::json::array();
-  // Per solve (PETSc): what it did with its preconditioner (new | refreshed | kept).
-  std::vector<std::string> preconditioner_setups_;
+  /// The current step's solves so far.
+  const StepTally& tally() const { return tally_; }
   std::size_t fixed() const { return system_->num_fixed(); }
 
  private:
   Basis& basis_;
   LinearSolver& solver_;
   std::unique_ptr<ReducedSystem> system_;
-  std::string flow_;
+  const FlowRow& flow_;
   double dt_;
+  StepTally tally_;
   /// The stabilized solve (flows/stabilization.h): Y = F + Δ with F the held values (the current
   /// coefficients when Y is a position, zero when it is a velocity) and Δ̂ = warm - F, the
   /// increment the solver starts from, as the prediction (for a position, the previous step's
@@ -267,7 +268,7 @@ class FlowRun {
   std::unique_ptr<Integrator> integrator_;
   double build_seconds_ = 0;  // a rebuilt basis: its step 1's update
   std::unique_ptr<FlowStepContext> ctx_;
-  bool stabilized_ = false;                ///< octree.stabilization normal-gradient
+  bool stabilized_ = false;                ///< the basis's system carries the stabilization
   bool keeps_previous_for_start_ = false;  ///< X_{n-1} for the solver's start (or prediction)
   Positions V_;
   Coefficients x_, x_prev_;
@@ -317,22 +318,26 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
   if (const auto settings = solver_->settings(); !settings.empty())
     for (const auto& [key, text] : settings) result["solver_settings"][key] = text;
 
-  stabilized_ = config.basis == "octree" && config.octree.stabilization == "normal-gradient";
+  const BasisRow& basis = basis_row(config.basis);
+  const std::optional<double> stabilization =
+      basis.stabilization ? basis.stabilization(config) : std::nullopt;
+  stabilized_ = stabilization.has_value();
   // The start is the stabilized solve's prediction too (FlowStepContext::solve_increment), so a
   // direct solver needs X_{n-1} then as well.
-  const bool iterative = config.solver.name == "multigrid" || config.solver.name == "pcg" ||
-                         config.solver.name == "petsc";
+  const bool iterative = solver_row(config.solver.name).iterative;
   keeps_previous_for_start_ = stabilized_ || iterative;
-  ctx_ = std::make_unique<FlowStepContext>(*basis_, *solver_, config.flow, config.dt, iterative,
-                                           stabilized_ ? config.octree.stabilization_weight : 0.0);
+  const FlowRow& flow = flow_row(config.flow);
+  ctx_ = std::make_unique<FlowStepContext>(*basis_, *solver_, flow, config.dt, iterative,
+                                           stabilization.value_or(0.0));
   V_ = mesh_.vertices;
   x_ = basis_->initial_coefficients();
   area0_ = surface_area(mesh_);
   previous_area_ = area0_;
   if (source.sphere_radius && !config.normalize_area)
-    sphere_.emplace(*source.sphere_radius, config.flow == "heat");
+    // On a sphere K is scale-invariant, so only a kept mass (heat flow) changes the law.
+    sphere_.emplace(*source.sphere_radius, flow.keeps_mass);
   if (source.cylinder_radius && !config.normalize_area)
-    cylinder_.emplace(*source.cylinder_radius, config.flow, V_);
+    cylinder_.emplace(*source.cylinder_radius, flow.keeps_mass, flow.keeps_stiffness, V_);
 }
 
 void FlowRun::begin_step(int step) {
@@ -355,29 +360,29 @@ void FlowRun::begin_step(int step) {
 }
 
 nlohmann::json FlowRun::solver_record(int step, double t) const {
-  const FlowStepContext& ctx = *ctx_;
-  const SolveReport& worst = ctx.worst_;
+  const StepTally& tally = ctx_->tally();
+  const SolveReport& worst = tally.worst;
   nlohmann::json record = {{"step", step}, {"t", t}};
   record["solver"] = {
-      {"iterations", ctx.iterations_},
-      {"solves", ctx.solves_},
-      {"residuals",
-       ctx.residuals_per_solve_.empty() ? std::vector<double>{} : ctx.residuals_per_solve_.back()},
+      {"iterations", tally.iterations},
+      {"solves", tally.solves},
+      {"residuals", tally.residuals_per_solve.empty() ? std::vector<double>{}
+                                                      : tally.residuals_per_solve.back()},
       {"relative_residual", worst.relative_residual},
       {"status", to_string(worst.status)}};
-  if (ctx.solves_ > 1) record["solver"]["residuals_per_solve"] = ctx.residuals_per_solve_;
-  if (ctx.contraction_ >= 0) record["solver"]["contraction"] = ctx.contraction_;
-  if (ctx.fallbacks_ > 0)
-    record["solver"]["fallback"] = {{"solves", ctx.fallbacks_},
-                                    {"iterations", ctx.fallback_iterations_}};
-  if (!ctx.columns_per_solve_.empty()) record["solver"]["rhs_per_solve"] = ctx.columns_per_solve_;
-  if (!ctx.preconditioner_setups_.empty())
-    record["solver"]["preconditioner_setup"] = ctx.preconditioner_setups_;
+  if (tally.solves > 1) record["solver"]["residuals_per_solve"] = tally.residuals_per_solve;
+  if (tally.contraction >= 0) record["solver"]["contraction"] = tally.contraction;
+  if (tally.fallbacks > 0)
+    record["solver"]["fallback"] = {{"solves", tally.fallbacks},
+                                    {"iterations", tally.fallback_iterations}};
+  if (!tally.columns_per_solve.empty()) record["solver"]["rhs_per_solve"] = tally.columns_per_solve;
+  if (!tally.preconditioner_setups.empty())
+    record["solver"]["preconditioner_setup"] = tally.preconditioner_setups;
   // What the solver noted on a matrix it accepted (a semi-definite coarsest level, serial
   // Gauss-Seidel on a level), or why it failed.
   if (!worst.message.empty()) record["solver"]["message"] = worst.message;
-  if (stabilized_) record["solver"]["stabilization_rho"] = ctx.stabilization_rho();
-  if (ctx.fixed()) record["fixed_functions"] = ctx.fixed();
+  if (stabilized_) record["solver"]["stabilization_rho"] = ctx_->stabilization_rho();
+  if (ctx_->fixed()) record["fixed_functions"] = ctx_->fixed();
   if (basis_->rebuilds_every_step()) {
     record["dimension"] = basis_->dimension();
     record["split_triangles"] = basis_->stats().split_triangles;
@@ -409,8 +414,8 @@ void FlowRun::stop(int step, Clock::time_point step_start, const std::string& re
                    nlohmann::json& record) {
   // A stopping step is recorded with its seconds too (every step has them: the result.json
   // contract), then the flow stops.
-  record["seconds"] = {{"update", ctx_->update_seconds_},
-                       {"solve", ctx_->solve_seconds_},
+  record["seconds"] = {{"update", ctx_->tally().update_seconds},
+                       {"solve", ctx_->tally().solve_seconds},
                        {"total", seconds_since(step_start)}};
   steps_.push_back(record);
   result_["status"] = "singular";
@@ -445,7 +450,7 @@ bool FlowRun::advance(int step) {
   begin_step(step);
   Coefficients x_new = integrator_->step(*ctx_);
   nlohmann::json record = solver_record(step, t);
-  const SolveReport& worst = ctx_->worst_;
+  const SolveReport& worst = ctx_->tally().worst;
   if (!worst.ok()) {
     stop(step, step_start,
          std::string("solver: ") + to_string(worst.status) +
@@ -484,8 +489,8 @@ bool FlowRun::advance(int step) {
   x_ = std::move(x_new);  // for a one-step scheme this frees X_{n-1}
   V_ = std::move(V_new);
   plant_slowdown(step_start);  // a no-op unless $MCFBENCH_PLANTED_SLOWDOWN is set
-  record["seconds"] = {{"update", ctx_->update_seconds_},
-                       {"solve", ctx_->solve_seconds_},
+  record["seconds"] = {{"update", ctx_->tally().update_seconds},
+                       {"solve", ctx_->tally().solve_seconds},
                        {"evaluate", evaluate_seconds},
                        {"total", seconds_since(step_start)}};
   steps_.push_back(std::move(record));

@@ -1,108 +1,50 @@
 #include "flows/flow_config.h"
 
+#include "flows/basis_registry.h"
 #include "flows/config_reader.h"
+#include "flows/config_schema.h"
+#include "flows/flow_registry.h"
 #include "flows/integrator.h"
+#include "flows/solver_registry.h"
+
+#include <optional>
 
 namespace mcf {
 
 FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& source) {
-  ConfigReader r(j, source);
+  ConfigReader top(j, source);
   FlowConfig c;
-  c.mesh = r.get_string("mesh", "");
-  if (c.mesh.empty()) r.fail("mesh", "missing (a mesh spec such as \"sphere:vertices=2000\")");
-  c.flow = r.get_string("flow", c.flow, {"mcf", "cmcf", "heat"});
-  c.basis = r.get_string("basis", c.basis, {"hat", "octree"});
-  c.mass = r.get_string("mass", c.mass, {"consistent", "lumped"});
-  {
-    auto o = r.child("octree");
-    c.octree.tracking = o.get_string("tracking", c.octree.tracking, {"tracked", "rebuilt"});
-    c.octree.depth = int(o.get_integer("depth", c.octree.depth, 4, 10));
-    c.octree.cubature = int(o.get_integer("cubature", c.octree.cubature, 1, 6));
-    if (c.octree.cubature != 1 && c.octree.cubature != 3 && c.octree.cubature != 6)
-      o.fail("cubature", "must be 1, 3 or 6, got " + std::to_string(c.octree.cubature));
-    c.octree.cube = o.get_string("cube", c.octree.cube, {"auto", "unit", "tight"});
-    c.octree.refine_input = o.get_bool("refine_input", c.octree.refine_input);
-    c.octree.stabilization =
-        o.get_string("stabilization", c.octree.stabilization, {"none", "normal-gradient"});
-    c.octree.stabilization_weight =
-        o.get_number("stabilization_weight", c.octree.stabilization_weight, 0.0, 1e6);
-    o.finish();
+  // One option after the other in the schema's order; an object's reader is finished (its
+  // unknown keys reported) when its last option has been read.
+  std::string object;
+  std::optional<ConfigReader> child;
+  for (const OptionSpec& o : flow_config_schema()) {
+    const std::string parent = split_key(o.key).first;
+    if (parent != object) {
+      if (child) child->finish();
+      child.reset();
+      object = parent;
+      if (!parent.empty()) child.emplace(top.child(parent));
+    }
+    read_option(parent.empty() ? top : *child, o, c);
   }
-  {
-    auto s = r.child("solver");
-    c.solver.name =
-        s.get_string("name", c.solver.name, {"cholmod", "pcg", "multigrid", "petsc", "dense"});
-    // PETSc's default cap is the paper's baseline's: CG + AMG stopped at 3000 iterations.
-    if (c.solver.name == "petsc") c.solver.max_iterations = 3000;
-    c.solver.tolerance =
-        s.get_number("tolerance", c.solver.tolerance, 0, 1);  // absent: -1, the solver's default
-    c.solver.max_iterations =
-        int(s.get_integer("max_iterations", c.solver.max_iterations, 1, 100000000));
-    c.solver.preconditioner = s.get_string("preconditioner", c.solver.preconditioner,
-                                           {"none", "jacobi", "ichol", "multigrid"});
-    c.solver.cycle = s.get_string("cycle", c.solver.cycle, {"V", "W"});
-    c.solver.cycles = int(s.get_integer("cycles", c.solver.cycles, 1, 10000));
-    c.solver.smooth = int(s.get_integer("smooth", c.solver.smooth, 0, 1000));
-    c.solver.stall_ratio = s.get_number("stall_ratio", c.solver.stall_ratio, 0, 1);
-    c.solver.fallback_tolerance =
-        s.get_number("fallback_tolerance", c.solver.fallback_tolerance, 1e-300, 1);
-    c.solver.petsc_options = s.get_string("petsc_options", c.solver.petsc_options);
-    s.finish();
-  }
-  c.integrator = r.get_string("integrator", c.integrator, integrator_names());
-  c.extrapolate = r.get_bool("extrapolate", c.extrapolate);
-  c.dt = r.get_number("dt", c.dt, 1e-300, 1e6);
-  if (c.dt <= 0) r.fail("dt", "must be > 0");
-  c.steps = int(r.get_integer("steps", c.steps, 0, 100000000));
-  c.normalize_area = r.get_bool("normalize_area", c.normalize_area);
-  c.threads = int(r.get_integer("threads", c.threads, 0, 4096));
-  c.blas_threads = int(r.get_integer("blas_threads", c.blas_threads, 0, 4096));
-  c.save_every = int(r.get_integer("save_every", c.save_every, 0, 100000000));
-  c.repair_degenerate = r.get_bool("repair_degenerate", c.repair_degenerate);
-  r.finish();
-  if (c.solver.tolerance < 0) c.solver.tolerance = c.solver.name == "multigrid" ? 0.0 : 1e-10;
+  if (child) child->finish();
+  top.finish();
+  if (c.solver.tolerance < 0) c.solver.tolerance = solver_row(c.solver.name).default_tolerance;
   validate_flow_config(c, source);
   return c;
 }
 
 nlohmann::json to_json(const FlowConfig& c) {
-  nlohmann::json j = {{"mesh", c.mesh},
-                      {"flow", c.flow},
-                      {"basis", c.basis},
-                      {"mass", c.mass},
-                      {"octree",
-                       {{"tracking", c.octree.tracking},
-                        {"depth", c.octree.depth},
-                        {"cubature", c.octree.cubature},
-                        {"cube", c.octree.cube},
-                        {"refine_input", c.octree.refine_input},
-                        {"stabilization", c.octree.stabilization},
-                        {"stabilization_weight", c.octree.stabilization_weight}}},
-                      {"solver",
-                       {{"name", c.solver.name},
-                        {"tolerance", c.solver.tolerance},
-                        {"max_iterations", c.solver.max_iterations},
-                        {"preconditioner", c.solver.preconditioner},
-                        {"cycle", c.solver.cycle},
-                        {"cycles", c.solver.cycles},
-                        {"smooth", c.solver.smooth}}},
-                      {"integrator", c.integrator},
-                      {"extrapolate", c.extrapolate},
-                      {"dt", c.dt},
-                      {"steps", c.steps},
-                      {"normalize_area", c.normalize_area},
-                      {"threads", c.threads},
-                      {"blas_threads", c.blas_threads},
-                      {"save_every", c.save_every}};
-  // Only when set: a key present with its default would change the config key of every cell
-  // (bench/cell_hash.h), and `compare` would find no cell of an earlier run to compare with.
-  if (c.repair_degenerate) j["repair_degenerate"] = true;
-  // A solver's own options only where that solver runs, for the same reason: the config keys of
-  // the other solvers' cells stay those of versions without them.
-  if (c.solver.name == "petsc") j["solver"]["petsc_options"] = c.solver.petsc_options;
-  if (c.solver.name == "multigrid") {
-    j["solver"]["stall_ratio"] = c.solver.stall_ratio;
-    j["solver"]["fallback_tolerance"] = c.solver.fallback_tolerance;
+  nlohmann::json j = nlohmann::json::object();
+  for (const OptionSpec& o : flow_config_schema()) {
+    // when_set and when_selected: a key present where it changes nothing would change the config
+    // key of every cell (bench/cell_hash.h), and `compare` would find no cell of an earlier run
+    // to compare with.
+    if (o.recorded == Recorded::when_set && o.get(c) == o.fallback) continue;
+    if (o.recorded == Recorded::when_selected && !o.selected(c)) continue;
+    const auto [parent, leaf] = split_key(o.key);
+    (parent.empty() ? j : j[parent])[leaf] = o.get(c);
   }
   return j;
 }
@@ -111,25 +53,21 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   auto fail = [&](const std::string& key, const std::string& what) {
     throw ConfigError(source + ": " + key + ": " + what);
   };
-  const bool rebuilt = c.basis == "octree" && c.octree.tracking == "rebuilt";
+  const BasisRow& basis = basis_row(c.basis);
+  const bool fixed = !basis.fixed_functions || basis.fixed_functions(c);
   // Options no solver reads would be recorded as if they had shaped the run.
-  if (c.solver.name != "petsc" && !c.solver.petsc_options.empty())
-    fail("solver.petsc_options",
-         "applies to solver \"petsc\" only, the solver is \"" + c.solver.name + "\"");
+  for (const OptionSpec& o : flow_config_schema())
+    if (o.refused_elsewhere && !o.selected(c) && o.get(c) != o.fallback)
+      fail(o.key,
+           "applies to solver \"" + o.owner + "\" only, the solver is \"" + c.solver.name + "\"");
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
-  if (c.basis != "hat" && c.mass != "consistent")
+  if (!basis.takes_mass && c.mass != "consistent")
     fail("mass", "\"" + c.mass +
                      "\" applies to the hat basis only; the octree basis integrates its "
                      "consistent mass matrix by cubature");
-  if (rebuilt && c.flow == "cmcf")
-    fail("flow",
-         "cmcf keeps the stiffness of t=0, which needs a fixed basis; the rebuilt octree "
-         "changes its functions every step (use octree.tracking \"tracked\" or basis \"hat\")");
-  if (rebuilt && c.flow == "heat")
-    fail("flow",
-         "heat flow keeps the operators of t=0, which needs a fixed basis; the rebuilt "
-         "octree changes its functions every step");
-  if (rebuilt && (c.integrator == "bdf2" || c.integrator == "crank-nicolson"))
+  if (!fixed && !flow_row(c.flow).fixed_basis_reason.empty())
+    fail("flow", flow_row(c.flow).fixed_basis_reason);
+  if (!fixed && make_integrator(c.integrator, c.extrapolate)->uses_previous())
     fail("integrator",
          "two-step schemes need coefficients in one fixed basis; the rebuilt octree "
          "changes its functions every step");
@@ -154,7 +92,7 @@ MeshLoadOptions mesh_load_options(const FlowConfig& c) {
   MeshLoadOptions o;
   if (c.repair_degenerate) {
     o.degenerate = DegenerateFaces::repair;
-  } else if (c.basis == "octree") {
+  } else if (basis_row(c.basis).keeps_degenerate_faces) {
     // The octree basis integrates over the surface by cubature on clipped pieces, and a
     // zero-area face leaves no piece: it changes nothing there.
     o.degenerate = DegenerateFaces::keep;

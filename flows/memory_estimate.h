@@ -9,25 +9,19 @@
 // matrices on the fixed pattern, the multigrid hierarchy, the normal-gradient term, a factor).
 // The figures per vertex and per function were fitted to measured peaks (docs/benchmarks.md
 // "Peak memory and set-up"); result.json records estimate and peak side by side, so the model can
-// be checked on any run.
+// be checked on any run. Each basis and solver row carries its own model (flows/memory_model.h):
+// the estimate adds the basis's share and the solver's.
 
 #include "datasets/mesh.h"
 #include "datasets/mesh_spec.h"
 #include "flows/flow_config.h"
+#include "flows/memory_model.h"
 
 #include <nlohmann/json.hpp>
 
 #include <string>
 
 namespace mcf {
-
-/// The sizes an estimate needs. `area_over_side2` < 0: the octree's size is not known yet (a
-/// spec that has not been built), so the estimate leaves the octree out and is a lower bound.
-struct FlowSizes {
-  double vertices = 0, faces = 0;
-  double area_over_side2 = -1;  ///< surface area / (octree cube side)^2, the octree's scale
-  bool exact = false;           ///< from the mesh itself, not from a spec's sizes
-};
 
 struct MemoryEstimate {
   double resident_bytes = 0;  ///< the process's resident memory when the estimate was made

@@ -1,9 +1,10 @@
 #pragma once
-// The one place where config names map to implementations (bases, solvers, integrators).
+// A flow config's basis and solver, made from their rows (flows/basis_registry.h,
+// flows/solver_registry.h): what the flow and the tests call.
 
 #include "bases/basis.h"
-#include "bases/octree_basis.h"
 #include "datasets/mesh.h"
+#include "flows/basis_registry.h"
 #include "flows/flow_config.h"
 #include "solvers/linear_solver.h"
 
@@ -11,10 +12,10 @@
 
 namespace mcf {
 
-/// The octree basis's options for a config; `analytic` shapes get the tight cube under "auto".
-OctreeOptions octree_options(const OctreeConfig& c, bool analytic);
+/// The basis of `config` on `mesh`, with the geometric hierarchy where its solver needs one.
 std::unique_ptr<Basis> make_basis(const FlowConfig& config, const TriangleMesh& mesh,
                                   bool analytic);
+/// Throws std::invalid_argument for an unknown name or options the solver refuses.
 std::unique_ptr<LinearSolver> make_solver(const SolverConfig& config);
 
 }  // namespace mcf

@@ -1,0 +1,228 @@
+#include "flows/config_schema.h"
+
+#include "flows/basis_registry.h"
+#include "flows/config_reader.h"
+#include "flows/flow_registry.h"
+#include "flows/integrator.h"
+#include "flows/solver_registry.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace mcf {
+namespace {
+
+/// The flow's own keys before the components' (mesh, flow, basis, mass).
+std::vector<OptionSpec> head_options() {
+  OptionSpec mesh = bind(
+      option("mesh", OptionType::string, "", "--mesh", "The input surface"),
+      [](auto& c) -> auto& { return c.mesh; });
+  mesh.default_text = "required";
+  mesh.values_text = "a mesh spec: generator, cgal:MODEL[@faces=N] or a file path";
+  mesh.after = [](FlowConfig& c, const ConfigReader& r, const std::string& leaf) {
+    if (c.mesh.empty()) r.fail(leaf, "missing (a mesh spec such as \"sphere:vertices=2000\")");
+  };
+  OptionSpec flow = bind(
+      option("flow", OptionType::string, "mcf", "--flow", "The flow"),
+      [](auto& c) -> auto& { return c.flow; });
+  flow.choices = [] { return flow_table().choices(); };
+  OptionSpec basis = bind(
+      option("basis", OptionType::string, "hat", "--basis", "The finite-element basis"),
+      [](auto& c) -> auto& { return c.basis; });
+  basis.choices = [] { return basis_table().choices(); };
+  OptionSpec mass = bind(
+      option("mass", OptionType::string, "consistent", "--mass",
+             "Hat basis mass matrix (the octree basis integrates its "
+             "consistent mass by cubature and refuses lumped)"),
+      [](auto& c) -> auto& { return c.mass; });
+  mass.choices = [] {
+    return std::vector<Choice>{{"consistent", "the consistent mass matrix"},
+                               {"lumped", "the lumped (diagonal) mass matrix"}};
+  };
+  return {mesh, flow, basis, mass};
+}
+
+nlohmann::json blas_threads_of_flag(const std::string& text) {
+  if (text == "auto") return 0;
+  int n = 0;
+  std::size_t used = 0;
+  try {
+    n = std::stoi(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || n < 1 || n > 4096)
+    throw std::invalid_argument("expected auto or a count 1..4096, got \"" + text + "\"");
+  return n;
+}
+
+/// The flow's own keys after the components' (time stepping, threads, output).
+std::vector<OptionSpec> tail_options() {
+  OptionSpec integrator = bind(
+      option("integrator", OptionType::string, "semi-implicit", "--integrator",
+             "Time integrator (docs/design.md)"),
+      [](auto& c) -> auto& { return c.integrator; });
+  integrator.choices = [] {
+    std::vector<Choice> c;
+    for (const std::string& name : integrator_names()) c.emplace_back(name, "");
+    return c;
+  };
+  OptionSpec extrapolate = bind(
+      option("extrapolate", OptionType::boolean, true, "--frozen",
+             "CN/BDF2: operators at the extrapolated X*; --frozen "
+             "evaluates them at X_n instead (first order)"),
+      [](auto& c) -> auto& { return c.extrapolate; });
+  extrapolate.flag_kind = FlagKind::set_false;
+  OptionSpec dt = ranged(bind(
+                             option("dt", OptionType::number, 1e-3, "--dt", "Time step"),
+                             [](auto& c) -> auto& { return c.dt; }),
+                         1e-300, 1e6);
+  dt.values_text = "> 0";
+  dt.after = [](FlowConfig& c, const ConfigReader& r, const std::string& leaf) {
+    if (c.dt <= 0) r.fail(leaf, "must be > 0");
+  };
+  OptionSpec steps =
+      ranged(bind(
+                 option("steps", OptionType::integer, 10, "--steps", "Number of steps"),
+                 [](auto& c) -> auto& { return c.steps; }),
+             0, 100000000);
+  OptionSpec normalize = bind(
+      option("normalize_area", OptionType::boolean, false, "--normalize-area",
+             "Unit total area, centroid at the origin, before and after "
+             "every step (refused on an open surface)"),
+      [](auto& c) -> auto& { return c.normalize_area; });
+  normalize.flag_kind = FlagKind::set_true;
+  OptionSpec threads = ranged(bind(
+                                  option("threads", OptionType::integer, 0, "--threads",
+                                         "Worker threads, and the most OpenBLAS may use under "
+                                         "CHOLMOD"),
+                                  [](auto& c) -> auto& { return c.threads; }),
+                              0, 4096);
+  threads.default_text = "0 = all cores";
+  OptionSpec blas = ranged(bind(
+                               option("blas_threads", OptionType::integer, 0, "--blas-threads",
+                                      "OpenBLAS threads under CHOLMOD: auto (one below 20000 "
+                                      "unknowns, else up to 4) or a count, at most --threads"),
+                               [](auto& c) -> auto& { return c.blas_threads; }),
+                           0, 4096);
+  blas.default_text = "auto (0 in the config)";
+  blas.values_text = "auto | 1..4096";
+  blas.parse_flag = blas_threads_of_flag;
+  OptionSpec save = ranged(bind(
+                               option("save_every", OptionType::integer, 0, "--save-every",
+                                      "Write OUT/frame_NNNNN.ply every K steps"),
+                               [](auto& c) -> auto& { return c.save_every; }),
+                           0, 100000000);
+  save.default_text = "0 = never";
+  OptionSpec repair = bind(
+      option("repair_degenerate", OptionType::boolean, false, "--repair-degenerate",
+             "Collapse the mesh's zero-area faces first (the hat basis "
+             "refuses them; the octree basis takes them as they are)"),
+      [](auto& c) -> auto& { return c.repair_degenerate; });
+  repair.flag_kind = FlagKind::set_true;
+  repair.recorded = Recorded::when_set;
+  return {integrator, extrapolate, dt, steps, normalize, threads, blas, save, repair};
+}
+
+std::vector<OptionSpec> gather() {
+  std::vector<OptionSpec> all = head_options();
+  for (const BasisRow& row : basis_table().rows())
+    all.insert(all.end(), row.options.begin(), row.options.end());
+  const std::vector<OptionSpec>& shared = solver_options();
+  all.insert(all.end(), shared.begin(), shared.end());
+  for (const SolverRow& row : solver_table().rows())
+    for (OptionSpec o : row.options) {
+      o.key = "solver." + o.key;
+      o.owner = row.name;
+      o.selected = [name = row.name](const FlowConfig& c) { return c.solver.name == name; };
+      o.recorded = Recorded::when_selected;
+      all.push_back(std::move(o));
+    }
+  const std::vector<OptionSpec> tail = tail_options();
+  all.insert(all.end(), tail.begin(), tail.end());
+  return all;
+}
+
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+}  // namespace
+
+const std::vector<OptionSpec>& flow_config_schema() {
+  // Built on first use, after every row registered from a static initializer.
+  static const std::vector<OptionSpec> schema = gather();
+  return schema;
+}
+
+std::string option_values(const OptionSpec& o) {
+  if (!o.values_text.empty()) return o.values_text;
+  if (o.choices) {
+    std::string v;
+    for (const Choice& c : o.choices()) v += (v.empty() ? "" : " | ") + c.first;
+    return v;
+  }
+  switch (o.type) {
+    case OptionType::integer:
+      return number_text(o.min) + ".." + number_text(o.max);
+    case OptionType::number:
+      return "[" + number_text(o.min) + ", " + number_text(o.max) + "]";
+    case OptionType::boolean:
+      return "true | false";
+    case OptionType::string:
+      break;
+  }
+  return "text";
+}
+
+std::string option_default(const OptionSpec& o) {
+  if (!o.default_text.empty()) return o.default_text;
+  if (o.fallback.is_string()) {
+    const std::string s = o.fallback.get<std::string>();
+    return s.empty() ? "\"\"" : s;
+  }
+  if (o.fallback.is_number_float()) return number_text(o.fallback.get<double>());
+  return o.fallback.dump();
+}
+
+std::string option_flag_help(const OptionSpec& o) {
+  std::string h = o.help;
+  if (o.flag_kind != FlagKind::value) return h + " (config key " + o.key + ")";
+  if (o.choices) {
+    h += ":";
+    const char* sep = " ";
+    for (const Choice& c : o.choices()) {
+      h += sep + c.first + (c.second.empty() ? "" : " (" + c.second + ")");
+      sep = " | ";
+    }
+  } else {
+    h += ": " + option_values(o);
+  }
+  return h + "; default " + option_default(o);
+}
+
+std::string flow_options_markdown() {
+  std::string md = "| flag | config key | values | default | meaning |\n|---|---|---|---|---|\n";
+  auto cell = [](std::string s) {
+    std::string out;
+    for (char ch : s) out += ch == '|' ? std::string("\\|") : std::string(1, ch);
+    return out;
+  };
+  for (const OptionSpec& o : flow_config_schema()) {
+    std::string flag = o.flag.empty() ? "" : "`" + o.flag + "`";
+    if (o.flag_kind == FlagKind::set_true) flag += " (sets true)";
+    if (o.flag_kind == FlagKind::set_false) flag += " (sets false)";
+    std::string meaning = o.help;
+    if (o.choices)
+      for (const Choice& c : o.choices())
+        if (!c.second.empty()) meaning += "; `" + c.first + "`: " + c.second;
+    if (!o.owner.empty()) meaning += " (solver `" + o.owner + "` only)";
+    md += "| " + flag + " | `" + o.key + "` | " + cell(option_values(o)) + " | " +
+          cell(option_default(o)) + " | " + cell(meaning) + " |\n";
+  }
+  return md;
+}
+
+}  // namespace mcf
