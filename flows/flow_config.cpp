@@ -47,6 +47,8 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
     c.solver.fallback_tolerance =
         s.get_number("fallback_tolerance", c.solver.fallback_tolerance, 1e-300, 1);
     c.solver.petsc_options = s.get_string("petsc_options", c.solver.petsc_options);
+    c.solver.galerkin_by_term = s.get_bool("galerkin_by_term", c.solver.galerkin_by_term);
+    c.solver.precision = s.get_string("precision", c.solver.precision, {"double", "mixed"});
     s.finish();
   }
   c.integrator = r.get_string("integrator", c.integrator, integrator_names());
@@ -100,6 +102,8 @@ nlohmann::json to_json(const FlowConfig& c) {
   // A solver's own options only where that solver runs, for the same reason: the config keys of
   // the other solvers' cells stay those of versions without them.
   if (c.solver.name == "petsc") j["solver"]["petsc_options"] = c.solver.petsc_options;
+  if (c.solver.galerkin_by_term) j["solver"]["galerkin_by_term"] = true;
+  if (c.solver.precision != "double") j["solver"]["precision"] = c.solver.precision;
   if (c.solver.name == "multigrid") {
     j["solver"]["stall_ratio"] = c.solver.stall_ratio;
     j["solver"]["fallback_tolerance"] = c.solver.fallback_tolerance;
@@ -116,6 +120,15 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   if (c.solver.name != "petsc" && !c.solver.petsc_options.empty())
     fail("solver.petsc_options",
          "applies to solver \"petsc\" only, the solver is \"" + c.solver.name + "\"");
+  const bool multigrid = c.solver.name == "multigrid" ||
+                         (c.solver.name == "pcg" && c.solver.preconditioner == "multigrid");
+  if (c.solver.galerkin_by_term && !multigrid)
+    fail("solver.galerkin_by_term", "applies to a multigrid (solver \"multigrid\", or \"pcg\" "
+                                    "with preconditioner \"multigrid\") only");
+  if (c.solver.precision != "double" && !multigrid)
+    fail("solver.precision", "\"" + c.solver.precision +
+                                 "\" applies to a multigrid (solver \"multigrid\", or \"pcg\" "
+                                 "with preconditioner \"multigrid\") only");
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
   if (c.basis != "hat" && c.mass != "consistent")
     fail("mass", "\"" + c.mass +

@@ -40,6 +40,8 @@ MultigridOptions multigrid_options(const SolverConfig& c) {
   o.cycles = c.cycles;
   o.pre_smooth = o.post_smooth = c.smooth;
   o.tolerance = c.tolerance;
+  o.galerkin_by_term = c.galerkin_by_term;
+  o.mixed_precision = c.precision == "mixed";
   return o;
 }
 

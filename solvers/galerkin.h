@@ -12,6 +12,7 @@
 // interface.
 
 #include "core/sparse.h"
+#include "solvers/csc_view.h"
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -38,7 +39,9 @@ using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 /// Columns are visited in `column_order` (internal column of the caller's column jj; empty:
 /// identity), i.e. in grid order, so consecutive columns share most of their fine support:
 /// visiting them colour-major measured 1.3x slower.
-void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatrix& Cm,
+/// A is a view (its values may be one term's, on the level's pattern); the values are written to
+/// `Cval`, on Cm's pattern (Cm's own values when Cval is Cm.valuePtr()).
+void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm, double* Cval,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
                      Spa& spa);
 
