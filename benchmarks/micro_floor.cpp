@@ -59,7 +59,8 @@ std::string env_or(const char* name, const char* fallback) {
 }
 
 const MeshSource& floor_mesh() {
-  static const MeshSource m = load_mesh_spec(env_or("MCFBENCH_FLOOR_MESH", "sphere:vertices=40000"));
+  static const MeshSource m =
+      load_mesh_spec(env_or("MCFBENCH_FLOOR_MESH", "sphere:vertices=40000"));
   return m;
 }
 
@@ -82,8 +83,8 @@ PhaseCost galerkin_floor(const SparseMatrix& A, const SparseMatrix& P, const Spa
 /// restriction and prolongation (to and from level l - 1); on level 0 the direct solve.
 PhaseCost visit_floor(const MultigridSolver& mg, const std::vector<SparseMatrix>& P, int l,
                       int smooth, int columns) {
-  if (l == 0) return factor_solve_cost(mg.level_matrix(0).rows(), mg.coarsest_factor_nonzeros(),
-                                       columns);
+  if (l == 0)
+    return factor_solve_cost(mg.level_matrix(0).rows(), mg.coarsest_factor_nonzeros(), columns);
   const SparseSize A = sparse_size(mg.level_matrix(l));
   SparseSize S = A;
   S.index_bytes = 0;  // the entry's bytes, offset and value together
@@ -171,11 +172,11 @@ void BM_Floor_HatUpdate(benchmark::State& state) {
     benchmark::DoNotOptimize(f.basis->mass().valuePtr());
   }
   const TriangleMesh& m = floor_mesh().mesh;
-  report(state,
-         assembly_cost(m.num_faces(), m.num_vertices(), f.basis->mass().nonZeros(),
-                       stiffness ? 2 : 1,
-                       kHatMassFlopsPerFace + (stiffness ? kHatStiffnessFlopsPerFace : 0)),
-         threads);
+  report(
+      state,
+      assembly_cost(m.num_faces(), m.num_vertices(), f.basis->mass().nonZeros(), stiffness ? 2 : 1,
+                    kHatMassFlopsPerFace + (stiffness ? kHatStiffnessFlopsPerFace : 0)),
+      threads);
 }
 BENCHMARK(BM_Floor_HatUpdate)
     ->ArgNames({"threads", "matrices"})
@@ -219,8 +220,8 @@ void BM_Floor_HatGalerkin(benchmark::State& state) {
   const std::vector<int> transpose_pos = multigrid_detail::transpose_positions(C);
   multigrid_detail::Spa spa;
   for (auto _ : state) {
-    multigrid_detail::galerkin_values(multigrid_detail::Csc(A), P, C, C.valuePtr(),
-                                      transpose_pos, {}, spa);
+    multigrid_detail::galerkin_values(multigrid_detail::Csc(A), P, C, C.valuePtr(), transpose_pos,
+                                      {}, spa);
     benchmark::DoNotOptimize(C.valuePtr());
   }
   report(state, galerkin_floor(A, P, C), threads);
@@ -407,10 +408,30 @@ void BM_Floor_TrackedEvaluate(benchmark::State& state) {
   report(state, stencil_cost(floor_mesh().mesh.num_vertices(), 8, f.x.rows(), 3), threads);
 }
 
-BENCHMARK(BM_Floor_TrackedUpdate)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Floor_TrackedSetMatrix)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Floor_TrackedCycle)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Floor_TrackedEvaluate)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Floor_TrackedUpdate)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Floor_TrackedSetMatrix)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Floor_TrackedCycle)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Floor_TrackedEvaluate)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace mcf

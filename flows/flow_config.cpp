@@ -123,8 +123,9 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   const bool multigrid = c.solver.name == "multigrid" ||
                          (c.solver.name == "pcg" && c.solver.preconditioner == "multigrid");
   if (c.solver.galerkin_by_term && !multigrid)
-    fail("solver.galerkin_by_term", "applies to a multigrid (solver \"multigrid\", or \"pcg\" "
-                                    "with preconditioner \"multigrid\") only");
+    fail("solver.galerkin_by_term",
+         "applies to a multigrid (solver \"multigrid\", or \"pcg\" "
+         "with preconditioner \"multigrid\") only");
   if (c.solver.precision != "double" && !multigrid)
     fail("solver.precision", "\"" + c.solver.precision +
                                  "\" applies to a multigrid (solver \"multigrid\", or \"pcg\" "

@@ -774,8 +774,8 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
   // Mixed precision: each cycle runs on the correction of the residual that the previous
   // convergence check kept (correction_cycle).
   const bool mixed = m.fine_single && top > 0;
-  double rel = measure_start ? m.relative_residual(bnorm, mixed)
-                             : std::numeric_limits<double>::infinity();
+  double rel =
+      measure_start ? m.relative_residual(bnorm, mixed) : std::numeric_limits<double>::infinity();
   bool have_r = measure_start && mixed;
   const double start = rel;
   if (tol > 0.0 && rel < tol) {
@@ -853,20 +853,32 @@ void MultigridSolver::run_kernel(MultigridKernel kernel, int l, int columns) {
   Impl& m = *impl_;
   if (!m.ready) throw std::logic_error("MultigridSolver::run_kernel before set_matrix");
   const int top = int(m.levels.size()) - 1;
-  const bool transfer = kernel == MultigridKernel::restriction ||
-                        kernel == MultigridKernel::prolongation;
+  const bool transfer =
+      kernel == MultigridKernel::restriction || kernel == MultigridKernel::prolongation;
   if (l < 0 || l > top || (transfer && l == 0) ||
       (kernel == MultigridKernel::coarsest_solve && l != 0))
     throw std::invalid_argument("MultigridSolver::run_kernel: no such level for this kernel");
   if (columns <= 0) return;
   m.ensure_buffers(columns);
   switch (kernel) {
-    case MultigridKernel::forward_sweep: m.sweep(l, false); break;
-    case MultigridKernel::reverse_sweep: m.sweep(l, true); break;
-    case MultigridKernel::residual: m.residual(l); break;
-    case MultigridKernel::restriction: m.restrict_residual(l); break;
-    case MultigridKernel::prolongation: m.prolongate(l); break;
-    case MultigridKernel::coarsest_solve: m.coarse_solve(); break;
+    case MultigridKernel::forward_sweep:
+      m.sweep(l, false);
+      break;
+    case MultigridKernel::reverse_sweep:
+      m.sweep(l, true);
+      break;
+    case MultigridKernel::residual:
+      m.residual(l);
+      break;
+    case MultigridKernel::restriction:
+      m.restrict_residual(l);
+      break;
+    case MultigridKernel::prolongation:
+      m.prolongate(l);
+      break;
+    case MultigridKernel::coarsest_solve:
+      m.coarse_solve();
+      break;
   }
 }
 

@@ -74,9 +74,9 @@ double galerkin_flops(const SparseRef& Am, const SparseRef& Pm, const SparseRef&
 
 PhaseCost factor_solve_cost(std::int64_t n, std::int64_t factor_nnz, int columns) {
   const double c = columns;
-  return {2 * double(factor_nnz) * (4 + kDouble) + double(n) * kDouble +
-              2 * double(n) * c * kDouble,
-          (4 * double(factor_nnz) + double(n)) * c};
+  return {
+      2 * double(factor_nnz) * (4 + kDouble) + double(n) * kDouble + 2 * double(n) * c * kDouble,
+      (4 * double(factor_nnz) + double(n)) * c};
 }
 
 PhaseCost matrix_sum_cost(std::int64_t nnz) {
@@ -92,8 +92,9 @@ PhaseCost assembly_cost(std::int64_t faces, std::int64_t vertices, std::int64_t 
 
 PhaseCost integration_cost(double input_bytes, std::int64_t coefficients, std::int64_t nnz,
                            int matrices, std::int64_t points, double flops_per_point) {
-  return {input_bytes + double(coefficients) * 3 * kDouble + double(matrices) * double(nnz) * kDouble,
-          double(points) * flops_per_point};
+  return {
+      input_bytes + double(coefficients) * 3 * kDouble + double(matrices) * double(nnz) * kDouble,
+      double(points) * flops_per_point};
 }
 
 PhaseCost stencil_cost(std::int64_t outputs, int weights, std::int64_t coefficients, int columns) {

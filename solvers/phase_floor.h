@@ -25,7 +25,8 @@
 //   sum a M + b K on a pattern bytes 3 nnz 8 (M, K read; sum written)           flops 3 nnz
 //   assembly of m matrices     bytes faces 3 4 + vertices 3 8 + m nnz 8 (the values written)
 //                              flops faces × flops_per_face (the caller's count of its formula)
-//   integration at points      bytes input + coefficients 3 8 + m nnz 8      flops points × per point
+//   integration at points      bytes input + coefficients 3 8 + m nnz 8
+//                              flops points × flops_per_point
 //                              (the tracked octree's update: `input` its preprocessed bytes)
 //   stencil evaluation         bytes v w (4 + 8) + coefficients c 8 + v c 8   flops 2 v w c
 //                              (v output rows, w weights each, read once with their indices)

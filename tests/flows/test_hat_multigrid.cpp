@@ -141,8 +141,12 @@ TEST(HatMultigrid, FlowsWithMultigridFollowCholmod) {
 // about the contraction times that; cMCF changes only the mass, heat flow nothing).
 TEST(HatMultigrid, GalerkinByTermFlowsAsTheSumsGalerkinProduct) {
   for (const char* flow : {"cmcf", "heat", "mcf"}) {
-    const json base = {{"mesh", "cgal:armadillo"}, {"basis", "hat"}, {"flow", flow},
-                       {"dt", 1e-3},              {"steps", 4},     {"solver", {{"name", "multigrid"}, {"cycles", 3}}}};
+    const json base = {{"mesh", "cgal:armadillo"},
+                       {"basis", "hat"},
+                       {"flow", flow},
+                       {"dt", 1e-3},
+                       {"steps", 4},
+                       {"solver", {{"name", "multigrid"}, {"cycles", 3}}}};
     json by_term = base;
     by_term["solver"]["galerkin_by_term"] = true;
     const FlowOutcome plain = testing::run(base), o = testing::run(by_term);

@@ -425,15 +425,15 @@ TEST(Multigrid, GalerkinByTermRefreshesOnlyChangedTermsAndMatchesTheSum) {
     const SparseMatrix* M;
     double b;
     const SparseMatrix* K;
-    double s;  // 0: two terms
+    double s;               // 0: two terms
     std::int64_t products;  // term products this call must compute
   };
   const int coarse = int(pm.P.size());
   const std::int64_t none = 0, one = coarse, two = 2 * coarse, three = 3 * coarse;
-  for (const Call c : {Call{1.0, &M, 0.05, &K, 0, two},   // new pattern: both terms
-                       Call{1.0, &M2, 0.05, &K, 0, one},  // cMCF: the mass changed
-                       Call{1.0, &M2, 0.2, &K, 0, none},  // new coefficients, same terms
-                       Call{1.0, &M2, 0.2, &K2, 0, one},  // the stiffness changed
+  for (const Call c : {Call{1.0, &M, 0.05, &K, 0, two},      // new pattern: both terms
+                       Call{1.0, &M2, 0.05, &K, 0, one},     // cMCF: the mass changed
+                       Call{1.0, &M2, 0.2, &K, 0, none},     // new coefficients, same terms
+                       Call{1.0, &M2, 0.2, &K2, 0, one},     // the stiffness changed
                        Call{1.0, &M, 0.2, &K2, 0.7, three},  // a third term: all anew
                        Call{1.0, &M2, 0.2, &K2, 0.7, one}}) {
     SCOPED_TRACE(c.products);

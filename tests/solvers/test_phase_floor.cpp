@@ -73,8 +73,8 @@ TEST(PhaseFloor, GalerkinMatchesHandCounts) {
   // is P e_0 · v (2 entries). Column 1: A's columns 1 and 2 (3 + 2); entries (0, 1) and (1, 1), 2
   // each. 16 multiply-adds.
   EXPECT_EQ(mcf::galerkin_flops(t.A, t.P, t.C), 32);
-  const mcf::PhaseCost c = mcf::galerkin_cost(mcf::sparse_size(t.A), mcf::sparse_size(t.P),
-                                              mcf::sparse_size(t.C), 32);
+  const mcf::PhaseCost c =
+      mcf::galerkin_cost(mcf::sparse_size(t.A), mcf::sparse_size(t.P), mcf::sparse_size(t.C), 32);
   EXPECT_EQ(c.bytes, (84 + 16) + (48 + 12) + 4 * 12);
   EXPECT_EQ(c.flops, 32);
 }
