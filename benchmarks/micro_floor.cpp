@@ -74,6 +74,19 @@ void report(benchmark::State& state, const PhaseCost& c, int threads) {
   state.counters["threads"] = threads;
 }
 
+/// A benchmark of one argument, the thread count: 1 and 2.
+void per_thread_count(benchmark::internal::Benchmark* b) {
+  b->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+/// The thread count of range(0), held by `limit` for the benchmark's lifetime.
+int set_threads(benchmark::State& state, std::unique_ptr<tbb::global_control>& limit) {
+  const int t = int(state.range(0));
+  limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                std::size_t(t));
+  return t;
+}
+
 /// The Galerkin product onto level l (from l + 1) by the floor model.
 PhaseCost galerkin_floor(const SparseMatrix& A, const SparseMatrix& P, const SparseMatrix& C) {
   return galerkin_cost(sparse_size(A), sparse_size(P), sparse_size(C), galerkin_flops(A, P, C));
@@ -124,6 +137,36 @@ PhaseCost set_matrix_floor(const MultigridSolver& mg, const std::vector<SparseMa
   return c;
 }
 
+/// One cycle of a fixture's solver (a cycle from zero: MultigridSolver::precondition) against
+/// the sum of its levels' visits.
+template <class Fixture>
+void time_cycle(benchmark::State& state) {
+  std::unique_ptr<tbb::global_control> limit;
+  const int threads = set_threads(state, limit);
+  Fixture& f = Fixture::get();
+  Eigen::MatrixXd r, z;
+  symmetric_multiply(f.basis->mass(), f.x, r);
+  for (auto _ : state) {
+    f.mg->precondition(r, z);
+    benchmark::DoNotOptimize(z.data());
+  }
+  report(state, cycle_floor(*f.mg, f.P(), Fixture::smooth, 4), threads);
+  state.counters["levels"] = f.mg->levels();
+}
+
+/// A fixture's evaluate_vertices against its floor (Fixture::evaluate_floor).
+template <class Fixture>
+void time_evaluate(benchmark::State& state) {
+  std::unique_ptr<tbb::global_control> limit;
+  const int threads = set_threads(state, limit);
+  Fixture& f = Fixture::get();
+  for (auto _ : state) {
+    Positions v = f.basis->evaluate_vertices(f.x);
+    benchmark::DoNotOptimize(v.data());
+  }
+  report(state, f.evaluate_floor(), threads);
+}
+
 // ---- the hat basis ---------------------------------------------------------------------------
 
 struct HatFloor {
@@ -153,14 +196,9 @@ struct HatFloor {
   }
   HierarchyView view() const { return {basis->prolongations(), basis->colours()}; }
   const std::vector<SparseMatrix>& P() const { return *basis->prolongations(); }
+  /// A permuted copy of the coefficients.
+  PhaseCost evaluate_floor() const { return copy_cost(x.rows(), 3); }
 };
-
-int set_threads(benchmark::State& state, std::unique_ptr<tbb::global_control>& limit) {
-  const int t = int(state.range(0));
-  limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                std::size_t(t));
-  return t;
-}
 
 void BM_Floor_HatUpdate(benchmark::State& state) {
   std::unique_ptr<tbb::global_control> limit;
@@ -285,49 +323,17 @@ void BM_Floor_HatCoarsestSolve(benchmark::State& state) {
          factor_solve_cost(f.mg->level_matrix(0).rows(), f.mg->coarsest_factor_nonzeros(), 3),
          threads);
 }
-BENCHMARK(BM_Floor_HatCoarsestSolve)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_Floor_HatCoarsestSolve)->Apply(per_thread_count);
 
 void BM_Floor_HatCycle(benchmark::State& state) {
-  std::unique_ptr<tbb::global_control> limit;
-  const int threads = set_threads(state, limit);
-  HatFloor& f = HatFloor::get();
-  Eigen::MatrixXd r, z;
-  symmetric_multiply(f.basis->mass(), f.x, r);
-  for (auto _ : state) {
-    f.mg->precondition(r, z);
-    benchmark::DoNotOptimize(z.data());
-  }
-  report(state, cycle_floor(*f.mg, f.P(), HatFloor::smooth, 4), threads);
-  state.counters["levels"] = f.mg->levels();
+  time_cycle<HatFloor>(state);
 }
-BENCHMARK(BM_Floor_HatCycle)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_Floor_HatCycle)->Apply(per_thread_count);
 
 void BM_Floor_HatEvaluate(benchmark::State& state) {
-  std::unique_ptr<tbb::global_control> limit;
-  const int threads = set_threads(state, limit);
-  HatFloor& f = HatFloor::get();
-  for (auto _ : state) {
-    Positions v = f.basis->evaluate_vertices(f.x);
-    benchmark::DoNotOptimize(v.data());
-  }
-  report(state, copy_cost(f.x.rows(), 3), threads);
+  time_evaluate<HatFloor>(state);
 }
-BENCHMARK(BM_Floor_HatEvaluate)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_Floor_HatEvaluate)->Apply(per_thread_count);
 
 // ---- the tracked octree basis ----------------------------------------------------------------
 
@@ -356,6 +362,10 @@ struct TrackedFloor {
   }
   HierarchyView view() const { return {basis->prolongations(), basis->colours()}; }
   const std::vector<SparseMatrix>& P() const { return *basis->prolongations(); }
+  /// Each original vertex: the 8 trilinear weights of its cell's corners (VertexStencils).
+  PhaseCost evaluate_floor() const {
+    return stencil_cost(floor_mesh().mesh.num_vertices(), 8, x.rows(), 3);
+  }
 };
 
 void BM_Floor_TrackedUpdate(benchmark::State& state) {
@@ -384,54 +394,16 @@ void BM_Floor_TrackedSetMatrix(benchmark::State& state) {
 }
 
 void BM_Floor_TrackedCycle(benchmark::State& state) {
-  std::unique_ptr<tbb::global_control> limit;
-  const int threads = set_threads(state, limit);
-  TrackedFloor& f = TrackedFloor::get();
-  Eigen::MatrixXd r, z;
-  symmetric_multiply(f.basis->mass(), f.x, r);
-  for (auto _ : state) {
-    f.mg->precondition(r, z);
-    benchmark::DoNotOptimize(z.data());
-  }
-  report(state, cycle_floor(*f.mg, f.P(), TrackedFloor::smooth, 4), threads);
+  time_cycle<TrackedFloor>(state);
 }
-
 void BM_Floor_TrackedEvaluate(benchmark::State& state) {
-  std::unique_ptr<tbb::global_control> limit;
-  const int threads = set_threads(state, limit);
-  TrackedFloor& f = TrackedFloor::get();
-  for (auto _ : state) {
-    Positions v = f.basis->evaluate_vertices(f.x);
-    benchmark::DoNotOptimize(v.data());
-  }
-  // Each original vertex: the 8 trilinear weights of its cell's corners (VertexStencils).
-  report(state, stencil_cost(floor_mesh().mesh.num_vertices(), 8, f.x.rows(), 3), threads);
+  time_evaluate<TrackedFloor>(state);
 }
 
-BENCHMARK(BM_Floor_TrackedUpdate)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(BM_Floor_TrackedSetMatrix)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(BM_Floor_TrackedCycle)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(BM_Floor_TrackedEvaluate)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_Floor_TrackedUpdate)->Apply(per_thread_count);
+BENCHMARK(BM_Floor_TrackedSetMatrix)->Apply(per_thread_count);
+BENCHMARK(BM_Floor_TrackedCycle)->Apply(per_thread_count);
+BENCHMARK(BM_Floor_TrackedEvaluate)->Apply(per_thread_count);
 
 }  // namespace
 }  // namespace mcf
