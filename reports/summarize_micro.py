@@ -76,7 +76,8 @@ def floor_table(b, peak_gflops=None):
     """Markdown lines of the Floors table, [] without BM_Floor_* benchmarks. A benchmark skipped
     for a level the mesh lacks (error_occurred) is left out."""
     triad = {}
-    for name, x in b.items():
+    # "BM_StreamTriad/0" (all cores) first, so that an explicit thread count of the same value wins.
+    for name, x in sorted(b.items(), key=lambda kv: not kv[0].startswith("BM_StreamTriad/0")):
         if name.startswith("BM_StreamTriad/") and "bandwidth_GBps" in x:
             triad[int(x.get("threads", 0))] = x["bandwidth_GBps"] * 1e9
     rows = []
