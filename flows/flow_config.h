@@ -39,6 +39,12 @@ struct SolverConfig {
   /// (never below `fallback_tolerance`; solvers/multigrid_fallback.h). 0 = never.
   double stall_ratio = 0.2;
   double fallback_tolerance = 1e-10;
+  /// multigrid (also as PCG's preconditioner): refresh the coarse operators term by term,
+  /// recomputing only the terms whose values changed (MultigridOptions::galerkin_by_term).
+  bool galerkin_by_term = false;
+  /// multigrid: double | mixed (the finest sweeps in single precision inside a double-precision
+  /// residual correction; MultigridOptions::mixed_precision).
+  std::string precision = "double";
   /// petsc: PETSc options ("-pc_type hypre -pc_hypre_type boomeramg") over the defaults (CG +
   /// GAMG, solvers/petsc_solver.h), kept verbatim in result.json.
   std::string petsc_options;

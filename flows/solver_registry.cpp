@@ -154,7 +154,34 @@ std::vector<OptionSpec> shared_options() {
                         "Gauss-Seidel sweeps before and after each coarse correction"),
                  [](auto& c) -> auto& { return c.solver.smooth; }),
              0, 1000);
-  return {name, tolerance, max_iterations, preconditioner, cycle, cycles, smooth};
+  // Options of the geometric multigrid wherever it runs: as the solver or as PCG's
+  // preconditioner. Recorded only when set, refused where no multigrid runs.
+  const auto multigrid_option = [](OptionSpec o) {
+    o.recorded = Recorded::when_set;
+    o.refused_elsewhere = true;
+    o.owner_text =
+        "a multigrid (solver \"multigrid\", or \"pcg\" with preconditioner \"multigrid\")";
+    o.selected = [](const FlowConfig& c) { return needs_hierarchy(c.solver); };
+    return o;
+  };
+  OptionSpec by_term = multigrid_option(bind(
+      option("solver.galerkin_by_term", OptionType::boolean, false, "--galerkin-by-term",
+             "Multigrid: refresh the coarse operators term by term, only the terms whose "
+             "values changed (cMCF: the mass alone); equal to the sum's products up to "
+             "rounding"),
+      [](auto& c) -> auto& { return c.solver.galerkin_by_term; }));
+  by_term.flag_kind = FlagKind::set_true;
+  OptionSpec precision = multigrid_option(bind(
+      option("solver.precision", OptionType::string, "double", "--precision",
+             "Multigrid: the finest level's sweeps in double or in single precision inside "
+             "a double-precision residual correction (same solution, fewer bytes a sweep)"),
+      [](auto& c) -> auto& { return c.solver.precision; }));
+  precision.choices = [] {
+    return std::vector<Choice>{{"double", "every sweep in double precision"},
+                               {"mixed", "the finest sweeps read a single-precision copy"}};
+  };
+  return {name,   tolerance, max_iterations, preconditioner, cycle,
+          cycles, smooth,    by_term,        precision};
 }
 
 NamedTable<SolverRow>& table() {
@@ -193,6 +220,8 @@ MultigridOptions multigrid_options(const SolverConfig& c) {
   o.cycles = c.cycles;
   o.pre_smooth = o.post_smooth = c.smooth;
   o.tolerance = c.tolerance;
+  o.galerkin_by_term = c.galerkin_by_term;
+  o.mixed_precision = c.precision == "mixed";
   return o;
 }
 

@@ -6,7 +6,14 @@ targets and the paper's values, and each multigrid level's visits and own time p
 W-cycle. Ratios only compare benchmarks of the same JSON file (same run); with
 --benchmark_repetitions each benchmark counts as the median of its repetitions.
 
-Usage: reports/summarize_micro.py micro_octree.json [> table.md]
+With BM_Floor_* benchmarks in the file (benchmarks/micro_floor.cpp), also the Floors table of
+docs/benchmarks.md: per phase its time, the bytes and flops of its floor (solvers/phase_floor.h),
+the bandwidth achieved as a fraction of BM_StreamTriad at the same thread count (from the same
+file), its floor max(bytes / triad, flops / peak) and its time as a multiple of that floor. The
+peak is --peak-gflops (per thread count: the machine's figure times the threads); without it the
+floor is the bytes' alone.
+
+Usage: reports/summarize_micro.py [--peak-gflops G] micro.json [> table.md]
 """
 import json
 import sys
@@ -65,11 +72,55 @@ def fmt(x, digits=3):
     return str(x)
 
 
+def floor_table(b, peak_gflops=None):
+    """Markdown lines of the Floors table, [] without BM_Floor_* benchmarks. A benchmark skipped
+    for a level the mesh lacks (error_occurred) is left out."""
+    triad = {}
+    # "BM_StreamTriad/0" (all cores) first, so that an explicit thread count of the same value wins.
+    for name, x in sorted(b.items(), key=lambda kv: not kv[0].startswith("BM_StreamTriad/0")):
+        if name.startswith("BM_StreamTriad/") and "bandwidth_GBps" in x:
+            triad[int(x.get("threads", 0))] = x["bandwidth_GBps"] * 1e9
+    rows = []
+    for name, x in b.items():
+        if not name.startswith("BM_Floor_") or x.get("error_occurred") or "bytes" not in x:
+            continue
+        seconds = ms(x) * 1e-3
+        threads = int(x.get("threads", 0))
+        probe = triad.get(threads)
+        nbytes, flops = float(x["bytes"]), float(x["flops"])
+        peak = peak_gflops * 1e9 * threads if peak_gflops else None
+        floor = max(nbytes / probe if probe else 0.0, flops / peak if peak else 0.0)
+        achieved = nbytes / seconds if seconds > 0 else None
+        label = name[len("BM_Floor_"):] + (f" ({x['label']})" if x.get("label") else "")
+        rows.append(f"| {label} | {fmt(ms(x))} | {fmt(nbytes / 1e6)} | {fmt(flops / 1e6)} | "
+                    f"{fmt(achieved / 1e9 if achieved else None)} | "
+                    f"{fmt(achieved / probe if achieved and probe else None)} | "
+                    f"{fmt(floor * 1e3 if floor > 0 else None)} | "
+                    f"{fmt(seconds / floor if floor > 0 else None)} |")
+    if not rows:
+        return []
+    probes = ", ".join(f"{t} thread{'s' if t != 1 else ''} {fmt(v / 1e9)} GB/s"
+                       for t, v in sorted(triad.items())) or "none in this file"
+    peak = f"{peak_gflops} GFLOP/s per thread" if peak_gflops else "not given (bytes alone)"
+    return [f"Floors: STREAM triad {probes}; compute peak {peak}.\n",
+            "| phase | ms | floor MB | floor Mflop | GB/s | of triad | floor ms | x floor |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|"] + rows + [""]
+
+
 def main():
-    if len(sys.argv) != 2:
+    args = sys.argv[1:]
+    peak_gflops = None
+    if len(args) == 3 and args[0] == "--peak-gflops":
+        peak_gflops = float(args[1])
+        args = args[2:]
+    if len(args) != 1:
         print(__doc__, file=sys.stderr)
         sys.exit(2)
-    ctx, b = load(sys.argv[1])
+    ctx, b = load(args[0])
+    floors = floor_table(b, peak_gflops)
+    if floors and all(n.startswith(("BM_Floor_", "BM_Stream")) for n in b):
+        print("\n".join(floors))  # a floors run alone: no step tables to fill
+        return
     get = b.get
     lines = []
     lines.append(f"Machine: {ctx.get('host_name', '?')}, {ctx.get('num_cpus', '?')} CPUs "
@@ -207,7 +258,7 @@ def main():
     if tb:
         lines.append(f"| bytes of preprocessed data per cubature point | {fmt(tb['bytes_per_cubature_point'])} "
                      f"| ≤ 33 | 100 |")
-    print("\n".join(lines))
+    print("\n".join(lines + ([""] + floors if floors else [])))
 
 
 if __name__ == "__main__":

@@ -63,14 +63,13 @@ std::vector<int> transpose_positions(const SparseMatrix& C) {
   return transpose_pos;
 }
 
-void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatrix& Cm,
+void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm, double* Cval,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
                      Spa& spa) {
-  const Csc A(Am), P(Pm);
+  const Csc P(Pm);
   const int m = A.rows;
   const int* Couter = Cm.outerIndexPtr();
   const int* Cinner = Cm.innerIndexPtr();
-  double* Cval = Cm.valuePtr();
   tbb::parallel_for(tbb::blocked_range<int>(0, P.cols, 64), [&](const tbb::blocked_range<int>& r) {
     auto& v = spa.local();
     if (v.size() < std::size_t(m)) v.assign(std::size_t(m), 0.0);

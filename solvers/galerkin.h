@@ -12,6 +12,7 @@
 // interface.
 
 #include "core/sparse.h"
+#include "solvers/csc_view.h"
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -39,7 +40,9 @@ using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 /// identity), i.e. in grid order, so consecutive columns share most of their fine support and
 /// their accumulators stay in cache (a colour-major visit is slower: docs/benchmarks.md,
 /// "Measurements behind implementation choices").
-void galerkin_values(const SparseMatrix& Am, const SparseMatrix& Pm, SparseMatrix& Cm,
+/// A is a view (its values may be one term's, on the level's pattern); the values are written to
+/// `Cval`, on Cm's pattern (Cm's own values when Cval is Cm.valuePtr()).
+void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm, double* Cval,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
                      Spa& spa);
 

@@ -13,6 +13,8 @@
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -96,12 +98,18 @@ struct MultigridSolver::Impl {
     // (-1: none). Empty on coarse levels and a single level.
     std::vector<int> diag_rank;
     SmootherRows smoother;  // compact off-diagonal rows for the sweeps (may be empty)
+    // galerkin_by_term: each term's values on A's pattern (the finest level: the caller's terms
+    // in the finest numbering; coarse levels: their Galerkin products). Empty otherwise.
+    std::vector<std::vector<double>> terms;
     // Transfer to the next finer level (absent on the finest level).
     SparseMatrix P;   // n_{l+1} x n_l
     SparseMatrix PT;  // n_l x n_{l+1}
     Spa spa;          // dense accumulators of the Galerkin product
     // Work buffers (interleaved n x k, row stride padded to a multiple of 4).
     Buffer x, b, r;
+    // Finest level, mixed precision: the iterate and right-hand side kept while a cycle runs on
+    // the correction (correction_cycle).
+    Buffer saved_x, saved_b;
     int n() const { return int(A.rows()); }
   };
 
@@ -115,7 +123,13 @@ struct MultigridSolver::Impl {
   int k = 0;          // columns the buffers are sized for
   std::size_t s = 0;  // their row stride: k rounded up to a multiple of 4
   bool ready = false;
+  bool fine_single = false;  // the finest level's sweeps read single precision (mixed_precision)
   std::int64_t symbolic_builds = 0, numeric_builds = 0, pattern_comparisons = 0;
+  std::int64_t term_products = 0;
+  // galerkin_by_term: the number of terms the levels' `terms` hold (0: none kept) and which of
+  // them changed in this call.
+  int term_count = 0;
+  std::vector<char> term_changed;
   std::uint64_t pattern_key = 0;         // the key the current pattern was set with (0: none)
   std::vector<MultigridLevelWork> work;  // per level, coarsest first (level_work())
 
@@ -134,7 +148,8 @@ struct MultigridSolver::Impl {
   }
 
   void symbolic(const SparseRef& A, const std::vector<SparseMatrix>& P,
-                const std::vector<std::vector<std::uint8_t>>* given_colours) {
+                const std::vector<std::vector<std::uint8_t>>* given_colours, bool single) {
+    fine_single = single;
     const std::size_t nl = P.size() + 1;
     levels.clear();
     levels.resize(nl);
@@ -172,34 +187,24 @@ struct MultigridSolver::Impl {
       check_colouring(L, L.A, l < colours.size() ? &colours[l] : nullptr);
       L.diag_pos = diagonal_positions(L.A);
       find_blocks(L, L.A);
-      // The serial fallback reads the double-precision matrix.
-      L.smoother = L.coloured ? smoother_pattern(L.A, L.diag_pos, l + 1 == nl) : SmootherRows{};
+      // The serial fallback reads the double-precision matrix; the finest level's compact rows
+      // are the matrix's own (aligned) unless its sweeps read single precision.
+      L.smoother = L.coloured ? smoother_pattern(L.A, L.diag_pos, l + 1 == nl && !fine_single)
+                              : SmootherRows{};
     }
     k = 0;
     work.assign(nl, MultigridLevelWork{});
     ++symbolic_builds;
   }
 
-  /// New values of the finest matrix (same pattern as the stored one, in the caller's numbering):
-  /// A's, or the sum's entry by entry when one is given (its terms on A's pattern, A its M;
-  /// sum_entry, so bitwise what sum_on_pattern would have handed to set_matrix).
-  void set_fine_values(const SparseRef& A, const MatrixSum* sum) {
+  /// Walks the finest matrix's stored entries column by column: put(p, q, out) writes the
+  /// caller's entries [p, q) (positions in G, the caller's numbering) at `out` (in `val`, an array
+  /// on the finest pattern) and returns the end of what it wrote. The diagonal goes last
+  /// (diagonal_last).
+  template <class Put>
+  void walk_fine(const Csc& G, double* val, const Put& put) {
     Level& F = levels.back();
-    const Csc G(A);
     const int* outer = F.A.outerIndexPtr();
-    double* val = F.A.valuePtr();
-    const double* kv = sum ? sum->K.valuePtr() : nullptr;
-    const double* sv = sum && sum->S ? sum->S->valuePtr() : nullptr;
-    const double a = sum ? sum->a : 1.0, b = sum ? sum->b : 0.0, s = sum ? sum->s : 0.0;
-    // Caller's entries [p, q) of column j to out: copied, or summed with the other terms'.
-    const auto put = [&](int p, int q, double* out) {
-      if (!kv) return std::copy(G.val + p, G.val + q, out);
-      if (sv)
-        for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p], s, sv[p]);
-      else
-        for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p]);
-      return out;
-    };
     for_rows(F.n(), [&](int rb, int re) {
       for (int r = rb; r < re; ++r) {
         const int j = old_index(F.perm, r);
@@ -218,12 +223,97 @@ struct MultigridSolver::Impl {
     });
   }
 
+  /// New values of the finest matrix (same pattern as the stored one, in the caller's numbering):
+  /// A's, or the sum's entry by entry when one is given (its terms on A's pattern, A its M;
+  /// sum_entry, so bitwise what sum_on_pattern would have handed to set_matrix).
+  void set_fine_values(const SparseRef& A, const MatrixSum* sum) {
+    const Csc G(A);
+    const double* kv = sum ? sum->K.valuePtr() : nullptr;
+    const double* sv = sum && sum->S ? sum->S->valuePtr() : nullptr;
+    const double a = sum ? sum->a : 1.0, b = sum ? sum->b : 0.0, s = sum ? sum->s : 0.0;
+    // Caller's entries [p, q) of column j to out: copied, or summed with the other terms'.
+    walk_fine(G, levels.back().A.valuePtr(), [&](int p, int q, double* out) {
+      if (!kv) return std::copy(G.val + p, G.val + q, out);
+      if (sv)
+        for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p], s, sv[p]);
+      else
+        for (; p < q; ++p) *out++ = sum_entry(a, G.val[p], b, kv[p]);
+      return out;
+    });
+  }
+
+  /// galerkin_by_term: the sum's terms into the finest level's `terms`, and which of them changed
+  /// (term_changed; bitwise comparison with the kept copy). `fresh`: the levels were just built or
+  /// held another number of terms; every level's terms are then sized and all count as changed.
+  void set_fine_terms(const MatrixSum& sum, bool fresh) {
+    const SparseRef* term[3] = {&sum.M, &sum.K, sum.S ? &*sum.S : nullptr};
+    const int count = sum.S ? 3 : 2;
+    if (fresh || term_count != count) {
+      for (auto& L : levels)
+        L.terms.assign(std::size_t(count), std::vector<double>(std::size_t(L.A.nonZeros()), 0.0));
+      term_count = count;
+      term_changed.assign(std::size_t(count), 1);
+    } else {
+      term_changed.assign(std::size_t(count), 0);
+    }
+    for (int t = 0; t < count; ++t) {
+      const Csc G(*term[t]);
+      std::atomic<bool> changed{false};
+      walk_fine(G, levels.back().terms[std::size_t(t)].data(), [&](int p, int q, double* out) {
+        bool differs = false;
+        for (; p < q; ++p, ++out) {
+          differs |= std::bit_cast<std::uint64_t>(*out) != std::bit_cast<std::uint64_t>(G.val[p]);
+          *out = G.val[p];
+        }
+        if (differs) changed.store(true, std::memory_order_relaxed);
+        return out;
+      });
+      if (changed.load()) term_changed[std::size_t(t)] = 1;
+    }
+  }
+
+  /// Drops the kept terms (a call without a sum, or without the option).
+  void drop_terms() {
+    term_count = 0;
+    term_changed.clear();
+    for (auto& L : levels) L.terms.clear();
+  }
+
+  /// galerkin_by_term: coarse level l's terms that changed, then its matrix as their sum.
+  void coarse_by_term(std::size_t l, const MatrixSum& sum) {
+    Level& C = levels[l];
+    const Level& F = levels[l + 1];
+    for (int t = 0; t < term_count; ++t) {
+      if (!term_changed[std::size_t(t)]) continue;
+      Csc A(F.A);
+      A.val = F.terms[std::size_t(t)].data();
+      galerkin_values(A, C.P, C.A, C.terms[std::size_t(t)].data(), C.transpose_pos, C.inv, C.spa);
+      ++term_products;
+    }
+    const double* mv = C.terms[0].data();
+    const double* kv = C.terms[1].data();
+    const double* sv = term_count > 2 ? C.terms[2].data() : nullptr;
+    double* val = C.A.valuePtr();
+    for_rows(int(C.A.nonZeros()), [&](int p, int q) {
+      if (sv)
+        for (; p < q; ++p) val[p] = sum_entry(sum.a, mv[p], sum.b, kv[p], sum.s, sv[p]);
+      else
+        for (; p < q; ++p) val[p] = sum_entry(sum.a, mv[p], sum.b, kv[p]);
+    });
+  }
+
   /// Numerical values of all levels from the finest level's values (already in place).
   /// Returns false when a diagonal entry is negative or not finite.
-  bool numeric() {
+  /// With `by_term` (the sum's terms set by set_fine_terms), coarse levels are refreshed by
+  /// term (coarse_by_term).
+  bool numeric(const MatrixSum* by_term) {
     for (std::size_t l = levels.size() - 1; l-- > 0;) {
       Level& C = levels[l];
-      galerkin_values(levels[l + 1].A, C.P, C.A, C.transpose_pos, C.inv, C.spa);
+      if (by_term)
+        coarse_by_term(l, *by_term);
+      else
+        galerkin_values(Csc(levels[l + 1].A), C.P, C.A, C.A.valuePtr(), C.transpose_pos, C.inv,
+                        C.spa);
     }
     bool ok = true;
     for (auto& L : levels) {
@@ -373,6 +463,26 @@ struct MultigridSolver::Impl {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   }
 
+  /// Restriction b_C = Pᵀ r_F from level l to l - 1 (gather over the columns of P).
+  void restrict_residual(int l) {
+    const Level& F = levels[std::size_t(l)];
+    Level& C = levels[std::size_t(l) - 1];
+    const Csc P(C.P);
+    for (int o = 0; o < int(s); o += 4)
+      for_rows(P.cols,
+               [&](int b, int e) { transpose_rows<false>(P, F.r.data(), C.b.data(), s, o, b, e); });
+  }
+
+  /// Prolongation x_F += P x_C from level l - 1 to l (gather over the columns of Pᵀ = rows of P).
+  void prolongate(int l) {
+    Level& F = levels[std::size_t(l)];
+    const Level& C = levels[std::size_t(l) - 1];
+    const Csc PT(C.PT);
+    for (int o = 0; o < int(s); o += 4)
+      for_rows(PT.cols,
+               [&](int b, int e) { transpose_rows<true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
+  }
+
   void cycle(int l, const MultigridOptions& opt) {
     const auto t0 = Clock::now();
     MultigridLevelWork& w = work[std::size_t(l)];
@@ -386,27 +496,44 @@ struct MultigridSolver::Impl {
     Level& C = levels[std::size_t(l) - 1];
     for (int i = 0; i < opt.pre_smooth; ++i) sweep(l, false);
     residual(l);
-    // Restriction: b_C = Pᵀ r_F (gather over the columns of P).
-    const Csc P(C.P), PT(C.PT);
-    for (int o = 0; o < int(s); o += 4)
-      for_rows(P.cols,
-               [&](int b, int e) { transpose_rows<false>(P, F.r.data(), C.b.data(), s, o, b, e); });
+    restrict_residual(l);
     std::fill(C.x.begin(), C.x.end(), 0.0);
     // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
     const int gamma = (opt.cycle == MultigridCycle::W && l - 1 > 0) ? 2 : 1;
     const auto tc = Clock::now();
     for (int g = 0; g < gamma; ++g) cycle(l - 1, opt);
     const double coarser = since(tc);  // the recursion's time, not this level's own
-    // Prolongation: x_F += P x_C (gather over the columns of Pᵀ = rows of P).
-    for (int o = 0; o < int(s); o += 4)
-      for_rows(PT.cols,
-               [&](int b, int e) { transpose_rows<true>(PT, C.x.data(), F.x.data(), s, o, b, e); });
+    prolongate(l);
     for (int i = 0; i < opt.post_smooth; ++i) sweep(l, true);
     w.seconds += since(t0) - coarser;
   }
 
-  /// max over columns of ||b - A x|| / ||b|| on the finest level (deterministic reduction).
-  double relative_residual(const Eigen::VectorXd& bnorm) {
+  /// Runs one cycle on the correction of the finest level's iterate (mixed_precision): from
+  /// r = b - A x (computed here unless `have_r`: the finest level's r holds it already), the
+  /// cycle solves A e ≈ r from e = 0, and x += e.
+  void correction_cycle(const MultigridOptions& opt, bool have_r) {
+    const int top = int(levels.size()) - 1;
+    Level& F = levels.back();
+    if (!have_r) residual(top);
+    if (F.saved_b.size() != F.b.size()) F.saved_b.assign(F.b.size(), 0.0);
+    if (F.saved_x.size() != F.x.size()) F.saved_x.assign(F.x.size(), 0.0);
+    std::swap(F.b, F.saved_b);  // b kept
+    std::swap(F.b, F.r);        // the cycle's right-hand side: the residual
+    std::swap(F.x, F.saved_x);  // x kept
+    std::fill(F.x.begin(), F.x.end(), 0.0);
+    cycle(top, opt);
+    double* x = F.x.data();
+    const double* x0 = F.saved_x.data();
+    for_rows(int(F.x.size()), [&](int b, int e) {
+      for (int i = b; i < e; ++i) x[i] = x0[i] + x[i];
+    });
+    std::swap(F.b, F.saved_b);  // b back
+  }
+
+  /// max over columns of ||b - A x|| / ||b|| on the finest level (deterministic reduction). With
+  /// `keep`, the residual b - A x is also stored in the finest level's r (what residual() would
+  /// write, bitwise: the same terms in the same order).
+  double relative_residual(const Eigen::VectorXd& bnorm, bool keep = false) {
     Level& L = levels.back();
     const Csc A(L.A);
     std::vector<double> rn(s, 0.0);
@@ -421,6 +548,7 @@ struct MultigridSolver::Impl {
               v4 res0 = load4(L.b.data() + std::size_t(i) * s + o), res1 = splat(0.0);
               gather_sub(A, L.x.data(), s, o, A.outer[i], A.outer[i + 1], res0, res1);
               const v4 res = res0 + res1;
+              if (keep) store4(L.r.data() + std::size_t(i) * s + o, res);
               acc.v += res * res;
             }
             return acc;
@@ -507,6 +635,9 @@ std::int64_t MultigridSolver::symbolic_builds() const {
 std::int64_t MultigridSolver::numeric_builds() const {
   return impl_->numeric_builds;
 }
+std::int64_t MultigridSolver::term_products() const {
+  return impl_->term_products;
+}
 std::int64_t MultigridSolver::pattern_comparisons() const {
   return impl_->pattern_comparisons;
 }
@@ -578,10 +709,17 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
           !same_permuted(m.levels[l].P, P[l], m.levels[l + 1].inv, m.levels[l].perm, true, true);
   }
   // symbolic() copies A's values along with its pattern; a sum overwrites them.
-  if (need_symbolic) m.symbolic(A, P, colours);
+  // A vouched-for pattern is still set up anew when the finest sweeps' precision changed.
+  if (!need_symbolic && m.fine_single != options_.mixed_precision) need_symbolic = true;
+  if (need_symbolic) m.symbolic(A, P, colours, options_.mixed_precision);
   if (!need_symbolic || sum) m.set_fine_values(A, sum);
+  const bool by_term = options_.galerkin_by_term && sum != nullptr && m.levels.size() > 1;
+  if (by_term)
+    m.set_fine_terms(*sum, need_symbolic);
+  else
+    m.drop_terms();
   m.pattern_key = key;
-  const bool diag_ok = m.numeric();
+  const bool diag_ok = m.numeric(by_term ? sum : nullptr);
 
   if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);
   m.ldlt.factorize(m.levels.front().A);
@@ -633,7 +771,12 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
   const double tol = options_.tolerance;
 
   const bool measure_start = tol > 0.0 || options_.measure_contraction;
-  double rel = measure_start ? m.relative_residual(bnorm) : std::numeric_limits<double>::infinity();
+  // Mixed precision: each cycle runs on the correction of the residual that the previous
+  // convergence check kept (correction_cycle).
+  const bool mixed = m.fine_single && top > 0;
+  double rel =
+      measure_start ? m.relative_residual(bnorm, mixed) : std::numeric_limits<double>::infinity();
+  bool have_r = measure_start && mixed;
   const double start = rel;
   if (tol > 0.0 && rel < tol) {
     rep.relative_residual = rel;
@@ -641,8 +784,12 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
   }
   rep.status = SolveStatus::max_iterations;
   for (int c = 0; c < std::max(options_.cycles, 0); ++c) {
-    m.cycle(top, options_);
-    rel = m.relative_residual(bnorm);
+    if (mixed)
+      m.correction_cycle(options_, have_r);
+    else
+      m.cycle(top, options_);
+    rel = m.relative_residual(bnorm, mixed);
+    have_r = mixed;
     rep.residuals.push_back(rel);
     rep.iterations = c + 1;
     if (!std::isfinite(rel)) {
@@ -683,6 +830,56 @@ void MultigridSolver::precondition(const Eigen::MatrixXd& r, Eigen::MatrixXd& z)
   std::fill(fine.x.begin(), fine.x.end(), 0.0);
   m.cycle(int(m.levels.size()) - 1, options_);
   m.store(fine, fine.x, z);
+}
+
+std::int64_t MultigridSolver::level_sweep_entries(int l) const {
+  const auto& L = impl_->levels.at(std::size_t(l));
+  std::int64_t diagonal = 0;
+  for (int p : L.diag_pos) diagonal += p >= 0 ? 1 : 0;
+  return std::int64_t(L.A.nonZeros()) - diagonal;
+}
+int MultigridSolver::level_sweep_entry_bytes(int l) const {
+  const auto& L = impl_->levels.at(std::size_t(l));
+  if (!L.coloured || L.smoother.empty()) return int(sizeof(int) + sizeof(double));
+  return int(sizeof(std::int16_t) + (L.smoother.aligned ? sizeof(double) : sizeof(float)));
+}
+std::int64_t MultigridSolver::coarsest_factor_nonzeros() const {
+  const Impl& m = *impl_;
+  if (!m.ready || m.coarse_pinv.size() > 0) return 0;
+  return std::int64_t(m.ldlt.matrixL().nestedExpression().nonZeros()) + m.levels.front().n();
+}
+
+void MultigridSolver::run_kernel(MultigridKernel kernel, int l, int columns) {
+  Impl& m = *impl_;
+  if (!m.ready) throw std::logic_error("MultigridSolver::run_kernel before set_matrix");
+  const int top = int(m.levels.size()) - 1;
+  const bool transfer =
+      kernel == MultigridKernel::restriction || kernel == MultigridKernel::prolongation;
+  if (l < 0 || l > top || (transfer && l == 0) ||
+      (kernel == MultigridKernel::coarsest_solve && l != 0))
+    throw std::invalid_argument("MultigridSolver::run_kernel: no such level for this kernel");
+  if (columns <= 0) return;
+  m.ensure_buffers(columns);
+  switch (kernel) {
+    case MultigridKernel::forward_sweep:
+      m.sweep(l, false);
+      break;
+    case MultigridKernel::reverse_sweep:
+      m.sweep(l, true);
+      break;
+    case MultigridKernel::residual:
+      m.residual(l);
+      break;
+    case MultigridKernel::restriction:
+      m.restrict_residual(l);
+      break;
+    case MultigridKernel::prolongation:
+      m.prolongate(l);
+      break;
+    case MultigridKernel::coarsest_solve:
+      m.coarse_solve();
+      break;
+  }
 }
 
 void MultigridSolver::gauss_seidel(int l, const Eigen::MatrixXd& B, Eigen::MatrixXd& X, int sweeps,

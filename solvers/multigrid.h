@@ -27,7 +27,10 @@
 // Coarse-level sweeps only shape a correction of the finest level's residual, which the
 // residual, the transfers and the coarse operators keep exact, so the cycle converges to the
 // solution of A x = b; a rounded finest-level matrix would not (solvers/smoother.h, SmootherRows).
-// A level whose couplings lie farther apart than 16 bits reach keeps CSC sweeps.
+// A level whose couplings lie farther apart than 16 bits reach keeps CSC sweeps. With
+// MultigridOptions::mixed_precision the finest level's sweeps read single precision too, and
+// solve() runs every cycle on the correction of a double-precision residual, so the finest sweeps
+// only shape a correction as well.
 //
 // Internal numbering: every coloured level is stored in tiles of `tile_size` consecutive indices,
 // colour-major inside each tile, so a colour pass streams contiguous segments of rows; the
@@ -60,6 +63,17 @@ namespace mcf {
 
 enum class MultigridCycle { V, W };
 
+/// The cycle's kernels one by one (MultigridSolver::run_kernel), for benchmarks that time a phase
+/// against its floor (solvers/phase_floor.h).
+enum class MultigridKernel {
+  forward_sweep,  ///< one pre-smoothing sweep on level l
+  reverse_sweep,  ///< one post-smoothing sweep on level l
+  residual,       ///< r = b - A x on level l
+  restriction,    ///< b_{l-1} = Pᵀ r_l
+  prolongation,   ///< x_l += P x_{l-1}
+  coarsest_solve  ///< the direct solve on level 0
+};
+
 /// Where a solver's cycles spent their time, per level: how often the cycle visited the level
 /// and the wall time spent on the level itself (its smoothing sweeps, residual, restriction and
 /// prolongation; on the coarsest level the direct solve), not counting the coarser levels it
@@ -81,6 +95,22 @@ struct MultigridOptions {
   /// Measure the warm start's residual (one residual pass) so that the report's contraction is
   /// known even when `tolerance` is 0; with a tolerance it is measured anyway.
   bool measure_contraction = false;
+  /// Galerkin refresh by term (set_matrix_sum with a hierarchy; docs/surface-multigrid.md): each
+  /// level keeps the coarse operators of the sum's terms, Pᵀ M P, Pᵀ K P (and Pᵀ S P), and a call
+  /// recomputes only those of a term whose values changed since the previous call (compared
+  /// bitwise with a kept copy), then A_l = a M_l + b K_l [+ s S_l] entry by entry. cMCF changes
+  /// only M, the heat flow nothing. The finest level is the sum itself, as without the option, so
+  /// the residual and the solution the cycles converge to are the same; the coarse operators equal
+  /// the Galerkin products of the sum up to rounding only (linearity, not bitwise). Costs one
+  /// copy of each term's values per level.
+  bool galerkin_by_term = false;
+  /// Mixed precision (docs/surface-multigrid.md "Options"): the finest level's sweeps read its
+  /// off-diagonal entries in single precision too (6 bytes an entry instead of 10), and solve()
+  /// runs each cycle on the correction: e = cycle(r) from e = 0 with r = b - A x in double
+  /// precision (the residual that the previous cycle's convergence check computed, kept), then
+  /// x += e. The fixed point is the solution of A x = b, as in double precision; only the
+  /// contraction per cycle may change. precondition() is a cycle from zero anyway.
+  bool mixed_precision = false;
 };
 
 const char* to_string(MultigridCycle c);
@@ -138,6 +168,9 @@ class MultigridSolver : public LinearSolver {
   std::vector<int> relaxation_blocks(int l) const;
   std::int64_t symbolic_builds() const;  ///< how often the Galerkin pattern was built
   std::int64_t numeric_builds() const;   ///< how often coarse values were computed
+  /// How many Galerkin products of one term on one level galerkin_by_term has computed (a refresh
+  /// of a sum of two terms on L levels computes 2 (L - 1) when both changed, L - 1 when one did).
+  std::int64_t term_products() const;
   /// How often set_matrix compared the given pattern with the stored one (skipped when the
   /// caller's pattern_key vouches for it).
   std::int64_t pattern_comparisons() const;
@@ -145,6 +178,18 @@ class MultigridSolver : public LinearSolver {
   /// levels were built (or since reset_level_work()); cleared when a new pattern is set up.
   std::vector<MultigridLevelWork> level_work() const;
   void reset_level_work();
+
+  /// Entries a sweep on level l reads (its off-diagonal entries) and the bytes of each (offset
+  /// and value: 6 on a coarse level's compact rows, 10 on the finest's, 12 on CSC sweeps).
+  std::int64_t level_sweep_entries(int l) const;
+  int level_sweep_entry_bytes(int l) const;
+  /// Entries of the coarsest level's LDLᵀ factor (L's, the unit diagonal included; 0 when the
+  /// pseudo-inverse serves: then n² entries are read).
+  std::int64_t coarsest_factor_nonzeros() const;
+  /// Runs one kernel of the cycle on level l's own buffers, sized for `columns` right-hand
+  /// sides (l >= 1 for restriction and prolongation, l = 0 for the coarsest solve). The buffers
+  /// hold what the last call left (zeros at first): the kernels' work does not depend on it.
+  void run_kernel(MultigridKernel kernel, int l, int columns);
 
   /// `sweeps` Gauss-Seidel sweeps on level l for A_l X = B, forward or reverse in the order
   /// relaxation_order(l, reverse) lists (header, "Smoother ordering"). X is updated in place.

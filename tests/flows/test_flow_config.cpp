@@ -66,6 +66,22 @@ TEST(FlowConfig, ErrorsNameFileAndKey) {
                           {"flow", "cmcf"}})
                 .find("flow"),
             std::string::npos);
+  // A multigrid option under a solver without one would be recorded as if it had shaped the run.
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"galerkin_by_term", true}}}})
+                .find("cfg.json: solver.galerkin_by_term: applies to a multigrid"),
+            std::string::npos);
+  EXPECT_EQ(error_of(json{
+                {"mesh", "a"},
+                {"solver",
+                 {{"name", "pcg"}, {"preconditioner", "multigrid"}, {"galerkin_by_term", true}}}}),
+            "");
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"precision", "mixed"}}}})
+                .find("cfg.json: solver.precision: \"mixed\" applies to a multigrid"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(json{{"mesh", "a"}, {"solver", {{"name", "multigrid"}, {"precision", "half"}}}})
+          .find("solver.precision"),
+      std::string::npos);
   // A lumped mass the octree basis would ignore while the result recorded it.
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"mass", "lumped"}})
                 .find("cfg.json: mass: \"lumped\" applies to the hat basis only"),

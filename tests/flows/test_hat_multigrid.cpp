@@ -135,5 +135,106 @@ TEST(HatMultigrid, FlowsWithMultigridFollowCholmod) {
   }
 }
 
+// solver.galerkin_by_term (solvers/multigrid.h): the coarse operators differ from the sum's
+// Galerkin products by rounding only, so the flow's final mesh stays within 1e-10 of the bounding
+// box's diagonal of the flow without it (a few cycles per step: the rounding moves the iterate by
+// about the contraction times that; cMCF changes only the mass, heat flow nothing). MCF at
+// δ = 1e-5: at 1e-3 the armadillo's MCF pinches within a few steps, where the slightest change
+// of the iterate changes the flow.
+TEST(HatMultigrid, GalerkinByTermFlowsAsTheSumsGalerkinProduct) {
+  for (const char* flow : {"cmcf", "heat", "mcf"}) {
+    const json base = {{"mesh", "cgal:armadillo"},
+                       {"basis", "hat"},
+                       {"flow", flow},
+                       {"dt", std::string(flow) == "mcf" ? 1e-5 : 1e-3},
+                       {"steps", 4},
+                       {"solver", {{"name", "multigrid"}, {"cycles", 3}}}};
+    json by_term = base;
+    by_term["solver"]["galerkin_by_term"] = true;
+    const FlowOutcome plain = testing::run(base), o = testing::run(by_term);
+    ASSERT_EQ(o.result["status"], "ok") << flow;
+    EXPECT_EQ(o.result["config"]["solver"]["galerkin_by_term"], true);
+    EXPECT_FALSE(plain.result["config"]["solver"].contains("galerkin_by_term"));
+    const double size = (plain.final_mesh.vertices.colwise().maxCoeff() -
+                         plain.final_mesh.vertices.colwise().minCoeff())
+                            .norm();
+    const double worst =
+        (o.final_mesh.vertices - plain.final_mesh.vertices).rowwise().norm().maxCoeff();
+    EXPECT_LE(worst, 1e-10 * size) << flow;
+  }
+}
+
+// solver.precision "mixed" (MultigridOptions::mixed_precision): the finest sweeps read single
+// precision, 6 bytes an entry instead of 10, inside a double-precision residual correction. On a
+// sphere the contraction per V(2,2)-cycle stays within 10% of double precision's, and the cycles
+// still reach a relative residual of 1e-11, which rounded finest sweeps without the correction
+// could not (they stall near 1e-8: solvers/smoother.h).
+TEST(HatMultigrid, MixedPrecisionContractsAsDoubleAndReachesTheSolution) {
+  const HatSystem s = hat_system("sphere:vertices=20000", 1e-3);
+  auto run = [&](bool mixed, double tolerance, int cycles) {
+    MultigridOptions o;
+    o.cycle = MultigridCycle::V;
+    o.pre_smooth = o.post_smooth = 2;
+    o.cycles = cycles;
+    o.tolerance = tolerance;
+    o.measure_contraction = true;
+    o.mixed_precision = mixed;
+    MultigridSolver mg(o);
+    EXPECT_TRUE(mg.set_matrix(s.A, view(*s.basis)).ok());
+    const int top = mg.levels() - 1;
+    EXPECT_TRUE(mg.level_has_compact_smoother(top));
+    EXPECT_EQ(mg.level_sweep_entry_bytes(top), mixed ? 6 : 10);
+    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(s.A.rows(), 3);
+    const SolveReport r = mg.solve(s.B, x);
+    return std::make_pair(r, x);
+  };
+  const auto [plain, xp] = run(false, 0, 5);
+  const auto [mixed, xm] = run(true, 0, 5);
+  ASSERT_GT(plain.contraction, 0);
+  EXPECT_LE(mixed.contraction, 1.1 * plain.contraction);
+  EXPECT_GE(mixed.contraction, plain.contraction / 1.1);
+  const auto [tight, xt] = run(true, 1e-11, 200);
+  EXPECT_EQ(tight.status, SolveStatus::converged);
+  EXPECT_LT(tight.relative_residual, 1e-11);
+  CholmodSolver exact;
+  ASSERT_TRUE(exact.set_matrix(s.A).ok());
+  Eigen::MatrixXd xc;
+  ASSERT_TRUE(exact.solve(s.B, xc).ok());
+  EXPECT_LT((xt - xc).norm(), 1e-9 * xc.norm());
+}
+
+// The flow with mixed precision against the flow in double precision, both solving each step to
+// a relative residual of 1e-10: each step's two solutions then differ by at most about κ(A) 2e-10
+// relative, which over 5 steps is far below the 1e-7 of the bounding box's diagonal tested here,
+// the bound that any two multigrid solves to 1e-10 meet (FlowsWithMultigridFollowCholmod). MCF at
+// δ = 1e-5, as above.
+TEST(HatMultigrid, MixedPrecisionFlowsAsDoublePrecision) {
+  for (const char* flow : {"cmcf", "mcf"}) {
+    const json base = {{"mesh", "cgal:armadillo"},
+                       {"basis", "hat"},
+                       {"flow", flow},
+                       {"dt", std::string(flow) == "mcf" ? 1e-5 : 1e-3},
+                       {"steps", 5},
+                       {"solver",
+                        {{"name", "multigrid"},
+                         {"cycle", "V"},
+                         {"smooth", 2},
+                         {"cycles", 100},
+                         {"tolerance", 1e-10}}}};
+    json mixed = base;
+    mixed["solver"]["precision"] = "mixed";
+    const FlowOutcome plain = testing::run(base), o = testing::run(mixed);
+    ASSERT_EQ(o.result["status"], "ok") << flow;
+    EXPECT_EQ(o.result["config"]["solver"]["precision"], "mixed");
+    EXPECT_EQ(o.result["steps"].back()["solver"]["status"], "converged") << flow;
+    const double size = (plain.final_mesh.vertices.colwise().maxCoeff() -
+                         plain.final_mesh.vertices.colwise().minCoeff())
+                            .norm();
+    const double rms = std::sqrt(
+        (o.final_mesh.vertices - plain.final_mesh.vertices).rowwise().squaredNorm().mean());
+    EXPECT_LT(rms / size, 1e-7) << flow;
+  }
+}
+
 }  // namespace
 }  // namespace mcf

@@ -41,6 +41,25 @@ for want in '| 1 | 2 | 100 | 25% |' '| outside the cycle (copies, final residual
             '| tracked, stabilized, 2x V(2,2), 2 threads | 700 |' '| tracked, stabilized, W(5,5), 2 threads | 900 |'; do
   grep -qF "$want" "$sw/out.md" || { cat "$sw/out.md"; echo "FAIL: summarize_micro.py lacks: $want"; exit 1; }
 done
+# The Floors table (benchmarks/micro_floor.cpp): 1e8 bytes in 10 ms is 10 GB/s, half the 2-thread
+# triad of 20 GB/s, twice its floor of 5 ms; with a peak of 0.01 GFLOP/s a thread, 1e6 flops take
+# 50 ms on two threads, so the phase runs at 0.2x that floor. A skipped level is left out.
+cat >"$sw/floor.json" <<'JSON'
+{"context": {"host_name": "h", "num_cpus": 2},
+ "benchmarks": [
+  {"name": "BM_StreamTriad/2/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 1,
+   "threads": 2, "bandwidth_GBps": 20},
+  {"name": "BM_Floor_HatKernel/threads:2/kernel:0/below:0/real_time", "run_type": "iteration",
+   "time_unit": "ms", "real_time": 10, "bytes": 1e8, "flops": 1e6, "threads": 2, "label": "sweep"},
+  {"name": "BM_Floor_HatGalerkin/threads:2/below:3/real_time", "run_type": "iteration",
+   "time_unit": "ms", "real_time": 0, "error_occurred": true, "error_message": "no such level"}]}
+JSON
+"$py" "$root/reports/summarize_micro.py" "$sw/floor.json" >"$sw/floor.md" 2>&1 || { cat "$sw/floor.md"; echo "FAIL: summarize_micro.py floors"; exit 1; }
+"$py" "$root/reports/summarize_micro.py" --peak-gflops 0.01 "$sw/floor.json" >"$sw/peak.md" 2>&1 || { cat "$sw/peak.md"; echo "FAIL: summarize_micro.py --peak-gflops"; exit 1; }
+grep -qF '| HatKernel/threads:2/kernel:0/below:0 (sweep) | 10 | 100 | 1 | 10 | 0.5 | 5 | 2 |' "$sw/floor.md" &&
+  grep -qF '| HatKernel/threads:2/kernel:0/below:0 (sweep) | 10 | 100 | 1 | 10 | 0.5 | 50 | 0.2 |' "$sw/peak.md" &&
+  ! grep -q 'HatGalerkin' "$sw/floor.md" && ! grep -q 'per step' "$sw/floor.md" ||
+  { cat "$sw/floor.md" "$sw/peak.md"; echo "FAIL: summarize_micro.py's floors table"; exit 1; }
 rm -rf "$sw"
 if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
   echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 77

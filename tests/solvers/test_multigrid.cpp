@@ -386,6 +386,110 @@ bool same_values(const SparseMatrix& X, const SparseMatrix& Y) {
          std::equal(X.valuePtr(), X.valuePtr() + X.nonZeros(), Y.valuePtr());
 }
 
+/// Largest relative difference, over the coarse levels, of two solvers' operators (Frobenius).
+double coarse_difference(const MultigridSolver& x, const MultigridSolver& y) {
+  double worst = 0;
+  for (int l = 0; l + 1 < x.levels(); ++l) {
+    const SparseMatrix X = x.level_matrix(l), Y = y.level_matrix(l);
+    EXPECT_TRUE(mcf::same_pattern(X, Y)) << "level " << l;
+    worst = std::max(worst, SparseMatrix(X - Y).norm() / Y.norm());
+  }
+  return worst;
+}
+
+// galerkin_by_term keeps Pᵀ M P, Pᵀ K P (and Pᵀ S P) per level and recomputes only the terms
+// whose values changed: the coarse operators equal those of the sum's Galerkin product to 1e-12
+// (linearity; rounding differs), the finest level bitwise, and a cMCF-like sequence (M changes,
+// K does not) computes one product per level instead of two.
+TEST(Multigrid, GalerkinByTermRefreshesOnlyChangedTermsAndMatchesTheSum) {
+  const Problem pm = make_problem(4, 1, 0.0, Drop::shell);
+  const Problem pk = make_problem(4, 1, 1.0, Drop::shell);
+  const Problem ps = make_problem(4, 1, 0.3, Drop::shell);
+  const SparseMatrix &M = pm.A, &K = pk.A, &S = ps.A;
+  SparseMatrix M2 = M;  // "the mass at the next step": other values on the same pattern
+  for (Eigen::Index p = 0; p < M2.nonZeros(); ++p)
+    M2.valuePtr()[p] *= 1.0 + 0.1 * std::sin(double(p));
+  M2 = SparseMatrix(0.5 * (M2 + SparseMatrix(M2.transpose())));
+  ASSERT_TRUE(mcf::same_pattern(M, M2));
+  SparseMatrix K2 = K;
+  K2.coeffs() *= 1.25;
+  const Eigen::MatrixXd B = random_matrix(M.rows(), 3, 5);
+  MultigridOptions by_term_options;
+  by_term_options.galerkin_by_term = true;
+  by_term_options.cycles = 3;
+  MultigridOptions plain_options = by_term_options;
+  plain_options.galerkin_by_term = false;
+  MultigridSolver by_term(by_term_options), plain(plain_options);
+  struct Call {
+    double a;
+    const SparseMatrix* M;
+    double b;
+    const SparseMatrix* K;
+    double s;               // 0: two terms
+    std::int64_t products;  // term products this call must compute
+  };
+  const int coarse = int(pm.P.size());
+  const std::int64_t none = 0, one = coarse, two = 2 * coarse, three = 3 * coarse;
+  for (const Call c : {Call{1.0, &M, 0.05, &K, 0, two},      // new pattern: both terms
+                       Call{1.0, &M2, 0.05, &K, 0, one},     // cMCF: the mass changed
+                       Call{1.0, &M2, 0.2, &K, 0, none},     // new coefficients, same terms
+                       Call{1.0, &M2, 0.2, &K2, 0, one},     // the stiffness changed
+                       Call{1.0, &M, 0.2, &K2, 0.7, three},  // a third term: all anew
+                       Call{1.0, &M2, 0.2, &K2, 0.7, one}}) {
+    SCOPED_TRACE(c.products);
+    const std::int64_t before = by_term.term_products();
+    const mcf::MatrixSum sum = c.s > 0 ? mcf::MatrixSum(c.a, *c.M, c.b, *c.K, c.s, S)
+                                       : mcf::MatrixSum(c.a, *c.M, c.b, *c.K);
+    ASSERT_TRUE(by_term.set_matrix_sum(sum, pm.view()).ok());
+    ASSERT_TRUE(plain.set_matrix_sum(sum, pm.view()).ok());
+    EXPECT_EQ(by_term.term_products() - before, c.products);
+    const SparseMatrix Fb = by_term.level_matrix(coarse), Fp = plain.level_matrix(coarse);
+    EXPECT_TRUE(same_values(Fb, Fp));  // the finest level is the sum itself
+    EXPECT_LE(coarse_difference(by_term, plain), 1e-12);
+    Eigen::MatrixXd X1, X2;
+    ASSERT_TRUE(by_term.solve(B, X1).ok());
+    ASSERT_TRUE(plain.solve(B, X2).ok());
+    EXPECT_LE((X1 - X2).norm(), 1e-10 * X2.norm());
+  }
+  EXPECT_EQ(plain.term_products(), 0);
+  // A plain set_matrix drops the kept terms; the next sum recomputes them all.
+  ASSERT_TRUE(by_term.set_matrix(M, pm.view()).ok());
+  const std::int64_t before = by_term.term_products();
+  ASSERT_TRUE(by_term.set_matrix_sum(1.0, M, 0.05, K, pm.view()).ok());
+  EXPECT_EQ(by_term.term_products() - before, two);
+}
+
+// mixed_precision: single-precision finest sweeps inside a double-precision residual correction
+// converge to the solution of A x = b (a relative residual of 1e-11 and the direct solution), where
+// rounded finest sweeps without the correction would stall near 1e-8.
+TEST(Multigrid, MixedPrecisionConvergesToTheDirectSolution) {
+  const Problem pr = make_problem(5, 2, 1e-2, Drop::shell);
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 3);
+  Eigen::SimplicialLDLT<SparseMatrix> direct(pr.A);
+  const Eigen::MatrixXd exact = direct.solve(B);
+  for (const MultigridCycle c : {MultigridCycle::V, MultigridCycle::W}) {
+    MultigridOptions o;
+    o.cycle = c;
+    o.cycles = 200;
+    o.tolerance = 1e-11;
+    o.mixed_precision = true;
+    MultigridSolver mg(o);
+    ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+    EXPECT_EQ(mg.level_sweep_entry_bytes(mg.levels() - 1), 6);
+    Eigen::MatrixXd X;
+    const mcf::SolveReport r = mg.solve(B, X);
+    EXPECT_EQ(r.status, SolveStatus::converged);
+    EXPECT_LT(r.relative_residual, 1e-11);
+    EXPECT_LT(rel_diff(X, exact), 1e-9);
+    // Switching back to double precision sets the finest sweeps up anew.
+    o.mixed_precision = false;
+    mg.set_options(o);
+    ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+    EXPECT_EQ(mg.level_sweep_entry_bytes(mg.levels() - 1), 10);
+    EXPECT_EQ(mg.symbolic_builds(), 2);
+  }
+}
+
 /// The finest level stores each column's diagonal last and remembers where the caller had it
 /// (solvers/smoother.h, diagonal_last): a value refresh and set_matrix_sum must put every entry
 /// back in its place, and the pattern comparison must recognise the caller's order. Checked with
