@@ -1,6 +1,7 @@
 #include "bench/experiment_config.h"
 
 #include "flows/config_reader.h"
+#include "flows/config_schema.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -16,14 +17,6 @@ using nlohmann::json;
 [[noreturn]] void fail(const std::string& source, const std::string& path,
                        const std::string& what) {
   throw ConfigError(source + ": " + path + ": " + what);
-}
-
-void flatten_keys(const json& j, const std::string& prefix, std::vector<std::string>& out) {
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
-    out.push_back(key);
-    if (it->is_object()) flatten_keys(*it, key, out);
-  }
 }
 
 bool is_config_key(const std::string& k) {
@@ -210,20 +203,18 @@ bool excluded(const json& raw, const json& exclude, std::vector<bool>& used) {
 }  // namespace
 
 const std::vector<std::string>& flow_config_keys() {
+  // The schema's keys (flows/config_schema.h) and the objects that hold them: every key a cell
+  // may set, whether or not result.json records it for the cell's solver.
   static const std::vector<std::string> keys = [] {
     std::vector<std::string> k;
-    // With every key that to_json writes only when it is set, or only for some solvers (the
-    // multigrid's fallback, PETSc's options).
-    FlowConfig every;
-    every.repair_degenerate = true;
-    for (const char* solver : {"multigrid", "petsc"}) {
-      every.solver.name = solver;
-      std::vector<std::string> keys;
-      flatten_keys(to_json(every), "", keys);
-      for (const std::string& key : keys)
-        if (std::find(k.begin(), k.end(), key) == k.end()) k.push_back(key);
+    for (const OptionSpec& o : flow_config_schema()) {
+      for (std::size_t dot = o.key.find('.'); dot != std::string::npos;
+           dot = o.key.find('.', dot + 1))
+        k.push_back(o.key.substr(0, dot));
+      k.push_back(o.key);
     }
     std::sort(k.begin(), k.end());
+    k.erase(std::unique(k.begin(), k.end()), k.end());
     return k;
   }();
   return keys;
