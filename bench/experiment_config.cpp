@@ -202,6 +202,19 @@ bool excluded(const json& raw, const json& exclude, std::vector<bool>& used) {
 
 }  // namespace
 
+namespace {
+
+/// Whether `value` is the default of an option that result.json's config records only when set
+/// or only for some components (mpi_ranks 1, repair_degenerate false): its absence from a cell's
+/// config means that value.
+bool is_unrecorded_default(const std::string& key, const json& value) {
+  for (const OptionSpec& o : flow_config_schema())
+    if (o.key == key) return o.recorded != Recorded::always && o.fallback == value;
+  return false;
+}
+
+}  // namespace
+
 const std::vector<std::string>& flow_config_keys() {
   // The schema's keys (flows/config_schema.h) and the objects that hold them: every key a cell
   // may set, whether or not result.json records it for the cell's solver.
@@ -248,7 +261,7 @@ bool matches_assignment(const Cell& cell, const json& partial) {
   if (!partial.is_object()) return false;
   for (auto it = partial.begin(); it != partial.end(); ++it) {
     const json* v = json_at_path(cell.config, it.key());
-    if (!v || *v != *it) return false;
+    if (v ? *v != *it : !is_unrecorded_default(it.key(), *it)) return false;
   }
   return true;
 }

@@ -100,7 +100,16 @@ void publish(const fs::path& out, const fs::path& staging, const std::set<std::s
 }  // namespace
 
 int run_flow_into_folder(const FlowRequest& request) {
-  const FlowConfig config = flow_config_of(request);
+  FlowConfig config = flow_config_of(request);
+  // The ranks are part of the run's config: the launcher's count where the config leaves it
+  // out, and a config that names another count than the launcher started is refused.
+  if (config.mpi_ranks == 1 && launched_ranks() > 1) config.mpi_ranks = launched_ranks();
+  if (config.mpi_ranks != launched_ranks())
+    throw ConfigError("mpi_ranks: " + std::to_string(config.mpi_ranks) +
+                      " ranks asked for, but this process is one of " +
+                      std::to_string(launched_ranks()) + "; start it as mpirun -n " +
+                      std::to_string(config.mpi_ranks) + " mcfbench flow ..., or as a cell of " +
+                      "mcfbench run, which does");
   // PETSc's options are checked (a trial solve, solvers/petsc_solver.h), and a build without
   // PETSc refuses, before anything is read or written.
   const bool distributed = solver_row(config.solver.name).distributed;

@@ -5,6 +5,7 @@
 #include "bench/memory_budget.h"
 #include "bench/metrics.h"
 #include "bench/result_record.h"
+#include "bench/subprocess.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
 #include "flows/config_reader.h"
@@ -20,6 +21,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace mcf {
 namespace {
@@ -65,6 +67,54 @@ json cell_json(const ExperimentConfig& e, const CellPlan& p) {
           {"study", e.name},
           {"quick", e.quick},
           {"mesh_fingerprint", p.mesh_fingerprint}};
+}
+
+/// A cell with mpi_ranks > 1: `mpirun -n P` runs this binary's `mcfbench flow` on the cell's
+/// config into a scratch folder under OUT, writing every step's frame where the cell needs frames
+/// or per-step metrics; the frames are then handed to `observer` as the steps would have been,
+/// so the cell's frames and metrics are made as for a cell run in this process. Returns the flow's
+/// result.json (its peak memory: rank 0's) and final mesh. Throws std::runtime_error when mpirun
+/// cannot be started or the flow fails (its own messages are on stderr).
+FlowOutcome run_flow_across_ranks(const FlowConfig& config, bool needs_frames,
+                                  const fs::path& scratch, const FlowObserver& observer) {
+  std::error_code ec;
+  fs::remove_all(scratch, ec);
+  fs::create_directories(scratch, ec);
+  if (ec) throw OutputFailure(scratch.string() + ": cannot create the folder: " + ec.message());
+  FlowConfig child = config;
+  if (needs_frames) child.save_every = 1;
+  const fs::path config_file = scratch / "config.json";
+  write_file_atomic(config_file.string(), to_json(child).dump(2) + "\n");
+  const int ranks = config.mpi_ranks;
+  std::vector<std::string> argv{"mpirun", "-n", std::to_string(ranks)};
+  // Open MPI refuses more ranks than cores unless told (a 2-core machine asking for 4).
+  if (unsigned(ranks) > std::thread::hardware_concurrency()) argv.push_back("--oversubscribe");
+  argv.insert(argv.end(),
+              {fs::read_symlink("/proc/self/exe").string(), "flow", "--config",
+               config_file.string(), "--max-memory", "none", "--out", (scratch / "flow").string()});
+  // The environment of this process's start: a PETSc cell run here before made MPI's singleton
+  // start, whose variables would tie the new mpirun to this process.
+  const ProgramResult r = run_program(argv, /*startup_environment=*/true);
+  if (!r.out.empty()) std::fprintf(stderr, "%s", r.out.c_str());  // mpirun's own messages
+  if (!r.ok())
+    throw std::runtime_error(
+        "mpirun -n " + std::to_string(ranks) + " mcfbench flow: " +
+        (r.start_error.empty()
+             ? "exit status " + std::to_string(r.status) + " (its messages above)"
+             : "could not start mpirun (" + r.start_error + "; apt-get install openmpi-bin)"));
+  FlowOutcome outcome;
+  outcome.result = read_json_file((scratch / "flow" / "result.json").string());
+  outcome.result["config"] = to_json(config);  // as the cell asked, without the frames it needed
+  outcome.final_mesh = read_mesh((scratch / "flow" / "final.ply").string());
+  // The frames are the steps the flow completed, each handed over as run_flow's observer sees it.
+  const int stop = outcome.result["stop"].value("step", 0);
+  for (int step = 0; needs_frames && step <= stop; ++step) {
+    const fs::path frame = scratch / "flow" / frame_name(step);
+    if (fs::exists(frame))
+      observer.on_step(step, step * config.dt, read_mesh(frame.string()).vertices);
+  }
+  fs::remove_all(scratch, ec);
+  return outcome;
 }
 
 json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, const fs::path& out,
@@ -115,7 +165,11 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
       if (per_step && (step % m.every == 0 || step == config.steps)) measure(step, V);
       if (on_step) on_step(step);  // after the step's frames and metrics: they are part of its time
     };
-    FlowOutcome outcome = run_flow(config, source, observer);
+    FlowOutcome outcome =
+        config.mpi_ranks > 1
+            ? run_flow_across_ranks(config, per_step || !frames.empty() || config.save_every > 0,
+                                    out / ".mpi" / p.hash, observer)
+            : run_flow(config, source, observer);
     // A flow that stopped early (singular, diverged) never reached config.steps: its last
     // completed step is the one before the stop, whose state is the final mesh (the stopping
     // step is recorded but its positions are dropped, and the observer does not see it).
@@ -141,7 +195,13 @@ json run_cell(const ExperimentConfig& e, const CellPlan& p, MeshCache& meshes, c
               {"config", p.cell.config},
               {"steps", json::array()}};
   }
+  // Across ranks the flow ran in other processes: their peak (rank 0's), not this one's.
+  const json child_peak = config.mpi_ranks > 1 ? result.value("peak_memory_bytes", json()) : json();
   recorder.complete(result, config.threads, memory, budget);
+  if (!child_peak.is_null()) {
+    result["peak_memory_bytes"] = child_peak;
+    result["peak_memory_scope"] = "rank 0 of mpirun -n " + std::to_string(config.mpi_ranks);
+  }
   result["cell"] = cell_json(e, p);
   result["study_config"] = e.study_config;
   if (!written.empty()) result["frames"] = {{"dir", "frames/" + p.hash}, {"steps", written}};

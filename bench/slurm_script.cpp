@@ -142,6 +142,8 @@ std::string run_array_script(const BatchScriptInput& in) {
   s += "#SBATCH --array=" + array_spec(in.array) + "\n";
   s += output_line(in, "run-%A_%a.out");
   s += common_lines(in);
+  if (in.job.ntasks > 1)  // the ranks of the cells that run across MPI ranks (mpi_ranks)
+    s += "#SBATCH --ntasks=" + std::to_string(in.job.ntasks) + "\n";
   s += "set -eu\n";
   s += "exec " + run_words(in) + " \\\n";
   s += "  --shard \"${SLURM_ARRAY_TASK_ID:?submit this script with sbatch}/" + n + "\" \\\n";

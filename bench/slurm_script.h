@@ -26,6 +26,9 @@ SlurmPaths slurm_paths(const std::string& out_dir);
 struct SlurmJobSettings {
   std::string partition, time, mem;  ///< empty: the cluster's default
   int cpus_per_task = 1;             ///< also the thread count of every cell (part of its key)
+  /// Slurm tasks of each array job: the MPI ranks its cells' flows run on (a cell with
+  /// mpi_ranks P starts mpirun -n P inside the job's allocation). 1: no --ntasks line.
+  int ntasks = 1;
 };
 
 struct BatchScriptInput {

@@ -37,6 +37,7 @@ constexpr ReservedOption kReserved[] = {
     {"cpus-per-task", 'c',
      "use submit's own --cpus-per-task, which is also every cell's thread count"},
     {"parsable", 0, "submit reads the job ids with it"},
+    {"ntasks", 'n', "use submit's own --ntasks (default: the largest mpi_ranks of the cells)"},
     {"wrap", 0, "submit writes the batch scripts itself"},
 };
 
@@ -81,6 +82,7 @@ std::string resubmit_command(const SubmitRequest& r, const BatchScriptInput& in)
   if (r.quick) words.push_back("--quick");
   words.insert(words.end(), {"--out", in.out_dir, "--tasks", std::to_string(in.tasks),
                              "--cpus-per-task", std::to_string(r.cpus_per_task)});
+  if (r.ntasks > 0) words.insert(words.end(), {"--ntasks", std::to_string(r.ntasks)});
   if (!r.partition.empty()) words.insert(words.end(), {"--partition", r.partition});
   if (!r.time.empty()) words.insert(words.end(), {"--time", r.time});
   if (!r.mem.empty()) words.insert(words.end(), {"--mem", r.mem});
@@ -213,6 +215,9 @@ void check_submit_request(const SubmitRequest& r) {
   if (r.cpus_per_task < 1)
     throw std::invalid_argument("--cpus-per-task: expected a number >= 1, got " +
                                 std::to_string(r.cpus_per_task));
+  if (r.ntasks < 0)
+    throw std::invalid_argument("--ntasks: expected a number >= 1, got " +
+                                std::to_string(r.ntasks));
   for (const std::string& a : r.sbatch_args) check_sbatch_argument(a);
 }
 
@@ -254,6 +259,14 @@ int submit_study(const SubmitRequest& r) {
   const std::vector<CellPlan> plans = plan_cells(e, in.out_dir, meshes, r.cpus_per_task);
   const int cells = int(plans.size());
   in.cells = cells;
+  // Every array job gets the ranks of the cell that asks for the most (its shard may hold it).
+  int ranks = 1;
+  for (const CellPlan& p : plans) ranks = std::max(ranks, p.cell.flow.mpi_ranks);
+  if (r.ntasks > 0 && r.ntasks < ranks)
+    throw std::invalid_argument("--ntasks " + std::to_string(r.ntasks) + ": a cell of " + e.name +
+                                " asks for mpi_ranks " + std::to_string(ranks) +
+                                "; give at least that many, or leave --ntasks out");
+  in.job.ntasks = r.ntasks > 0 ? r.ntasks : ranks;
   in.tasks = std::max(1, std::min(r.tasks > 0 ? r.tasks : kMaxArrayTasks, cells));
   std::set<int> shards;
   int to_run = 0;

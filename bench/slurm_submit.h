@@ -16,8 +16,10 @@ struct SubmitRequest {
   bool quick = false;  ///< the config's quick variant
   std::string out;     ///< the results folder (required)
   int tasks = 0;       ///< N, shards of the matrix; 0: one per cell, at most kMaxArrayTasks
-  std::string partition, time, mem;      ///< sbatch's --partition, --time, --mem; empty: default
-  int cpus_per_task = 1;                 ///< CPUs of every job, and threads of every cell
+  std::string partition, time, mem;  ///< sbatch's --partition, --time, --mem; empty: default
+  int cpus_per_task = 1;             ///< CPUs of every job, and threads of every cell
+  /// Slurm tasks of every array job, at least the cells' largest mpi_ranks; 0: that largest.
+  int ntasks = 0;
   bool dry_run = false;                  ///< write the scripts, submit nothing
   std::vector<std::string> sbatch_args;  ///< passed to both sbatch calls as they are
   /// The binary the jobs run; empty: this process's own (/proc/self/exe).

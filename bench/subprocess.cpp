@@ -12,8 +12,22 @@
 extern char** environ;
 
 namespace mcf {
+namespace {
 
-ProgramResult run_program(const std::vector<std::string>& argv) {
+/// The environment when the process started (static initialisation runs before main).
+const std::vector<std::string>& startup_environment_copy() {
+  static const std::vector<std::string> copy = [] {
+    std::vector<std::string> entries;
+    for (char** e = environ; e && *e; ++e) entries.emplace_back(*e);
+    return entries;
+  }();
+  return copy;
+}
+[[maybe_unused]] const bool kTakenAtStart = !startup_environment_copy().empty();
+
+}  // namespace
+
+ProgramResult run_program(const std::vector<std::string>& argv, bool startup_environment) {
   if (argv.empty()) throw std::invalid_argument("run_program: no program");
   ProgramResult result;
   // What this process printed so far comes before the program's own lines.
@@ -31,7 +45,14 @@ ProgramResult run_program(const std::vector<std::string>& argv) {
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   pid_t pid = 0;
-  const int spawn_error = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+  std::vector<char*> env;
+  if (startup_environment) {
+    for (const std::string& e : startup_environment_copy())
+      env.push_back(const_cast<char*>(e.c_str()));
+    env.push_back(nullptr);
+  }
+  const int spawn_error = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(),
+                                         startup_environment ? env.data() : environ);
   posix_spawn_file_actions_destroy(&actions);
   ::close(pipe_fds[1]);
   if (spawn_error != 0) {

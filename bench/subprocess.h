@@ -19,6 +19,9 @@ struct ProgramResult {
 /// Runs argv[0], looked up on PATH, with the arguments argv[1..]: standard input /dev/null,
 /// standard output captured, standard error shared. Waits for it to end. Never throws for the
 /// program's failure (the answer says it); throws std::invalid_argument for an empty argv.
-ProgramResult run_program(const std::vector<std::string>& argv);
+/// With `startup_environment`, the program gets this process's environment as it was when the
+/// process started, without what was set since (MPI's singleton start sets variables that would
+/// make an mpirun started from here take itself for a part of this process's job).
+ProgramResult run_program(const std::vector<std::string>& argv, bool startup_environment = false);
 
 }  // namespace mcf

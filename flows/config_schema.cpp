@@ -99,6 +99,17 @@ std::vector<OptionSpec> tail_options() {
                                   [](auto& c) -> auto& { return c.threads; }),
                               0, 4096);
   threads.default_text = "0 = all cores";
+  OptionSpec ranks = ranged(bind(
+                                option("mpi_ranks", OptionType::integer, 1, "--mpi-ranks",
+                                       "MPI ranks the solve is spread over: `mcfbench run` "
+                                       "starts the cell under mpirun -n N; `mcfbench flow` "
+                                       "must be started so (docs/petsc.md)"),
+                                [](auto& c) -> auto& { return c.mpi_ranks; }),
+                            1, 4096);
+  ranks.recorded = Recorded::when_set;
+  ranks.refused_elsewhere = true;
+  ranks.owner_text = "a solver that runs across MPI ranks (petsc)";
+  ranks.selected = [](const FlowConfig& c) { return solver_row(c.solver.name).distributed; };
   OptionSpec blas = ranged(bind(
                                option("blas_threads", OptionType::integer, 0, "--blas-threads",
                                       "OpenBLAS threads under CHOLMOD: auto (one below 20000 "
@@ -121,7 +132,7 @@ std::vector<OptionSpec> tail_options() {
       [](auto& c) -> auto& { return c.repair_degenerate; });
   repair.flag_kind = FlagKind::set_true;
   repair.recorded = Recorded::when_set;
-  return {integrator, extrapolate, dt, steps, normalize, threads, blas, save, repair};
+  return {integrator, extrapolate, dt, steps, normalize, threads, ranks, blas, save, repair};
 }
 
 std::vector<OptionSpec> gather() {

@@ -63,6 +63,9 @@ struct FlowConfig {
   int steps = 10;
   bool normalize_area = false;  ///< unit area, centroid at origin, before and after every step
   int threads = 0;              ///< 0 = all cores
+  /// MPI ranks the solve runs on (a solver whose row is `distributed`: petsc). `mcfbench run`
+  /// starts such a cell under `mpirun -n mpi_ranks`; `mcfbench flow` must be started so.
+  int mpi_ranks = 1;
   /// OpenBLAS threads under CHOLMOD: 0 = auto (auto_blas_threads, solvers/blas_threads.h), else
   /// this many, at most `threads`.
   int blas_threads = 0;

@@ -46,6 +46,10 @@ def family_and_knob(r):
                 pre = "MG " + cycle
             tol = s.get("tolerance", 0)
             return "hat CG (%s)" % pre, "tol %g" % tol, -tol
+        if name == "petsc":  # the paper's baseline (GAMG) and hypre's BoomerAMG, by tolerance
+            tol = s.get("tolerance", 0)
+            amg = "BoomerAMG" if "boomeramg" in (s.get("petsc_options") or "") else "GAMG"
+            return "hat CG (PETSc %s)" % amg, "tol %g" % tol, -tol
         return "hat + %s" % name, "", 0
     if o.get("tracking") == "rebuilt":
         system = "rebuilt octree"

@@ -35,6 +35,10 @@ void add_submit_command(CLI::App& app, std::function<int()>& run) {
                   "CPUs of every job, and every cell's thread count (part of its key; default 1)")
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--mem", a->mem, "sbatch --mem of every job, e.g. 8G");
+  cmd->add_option("--ntasks", a->ntasks,
+                  "Slurm tasks (MPI ranks) of every array job (default: the largest mpi_ranks of "
+                  "the cells; 1 writes no --ntasks line)")
+      ->check(CLI::Range(1, 1000000));
   cmd->add_flag("--dry-run", a->dry_run, "Write the scripts, submit nothing");
   cmd->add_option("sbatch_args", a->sbatch_args,
                   "Options passed to both sbatch calls, after --, one word each");

@@ -114,6 +114,12 @@ TEST(SlurmScript, ScriptsSayWhatTheyRunWithEveryPathQuoted) {
     EXPECT_TRUE(contains(run, line)) << line << "\nnot in\n" << run;
   // sbatch reads #SBATCH lines up to the first command only.
   EXPECT_LT(run.rfind("#SBATCH"), run.find("\nset -eu"));
+  EXPECT_FALSE(contains(run, "--ntasks"));  // one task: Slurm's default, no line
+  in.job.ntasks = 4;                        // cells that run their solve on 4 MPI ranks
+  const std::string ranked = run_array_script(in);
+  EXPECT_TRUE(contains(ranked, "#SBATCH --ntasks=4\n")) << ranked;
+  EXPECT_LT(ranked.rfind("#SBATCH"), ranked.find("\nset -eu"));
+  in.job.ntasks = 1;
   in.with_reference = true;
   const std::string collect = collect_script(in);
   for (const char* line :

@@ -82,6 +82,21 @@ TEST(FlowConfig, ErrorsNameFileAndKey) {
       error_of(json{{"mesh", "a"}, {"solver", {{"name", "multigrid"}, {"precision", "half"}}}})
           .find("solver.precision"),
       std::string::npos);
+  // Ranks only where the solve is spread over them; one rank is the default and recorded nowhere.
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"mpi_ranks", 2}})
+                .find("cfg.json: mpi_ranks: applies to a solver that runs across MPI ranks"),
+            std::string::npos);
+  EXPECT_EQ(error_of(json{{"mesh", "a"}, {"mpi_ranks", 1}}), "");
+  EXPECT_EQ(error_of(json{{"mesh", "a"}, {"solver", {{"name", "petsc"}}}, {"mpi_ranks", 4}}), "");
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"name", "petsc"}}}, {"mpi_ranks", 0}})
+                .find("mpi_ranks"),
+            std::string::npos);
+  EXPECT_FALSE(
+      to_json(flow_config_from_json(json{{"mesh", "a"}}, "cfg.json")).contains("mpi_ranks"));
+  EXPECT_EQ(to_json(flow_config_from_json(
+                json{{"mesh", "a"}, {"solver", {{"name", "petsc"}}}, {"mpi_ranks", 4}},
+                "cfg.json"))["mpi_ranks"],
+            4);
   // A lumped mass the octree basis would ignore while the result recorded it.
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"mass", "lumped"}})
                 .find("cfg.json: mass: \"lumped\" applies to the hat basis only"),

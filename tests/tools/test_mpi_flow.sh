@@ -3,7 +3,8 @@
 # `mpirun -n 2 mcfbench flow ... --solver petsc` writes one result whose final surface matches the
 # same flow run without mpirun to 1e-8 of the bounding box's diagonal, records two ranks, and
 # leaves no second output, and holds about half of the matrix and of GAMG's hierarchy on each rank; a
-# solver other than petsc under mpirun is refused, writing nothing.
+# solver other than petsc under mpirun is refused, writing nothing; a flow asking for 2 ranks without
+# them is refused; a study cell with mpi_ranks 2 runs under mpirun started by `mcfbench run`.
 #
 # usage: test_mpi_flow.sh MCFBENCH
 #
@@ -65,4 +66,36 @@ mpirun -n 2 "$mcfbench" flow --mesh sphere:vertices=500 --threads 1 --steps 1 --
   >"$work/cholmod.log" 2>&1 && fail "cholmod under mpirun -n 2 was not refused"
 grep -q 'only "petsc" runs across the 2 ranks' "$work/cholmod.log" || fail "no refusal message: $(cat "$work/cholmod.log")"
 [ ! -e "$work/cholmod" ] || fail "the refused run wrote $work/cholmod"
+# A flow that asks for 2 ranks is refused when not started on them, writing nothing.
+"$mcfbench" "${flow[@]}" --mpi-ranks 2 --out "$work/unranked" >"$work/unranked.log" 2>&1 &&
+  fail "--mpi-ranks 2 without mpirun was not refused"
+grep -q 'mpi_ranks: 2 ranks asked for, but this process is one of 1' "$work/unranked.log" ||
+  fail "no refusal message: $(cat "$work/unranked.log")"
+[ ! -e "$work/unranked" ] || fail "the refused run wrote $work/unranked"
+
+# A study cell with mpi_ranks 2: `mcfbench run` starts it under mpirun itself, and its frames and
+# reference distance are made as for the one-process cell beside it.
+cat >"$work/ranks.json" <<'JSON'
+{"name": "ranks", "defaults": {"mesh": "sphere:vertices=3000", "solver.name": "petsc", "threads": 1,
+  "dt": 1e-3, "steps": 3},
+ "axes": {"mpi_ranks": [1, 2]},
+ "metrics": {"frames": [3], "reference": {"mpi_ranks": 1}, "sphericity": true}}
+JSON
+"$mcfbench" run "$work/ranks.json" --out "$work/ranks" >"$work/ranks.log" 2>&1 ||
+  { cat "$work/ranks.log"; fail "the study with an mpi_ranks cell failed"; }
+"$py" - "$work/ranks" <<'PY' || exit 1
+import glob, json, sys
+cells = [json.load(open(f)) for f in glob.glob(sys.argv[1] + "/*.json")]
+cells = {c["config"].get("mpi_ranks", 1): c for c in cells if "cell" in c}
+two = cells[2]
+ok = sorted(cells) == [1, 2] and two["status"] == "ok" and two["solver_settings"]["ranks"] == "2"
+d = two["reference_distance"][0]
+ok = ok and d["step"] == 3 and d["max"] < 1e-8
+ok = ok and two["peak_memory_scope"] == "rank 0 of mpirun -n 2"
+ok = ok and "sphericity" in two["steps"][-1]["metrics"] and "sphericity" in two["initial_metrics"]
+print("run's 2-rank cell: status %s, ranks %s, max distance to the 1-rank cell at step 3 %.3g, "
+      "peak scope %r" % (two["status"], two["solver_settings"]["ranks"], d["max"], two["peak_memory_scope"]))
+sys.exit(0 if ok else 1)
+PY
+[ ! -e "$work/ranks/.mpi" ] || [ -z "$(ls -A "$work/ranks/.mpi")" ] || fail "the scratch folder of the 2-rank cell was left"
 echo "mpi_flow: ok"
