@@ -41,10 +41,14 @@ CpuCounters read_cpu_counters() {
       }
     }
   }
-  rusage u{};
-  if (::getrusage(RUSAGE_SELF, &u) == 0)
-    c.own = double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-            1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  // This process's time and that of its children it has waited for (and theirs): a cell run
+  // under mpirun (mpi_ranks) is its own work, not other work beside it.
+  rusage self{}, children{};
+  if (::getrusage(RUSAGE_SELF, &self) == 0 && ::getrusage(RUSAGE_CHILDREN, &children) == 0)
+    c.own = double(self.ru_utime.tv_sec + self.ru_stime.tv_sec + children.ru_utime.tv_sec +
+                   children.ru_stime.tv_sec) +
+            1e-6 * double(self.ru_utime.tv_usec + self.ru_stime.tv_usec +
+                          children.ru_utime.tv_usec + children.ru_stime.tv_usec);
   std::ifstream load("/proc/loadavg");
   if (double l = 0; load >> l) c.load1 = l;
   return c;

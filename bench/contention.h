@@ -14,7 +14,8 @@ namespace mcf {
 struct CpuCounters {
   double busy = -1;   ///< user + nice + system + irq + softirq of the whole machine
   double steal = -1;  ///< time the hypervisor gave to other guests
-  double own = -1;    ///< this process's user + system time, all its threads
+  double own =
+      -1;  ///< user + system time of this process (all its threads) and its waited-for children
   double wall = 0;    ///< a monotonic clock
   double load1 = -1;  ///< /proc/loadavg's one-minute load average
 };
