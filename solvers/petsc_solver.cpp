@@ -215,7 +215,17 @@ struct PetscSolver::Impl {
   double matrix_bytes_per_rank = 0, preconditioner_bytes_per_rank = -1;
   std::vector<PetscReal> history;
 
-  ~Impl() { destroy(); }
+  ~Impl() {
+    destroy();
+    // This solver's options leave the database with it: a process that makes many solvers (a
+    // study's cells) would otherwise fill it (PETSc holds at most 512 options).
+    PetscBool initialized = PETSC_FALSE, finalized = PETSC_FALSE;
+    PetscInitialized(&initialized);
+    PetscFinalized(&finalized);
+    if (initialized && !finalized && !prefix.empty())
+      for (const std::string& name : option_names(inserted))
+        PetscOptionsClearValue(nullptr, ("-" + prefix + name).c_str());
+  }
   void destroy() {
     if (ksp != nullptr) KSPDestroy(&ksp);
     if (A != nullptr) MatDestroy(&A);

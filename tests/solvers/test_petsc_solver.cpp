@@ -152,6 +152,25 @@ TEST(PetscSolver, TwoSolversKeepTheirOwnOptions) {
   }
 }
 
+// A study makes a solver per cell in one process: each solver's options leave PETSc's options
+// database (at most 512 entries) with it, so the hundredth is made as the first was.
+TEST(PetscSolver, ManySolversInOneProcessDoNotFillTheOptionsDatabase) {
+  SKIP_WITHOUT_PETSC();
+  PetscSolverOptions boomer;
+  boomer.options =
+      "-pc_type hypre -pc_hypre_type boomeramg -pc_hypre_boomeramg_strong_threshold 0.5";
+  for (int i = 0; i < 100; ++i) {
+    ASSERT_NO_THROW(PetscSolver(i % 2 ? boomer : PetscSolverOptions{})) << "solver " << i;
+  }
+  PetscSolver last;
+  const SparseMatrix A = laplacian3d(6, 6, 6, 0.1);
+  const Eigen::MatrixXd B = random_rhs(A.rows());
+  ASSERT_EQ(last.set_matrix(A).status, SolveStatus::converged);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(A.rows(), 3);
+  EXPECT_EQ(last.solve(B, X).status, SolveStatus::converged);
+  EXPECT_LE(relative_residual(A, B, X), 1e-9);
+}
+
 TEST(PetscSolver, PatternHandedOverOnceAndValuesRefreshed) {
   SKIP_WITHOUT_PETSC();
   const SparseMatrix M = laplacian3d(9, 9, 9, 1.0, 4, 0.0);  // a diagonal on the 7-point pattern
