@@ -145,6 +145,7 @@ std::vector<OptionSpec> gather() {
     for (OptionSpec o : row.options) {
       o.key = "solver." + o.key;
       o.owner = row.name;
+      o.owner_text = "solver \"" + row.name + "\"";
       o.selected = [name = row.name](const FlowConfig& c) { return c.solver.name == name; };
       o.recorded = Recorded::when_selected;
       all.push_back(std::move(o));

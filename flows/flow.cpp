@@ -315,8 +315,6 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
                               " basis are held by the mesh's boundary, which the flow keeps "
                               "fixed, so the mesh stays as it is");
   result["solver_name"] = solver_->name();
-  if (const auto settings = solver_->settings(); !settings.empty())
-    for (const auto& [key, text] : settings) result["solver_settings"][key] = text;
 
   const BasisRow& basis = basis_row(config.basis);
   const std::optional<double> stabilization =
@@ -501,7 +499,7 @@ TriangleMesh FlowRun::finish() {
   if (!result_.contains("stop"))
     result_["stop"] = {{"step", int(steps_.size())}, {"reason", "completed"}};
   result_["steps"] = std::move(steps_);
-  // Again at the end: some settings are known only after the solves (PETSc's storage per rank).
+  // At the end: some settings are known only after the solves (PETSc's storage per rank).
   for (const auto& [key, text] : solver_->settings()) result_["solver_settings"][key] = text;
   return TriangleMesh{V_, mesh_.faces};
 }

@@ -58,12 +58,9 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   // Options no solver reads would be recorded as if they had shaped the run.
   for (const OptionSpec& o : flow_config_schema())
     if (o.refused_elsewhere && !o.selected(c) && o.get(c) != o.fallback)
-      fail(o.key, o.owner_text.empty()
-                      ? "applies to solver \"" + o.owner + "\" only, the solver is \"" +
-                            c.solver.name + "\""
-                      : (o.type == OptionType::string ? "\"" + o.get(c).get<std::string>() + "\" "
-                                                      : std::string()) +
-                            "applies to " + o.owner_text + " only");
+      fail(o.key, (o.type == OptionType::string ? "\"" + o.get(c).get<std::string>() + "\" " : "") +
+                      "applies to " + o.owner_text + " only, the solver is \"" + c.solver.name +
+                      "\"");
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
   if (!basis.takes_mass && c.mass != "consistent")
     fail("mass", "\"" + c.mass +

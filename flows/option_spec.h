@@ -70,7 +70,7 @@ struct OptionSpec {
   /// The row that owns a `when_selected` option ("multigrid"), and whether a config selects it;
   /// flow_config_schema() fills both.
   std::string owner{};
-  /// What a refusal names as the owner where it is not one solver ("a multigrid (...)").
+  /// What a refusal names as the owner: `solver "petsc"`, "a multigrid (...)".
   std::string owner_text{};
   std::function<bool(const FlowConfig&)> selected{};
 };

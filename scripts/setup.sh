@@ -38,8 +38,7 @@ fi
 # Real meshes: libcgal-demo's data.tar.gz. Installing the package pulls in Qt, so download the
 # .deb and unpack it into a cache instead (docs/flow.md "Mesh specs").
 cache="${MCFBENCH_CACHE:-$HOME/.cache/mcfbench}"
-archive=/usr/share/doc/libcgal-dev/data.tar.gz
-if [ ! -f "$archive" ] && [ ! -f "$cache/cgal-demo/usr/share/doc/libcgal-dev/data.tar.gz" ]; then
+if ! bash "$(dirname "$0")/cgal_archive.sh" >/dev/null; then
   echo "setup: fetching libcgal-demo's data.tar.gz into $cache/cgal-demo" >&2
   mkdir -p "$cache/cgal-demo"
   tmp=$(mktemp -d)

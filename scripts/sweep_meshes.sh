@@ -33,11 +33,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
 if [ ${#files[@]} -eq 0 ]; then
-  cache=${MCFBENCH_CACHE:-${HOME:-/tmp}/.cache/mcfbench}
-  archive=
-  for a in /usr/share/doc/libcgal-dev/data.tar.gz "$cache/cgal-demo/usr/share/doc/libcgal-dev/data.tar.gz"; do
-    if [ -f "$a" ]; then archive=$a; break; fi
-  done
+  archive=$(bash "$(dirname "$0")/cgal_archive.sh") || archive=
   if [ -z "$archive" ]; then
     echo "sweep_meshes.sh: libcgal-demo's data.tar.gz not found; run scripts/setup.sh" >&2
     exit 77

@@ -7,11 +7,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$1
-cache=${MCFBENCH_CACHE:-${HOME:-/tmp}/.cache/mcfbench}
-archive=
-for a in /usr/share/doc/libcgal-dev/data.tar.gz "$cache/cgal-demo/usr/share/doc/libcgal-dev/data.tar.gz"; do
-  if [ -f "$a" ]; then archive=$a; break; fi
-done
+archive=$(bash "$root/scripts/cgal_archive.sh") || archive=
 if [ -z "$archive" ]; then
   echo "libcgal-demo's data.tar.gz not found (scripts/setup.sh): skipped"
   exit 77
