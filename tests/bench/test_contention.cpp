@@ -1,8 +1,11 @@
 // Contention from fabricated counters, /proc/stat parsing, and the timing summary of a result.
 #include "bench/contention.h"
+#include "bench/subprocess.h"
 #include "bench/timing_summary.h"
 
 #include <gtest/gtest.h>
+
+#include <sys/resource.h>
 
 namespace mcf {
 namespace {
@@ -34,6 +37,27 @@ TEST(Contention, OtherProcessesTimeMarksACell) {
   EXPECT_TRUE(contention_json(at(0, 0, 0, 0), at(10, 10, 10, 1), 2)["contended"].get<bool>());
   // Unknown counters never mark a cell.
   EXPECT_FALSE(contention_json(at(0, -1, -1, -1), at(10, -1, -1, -1), 2)["contended"].get<bool>());
+}
+
+// A child the process waits for (a cell's mpirun) is counted as the process's own time, so its
+// work is not taken for other work sharing the cores.
+TEST(Contention, WaitedForChildrenCountAsOwnTime) {
+  const auto children_seconds = [] {
+    rusage u{};
+    if (::getrusage(RUSAGE_CHILDREN, &u) != 0) return -1.0;
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+           1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  };
+  const CpuCounters before = read_cpu_counters();
+  const double children_before = children_seconds();
+  if (before.own < 0 || children_before < 0) GTEST_SKIP() << "no getrusage";
+  const ProgramResult r =
+      run_program({"awk", "BEGIN { for (i = 0; i < 20000000; ++i) s += i; print s }"});
+  ASSERT_TRUE(r.ok()) << r.start_error;
+  const CpuCounters after = read_cpu_counters();
+  const double child = children_seconds() - children_before;  // the kernel's count of the child
+  ASSERT_GT(child, 0.05) << "the child did too little work to measure";
+  EXPECT_GE(after.own - before.own, child) << "the child's CPU time is not in `own`";
 }
 
 TEST(Contention, ProcStatLine) {
