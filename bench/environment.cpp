@@ -12,6 +12,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 #include <algorithm>
+#include <exception>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -39,17 +40,28 @@ std::string hostname() {
 }  // namespace
 
 nlohmann::json environment_json(int threads, const nlohmann::json& result) {
-  const nlohmann::json* system =
-      result.is_object() && result.contains("system") ? &result["system"] : nullptr;
-  return environment_json(threads,
-                          system && system->is_object() ? system->value("blas_threads", 0) : 0);
+  // CHOLMOD records the OpenBLAS threads it ran with (solver_settings, solvers/cholmod_solver.h);
+  // under any other solver OpenBLAS stays at the flow's cap, `threads`.
+  int blas_threads = 0;
+  if (result.is_object() && result.contains("solver_settings")) {
+    const nlohmann::json& settings = result["solver_settings"];
+    if (settings.is_object() && settings.contains("blas_threads") &&
+        settings["blas_threads"].is_string()) {
+      try {
+        blas_threads = std::stoi(settings["blas_threads"].get<std::string>());
+      } catch (const std::exception&) {
+        blas_threads = 0;
+      }
+    }
+  }
+  return environment_json(threads, blas_threads);
 }
 
 nlohmann::json environment_json(int threads, int blas_threads) {
   const int cores = int(std::thread::hardware_concurrency());
   // What ran in parallel: TBB's arena never exceeds default_concurrency(), whatever the config
   // asked for (that request is in "config.threads"); OpenBLAS, under CHOLMOD, ran with the count
-  // the flow chose (solvers/blas_threads.h).
+  // the solver chose (solvers/cholmod_solver.h), else at the same cap.
   const int ran = runnable_threads(threads);
   const auto v = [](int a, int b, int c) {
     return std::to_string(a) + "." + std::to_string(b) + "." + std::to_string(c);

@@ -114,11 +114,14 @@ std::vector<OptionSpec> tail_options() {
                                option("blas_threads", OptionType::integer, 0, "--blas-threads",
                                       "OpenBLAS threads under CHOLMOD: auto (one below 20000 "
                                       "unknowns, else up to 4) or a count, at most --threads"),
-                               [](auto& c) -> auto& { return c.blas_threads; }),
+                               [](auto& c) -> auto& { return c.solver.blas_threads; }),
                            0, 4096);
   blas.default_text = "auto (0 in the config)";
   blas.values_text = "auto | 1..4096";
   blas.parse_flag = blas_threads_of_flag;
+  blas.refused_elsewhere = true;
+  blas.owner_text = "a solver that factorizes with CHOLMOD (cholmod)";
+  blas.selected = [](const FlowConfig& c) { return solver_row(c.solver.name).uses_blas_threads; };
   OptionSpec save = ranged(bind(
                                option("save_every", OptionType::integer, 0, "--save-every",
                                       "Write OUT/frame_NNNNN.ply every K steps"),

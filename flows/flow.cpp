@@ -64,17 +64,20 @@ struct StepTally {
 // mass only, heat neither after the first step), the reduced solve, and per-step timing.
 class FlowStepContext final : public StepContext {
  public:
-  /// stabilization_weight > 0: every solve is one for the increment over its held values, with
-  /// the basis's normal-gradient term added (solve()).
+  /// With a stabilization weight every solve is one for the increment over its held values, with
+  /// the basis's normal-gradient term added (flows/stabilization.h).
   FlowStepContext(Basis& basis, LinearSolver& solver, const FlowRow& flow, double dt,
-                  bool iterative, double stabilization_weight = 0.0)
+                  bool iterative, std::optional<double> stabilization_weight = std::nullopt)
       : basis_(basis),
         solver_(solver),
         system_(std::make_unique<ReducedSystem>(basis, solver)),
         flow_(flow),
         dt_(dt),
-        iterative_(iterative),
-        stabilization_weight_(stabilization_weight) {}
+        iterative_(iterative) {
+    // A weight of 0 adds nothing: the plain solve, as on the paper's system.
+    if (stabilization_weight && *stabilization_weight > 0.0)
+      stabilized_.emplace(*stabilization_weight);
+  }
 
   double dt() const override { return dt_; }
   const Coefficients& current() const override { return *x_; }
@@ -100,8 +103,8 @@ class FlowStepContext final : public StepContext {
                      const Coefficients& warm) override {
     const auto t0 = Clock::now();
     Coefficients Y;
-    if (stabilization_weight_ > 0.0) {
-      Y = solve_increment(a, b, R, fixed, warm);
+    if (stabilized_) {
+      Y = stabilized_->solve(*system_, basis_, a, b, R, fixed, warm);
     } else if (iterative_ && warm != fixed) {
       // The integrator's prediction, taken as far as it fits (flows/predicted_start.h).
       const SparseView M = basis_.mass(), K = basis_.stiffness();
@@ -147,7 +150,7 @@ class FlowStepContext final : public StepContext {
   }
   void add_update_seconds(double s) { tally_.update_seconds += s; }
   /// ρ of the last stabilized solve (0 without stabilization).
-  double stabilization_rho() const { return rho_; }
+  double stabilization_rho() const { return stabilized_ ? stabilized_->rho() : 0.0; }
   /// The current step's solves so far.
   const StepTally& tally() const { return tally_; }
   std::size_t fixed() const { return system_->num_fixed(); }
@@ -159,40 +162,8 @@ class FlowStepContext final : public StepContext {
   const FlowRow& flow_;
   double dt_;
   StepTally tally_;
-  /// The stabilized solve (flows/stabilization.h): Y = F + Δ with F the held values (the current
-  /// coefficients when Y is a position, zero when it is a velocity) and Δ̂ = warm - F, the
-  /// increment the solver starts from, as the prediction (for a position, the previous step's
-  /// increment, since the integrators start position solves at 2 X_n - X_{n-1}).
-  Coefficients solve_increment(double a, double b, const Coefficients& R, const Coefficients& F,
-                               const Coefficients& warm) {
-    const SparseView S = basis_.normal_gradient();
-    if (S.rows() != basis_.dimension())
-      throw std::logic_error("stabilized solve: the basis has no normal-gradient matrix");
-    const SparseView M = basis_.mass(), K = basis_.stiffness();
-    rho_ = mcf::stabilization_rho(stabilization_weight_, a, b, M, K, S);
-    PredictedStart start = predicted_start(MatrixSum(a, M, b, K), R, F, warm);
-    // R - (a M + b K) F + ρ S Δ̂, and Δ̂ is also where the solver starts.
-    Coefficients& rhs = start.residual;
-    if (start.theta > 0.0) rhs.noalias() += rho_ * symmetric_multiply(S, start.increment);
-    // The flow's first step has no previous increment to predict from: its solve starts from
-    // zero, and an iterative solver runs until the residual is down to kStartUpTolerance (what
-    // it leaves of that step's increment would stay in the surface; later steps start from a
-    // prediction and only remove its change).
-    const ReducedSystem::Passes start_up{kStartUpTolerance, kStartUpPasses};
-    const bool first = !started_ && start.theta == 0.0;
-    started_ = true;
-    const ReducedSystem::ExtraTerm term{rho_, S};
-    const Coefficients delta = system_->solve(a, b, rhs, Coefficients::Zero(F.rows(), 3),
-                                              start.increment, &term, first ? &start_up : nullptr);
-    return delta + F;
-  }
-
   bool iterative_ = false;  ///< the solver starts from the warm start (multigrid, PCG)
-  double stabilization_weight_ = 0.0;
-  double rho_ = 0.0;
-  bool started_ = false;  ///< a stabilized solve ran (the start-up is the first one's)
-  static constexpr double kStartUpTolerance = 1e-8;
-  static constexpr int kStartUpPasses = 20;
+  std::optional<StabilizedSolve> stabilized_;
   // The caller's iterates, which outlive the step: read in place, not copied.
   const Coefficients* x_ = nullptr;
   const Coefficients* x_prev_ = nullptr;
@@ -244,7 +215,6 @@ class FlowRun {
   FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::json& result);
 
   const Positions& vertices() const { return V_; }
-  Eigen::Index dimension() const { return basis_->dimension(); }
   /// Makes step `step`; false when a stop rule ends the flow there (result["stop"] says why).
   bool advance(int step);
   /// result["stop"] (if no rule stopped the flow) and result["steps"]; the final mesh.
@@ -320,13 +290,13 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
   const std::optional<double> stabilization =
       basis.stabilization ? basis.stabilization(config) : std::nullopt;
   stabilized_ = stabilization.has_value();
-  // The start is the stabilized solve's prediction too (FlowStepContext::solve_increment), so a
-  // direct solver needs X_{n-1} then as well.
+  // The start is the stabilized solve's prediction too (StabilizedSolve::solve,
+  // flows/stabilization.h), so a direct solver needs X_{n-1} then as well.
   const bool iterative = solver_row(config.solver.name).iterative;
   keeps_previous_for_start_ = stabilized_ || iterative;
   const FlowRow& flow = flow_row(config.flow);
   ctx_ = std::make_unique<FlowStepContext>(*basis_, *solver_, flow, config.dt, iterative,
-                                           stabilization.value_or(0.0));
+                                           stabilization);
   V_ = mesh_.vertices;
   x_ = basis_->initial_coefficients();
   area0_ = surface_area(mesh_);
@@ -528,10 +498,9 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   const int threads = config.threads > 0 ? config.threads : tbb::info::default_concurrency();
   tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
                                   std::size_t(threads));
-  // CHOLMOD's BLAS has its own pool: capped at what TBB can run while the flow is set up, then at
-  // the count for this system (blas_threads or auto_blas_threads; environment.blas_threads).
-  const int runnable = runnable_threads(config.threads);
-  const ScopedBlasThreads setup_blas(runnable);
+  // OpenBLAS keeps its own pool: capped at what TBB may run for the whole flow. Under that cap
+  // CHOLMOD chooses its own count (solver.blas_threads, solvers/cholmod_solver.h).
+  const ScopedBlasThreads blas_cap(runnable_threads(config.threads));
 
   validate_flow_mesh(config, source.report, source.spec);
   FlowOutcome out;
@@ -541,10 +510,6 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   out.result["mesh"] = mesh_json(source);
   if (!source.notes.empty()) out.result["mesh"]["notes"] = source.notes;
   FlowRun flow(config, source, out.result);
-  const int blas_threads = config.blas_threads > 0 ? std::min(config.blas_threads, runnable)
-                                                   : auto_blas_threads(runnable, flow.dimension());
-  const ScopedBlasThreads blas(blas_threads);
-  out.result["system"]["blas_threads"] = blas_threads;
   if (observer.on_step) observer.on_step(0, 0.0, flow.vertices());
   for (int step = 1; step <= config.steps; ++step) {
     if (!flow.advance(step)) break;

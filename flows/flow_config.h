@@ -48,6 +48,10 @@ struct SolverConfig {
   /// petsc: PETSc options ("-pc_type hypre -pc_hypre_type boomeramg") over the defaults (CG +
   /// GAMG, solvers/petsc_solver.h), kept verbatim in result.json.
   std::string petsc_options;
+  /// cholmod: OpenBLAS threads while it factorizes and solves, 0 = auto (auto_blas_threads,
+  /// solvers/blas_threads.h), else this many, at most the flow's `threads`. Config key
+  /// "blas_threads" (top level, as before it belonged to the solver).
+  int blas_threads = 0;
 };
 
 struct FlowConfig {
@@ -66,9 +70,6 @@ struct FlowConfig {
   /// MPI ranks the solve runs on (a solver whose row is `distributed`: petsc). `mcfbench run`
   /// starts such a cell under `mpirun -n mpi_ranks`; `mcfbench flow` must be started so.
   int mpi_ranks = 1;
-  /// OpenBLAS threads under CHOLMOD: 0 = auto (auto_blas_threads, solvers/blas_threads.h), else
-  /// this many, at most `threads`.
-  int blas_threads = 0;
   int save_every = 0;  ///< write frame_NNNN.ply every K steps (0 = never)
   /// Collapse the mesh's zero-area faces before the flow (datasets/repair.h) instead of refusing
   /// them where the basis needs their cotangents (hat); the octree basis takes them as they are.

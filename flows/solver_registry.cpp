@@ -57,11 +57,12 @@ void check(const SolverRow& row) {
 
 NamedTable<SolverRow> built_in() {
   NamedTable<SolverRow> t("solver", check);
-  SolverRow cholmod{"cholmod", "CHOLMOD's supernodal Cholesky factorization",
-                    [](const SolverConfig&) { return std::make_unique<CholmodSolver>(); },
-                    [](const SolverConfig&, const SystemFigures& s) {
-                      return s.factor_bytes_per_unknown * s.dimension;
-                    }};
+  SolverRow cholmod{
+      "cholmod", "CHOLMOD's supernodal Cholesky factorization",
+      [](const SolverConfig& c) { return std::make_unique<CholmodSolver>(c.blas_threads); },
+      [](const SolverConfig&, const SystemFigures& s) {
+        return s.factor_bytes_per_unknown * s.dimension;
+      }};
   cholmod.uses_blas_threads = true;
   SolverRow pcg{"pcg", "conjugate gradients with solver.preconditioner", make_pcg,
                 [](const SolverConfig& c, const SystemFigures& s) {

@@ -10,6 +10,7 @@
 // surface every step.
 
 #include "bases/basis.h"
+#include "flows/reduced_system.h"
 
 namespace mcf {
 
@@ -17,5 +18,32 @@ namespace mcf {
 /// means the same at every depth and time step. 0 when S has no positive diagonal.
 double stabilization_rho(double c, double a, double b, const SparseRef& M, const SparseRef& K,
                          const SparseRef& S);
+
+/// A flow's stabilized solves at weight c (the basis row's `stabilization`,
+/// flows/basis_registry.h): each step's solve made one for the increment, as above.
+class StabilizedSolve {
+ public:
+  explicit StabilizedSolve(double weight) : weight_(weight) {}
+
+  /// Y = F + Δ with F the held values (the current coefficients when Y is a position, zero when it
+  /// is a velocity) and Δ̂ = warm - F, the increment the solver starts from, as the prediction
+  /// (for a position, the previous step's increment: the integrators start position solves at
+  /// 2 X_n - X_{n-1}). Throws std::logic_error when the basis has no normal-gradient matrix.
+  Coefficients solve(ReducedSystem& system, const Basis& basis, double a, double b,
+                     const Coefficients& R, const Coefficients& F, const Coefficients& warm);
+  /// ρ of the last solve (0 before the first).
+  double rho() const { return rho_; }
+
+ private:
+  double weight_;
+  double rho_ = 0.0;
+  bool started_ = false;  ///< a solve ran (the start-up is the first one's)
+  /// The first solve's passes: the flow's first step has no previous increment to predict from,
+  /// so its solve starts from zero and an iterative solver runs until the residual is down to
+  /// kStartUpTolerance (what it leaves of that increment would stay in the surface; later steps
+  /// start from a prediction and only remove its change).
+  static constexpr double kStartUpTolerance = 1e-8;
+  static constexpr int kStartUpPasses = 20;
+};
 
 }  // namespace mcf

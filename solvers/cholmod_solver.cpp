@@ -1,5 +1,7 @@
 #include "solvers/cholmod_solver.h"
 
+#include "solvers/blas_threads.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -26,7 +28,7 @@ SolveReport make_report(SolveStatus status, std::string message = {}) {
 
 }  // namespace
 
-CholmodSolver::CholmodSolver() {
+CholmodSolver::CholmodSolver(int blas_threads) : blas_threads_(blas_threads) {
   cholmod_l_start(&common_);
   common_.supernodal = CHOLMOD_SUPERNODAL;
   common_.print = 0;
@@ -53,6 +55,18 @@ void CholmodSolver::free_all() {
 std::string CholmodSolver::version() {
   return "CHOLMOD " + std::to_string(CHOLMOD_MAIN_VERSION) + "." +
          std::to_string(CHOLMOD_SUB_VERSION) + "." + std::to_string(CHOLMOD_SUBSUB_VERSION);
+}
+
+int CholmodSolver::blas_threads_for(std::int64_t unknowns) const {
+  const int cap = mcf::blas_threads();
+  if (blas_threads_ == kKeepBlasThreads) return cap;
+  if (blas_threads_ == kAutoBlasThreads) return auto_blas_threads(cap, unknowns);
+  return std::min(blas_threads_, cap);
+}
+
+std::vector<std::pair<std::string, std::string>> CholmodSolver::settings() const {
+  if (blas_threads_used_ == 0) return {};
+  return {{"blas_threads", std::to_string(blas_threads_used_)}};
 }
 
 std::int64_t CholmodSolver::factor_nonzeros() const {
@@ -149,6 +163,8 @@ SolveReport CholmodSolver::factorize(const SparseRef& A, std::uint64_t key, Fill
   if (!fill(static_cast<double*>(lower_->x), gather_.data(), gather_.size()))
     return fail(SolveStatus::numerical_issue, "matrix has NaN/inf");
 
+  const ScopedBlasThreads blas(blas_threads_for(A.rows()));
+  blas_threads_used_ = mcf::blas_threads();
   const int ok = cholmod_l_factorize(lower_, factor_, &common_);
   ++factorizations_;
   const Long n = static_cast<Long>(A.rows());
@@ -235,6 +251,7 @@ SolveReport CholmodSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) 
   b.dtype = CHOLMOD_DOUBLE;
 
   // All columns in one call; solve2 reuses x_/y_/e_ across calls instead of reallocating.
+  const ScopedBlasThreads blas(blas_threads_for(n));
   if (!cholmod_l_solve2(CHOLMOD_A, factor_, &b, nullptr, &x_, nullptr, &y_, &e_, &common_) || !x_)
     return make_report(SolveStatus::failed,
                        "cholmod_solve failed (status " + std::to_string(common_.status) + ")");

@@ -15,9 +15,16 @@
 
 namespace mcf {
 
+/// OpenBLAS threads while CHOLMOD factorizes and solves (its supernodal updates call the BLAS,
+/// which keeps its own pool). The count is taken under the caller's cap (blas_threads() when the
+/// call starts: a flow caps it at its `threads`) and restored after each call.
+inline constexpr int kKeepBlasThreads = -1;  ///< run at the caller's cap
+inline constexpr int kAutoBlasThreads = 0;   ///< auto_blas_threads(cap, unknowns)
+
 class CholmodSolver final : public LinearSolver {
  public:
-  CholmodSolver();
+  /// blas_threads: kKeepBlasThreads, kAutoBlasThreads or a count (at most the caller's cap).
+  explicit CholmodSolver(int blas_threads = kKeepBlasThreads);
   ~CholmodSolver() override;
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
@@ -51,6 +58,11 @@ class CholmodSolver final : public LinearSolver {
 
   /// "CHOLMOD x.y.z" of the headers compiled against, for result.json "libraries".
   static std::string version();
+  /// The OpenBLAS threads the last factorization ran with, as OpenBLAS reported them (0 before
+  /// the first).
+  int blas_threads_used() const { return blas_threads_used_; }
+  /// {"blas_threads", N} once a factorization ran (result.json "solver_settings").
+  std::vector<std::pair<std::string, std::string>> settings() const override;
 
  protected:
   /// Solves all columns of B in one cholmod_solve call; X's input is ignored. Reports
@@ -84,6 +96,11 @@ class CholmodSolver final : public LinearSolver {
   // of A's full pattern is kept. Positions in an int-indexed matrix: int.
   std::vector<int> gather_;
 
+  /// The count for a system of `unknowns` under the current cap (the constructor's rule).
+  int blas_threads_for(std::int64_t unknowns) const;
+
+  int blas_threads_ = kKeepBlasThreads;
+  int blas_threads_used_ = 0;
   int analyses_ = 0;
   int factorizations_ = 0;
   bool factor_ok_ = false;

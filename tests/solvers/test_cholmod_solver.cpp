@@ -1,3 +1,4 @@
+#include "solvers/blas_threads.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/dense_reference.h"
 #include "test_matrices.h"
@@ -34,6 +35,30 @@ TEST(CholmodSolver, MatchesDenseOnLaplacian3d) {
   EXPECT_LT(r.relative_residual, 1e-12);
   // The reported residual is the true one.
   EXPECT_NEAR(r.relative_residual, test::relative_residual(A, B, Xc), 1e-14);
+}
+
+// The solver chooses OpenBLAS's threads for its own calls, under the caller's cap, and restores
+// the cap after: kept, a count (capped), or auto (one for a small system, the cap for a large one).
+TEST(CholmodSolver, ChoosesItsBlasThreadsUnderTheCallersCap) {
+  const ScopedBlasThreads two(2);
+  if (blas_threads() < 2) GTEST_SKIP() << "OpenBLAS runs one thread on this machine";
+  const SparseMatrix small = laplacian3d(6, 6, 6);      // 216 unknowns
+  const SparseMatrix large = laplacian3d(150, 150, 1);  // 22500 unknowns, a 2D grid: fast
+  ASSERT_GE(large.rows(), kBlasThreadsFromDimension);
+  const auto used = [](int request, const SparseMatrix& A) {
+    CholmodSolver s(request);
+    EXPECT_EQ(s.settings().size(), 0u);  // nothing to say before a factorization
+    EXPECT_EQ(s.set_matrix(A).status, SolveStatus::converged);
+    EXPECT_EQ(blas_threads(), 2);  // the cap is back
+    EXPECT_EQ(s.settings().at(0).first, "blas_threads");
+    EXPECT_EQ(s.settings().at(0).second, std::to_string(s.blas_threads_used()));
+    return s.blas_threads_used();
+  };
+  EXPECT_EQ(used(kKeepBlasThreads, small), 2);
+  EXPECT_EQ(used(1, small), 1);
+  EXPECT_EQ(used(8, small), 2);
+  EXPECT_EQ(used(kAutoBlasThreads, small), 1);
+  EXPECT_EQ(used(kAutoBlasThreads, large), 2);
 }
 
 TEST(CholmodSolver, MatchesDenseOnGraphLaplacian) {
