@@ -212,15 +212,27 @@ namespace {
 
 /// For metrics.reference: the reference cell of `cell` (same repetition preferred, then the
 /// one agreeing with the cell on most assigned keys, then the lowest index); nullptr if none or
-/// if the cell is a reference cell itself.
+/// if the cell is a reference cell itself. A reference is a flow of the same surface: it agrees
+/// with the cell on the mesh, the flow and the area normalisation unless the reference's own
+/// assignment sets them (a study whose reference is excluded on some mesh has none there, rather
+/// than one of another mesh).
 const CellPlan* reference_for(const ExperimentConfig& e, const std::vector<CellPlan>& plans,
                               const CellPlan& cell) {
   const json& ref = e.metrics.reference;
   if (ref.is_null() || matches_assignment(cell.cell, ref)) return nullptr;
+  const auto same_surface = [&](const CellPlan& p) {
+    for (const char* key : {"mesh", "flow", "normalize_area"}) {
+      if (ref.contains(key)) continue;
+      const json* a = json_at_path(p.cell.config, key);
+      const json* b = json_at_path(cell.cell.config, key);
+      if (!a || !b || *a != *b) return false;
+    }
+    return true;
+  };
   const CellPlan* best = nullptr;
   std::pair<int, int> best_score{-1, -1};
   for (const CellPlan& p : plans) {
-    if (!matches_assignment(p.cell, ref)) continue;
+    if (!matches_assignment(p.cell, ref) || !same_surface(p)) continue;
     int agree = 0;
     for (auto it = cell.cell.assignment.begin(); it != cell.cell.assignment.end(); ++it) {
       const json* v = json_at_path(p.cell.config, it.key());
@@ -272,6 +284,13 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
     if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
     if (const int signal = stop_requested()) throw Interrupt{signal};
     const CellPlan* ref = reference_for(e, plans, p);
+    if (!ref && fs::exists(p.file)) {
+      // No reference (any more): distances an earlier run recorded are not this study's.
+      json result = read_json_file(p.file);
+      if (result.erase("reference_distance") + result.erase("reference_cell") > 0)
+        write_file_atomic(p.file, result.dump(1) + "\n");
+      continue;
+    }
     if (!ref || !fs::exists(p.file) || !fs::exists(ref->file)) continue;
     json result = read_json_file(p.file);
     const bool stale =

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <fstream>
 #include <iterator>
 #include <map>
 #include <set>
@@ -166,6 +167,46 @@ ExperimentConfig three_dts_with_reference() {
       {"axes", {{"dt", {1e-3, 2e-3, 4e-3}}}},
       {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 100}}}};
   return parse_experiment_config(j, "r.json", false);
+}
+
+// A reference is a flow of the same surface: where the study excludes its reference on a mesh,
+// that mesh's cells get no distances (not distances to another mesh's reference), and distances
+// an earlier run recorded there are dropped.
+TEST(Runner, ReferenceDistancesOnlyToAReferenceOfTheSameMesh) {
+  const fs::path out = fresh_dir("reference_same_mesh");
+  const json j = {
+      {"name", "r"},
+      {"defaults", {{"steps", 2}, {"dt", 1e-3}}},
+      {"axes", {{"mesh", {"icosphere:level=1", "icosphere:level=2"}}, {"dt", {1e-3, 4e-3}}}},
+      {"exclude", {{{"mesh", "icosphere:level=2"}, {"dt", 1e-3}}}},
+      {"metrics", {{"frames", {2}}, {"reference", {{"dt", 1e-3}}}, {"distance_samples", 200}}}};
+  const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
+  RunOptions o;
+  o.out_dir = out.string();
+  const RunSummary s = run_experiment(e, o);
+  ASSERT_EQ(s.ran, 3);
+  EXPECT_EQ(s.distances, 1);
+  MeshCache meshes;
+  const auto plans = plan_cells(e, out.string(), meshes);
+  const CellPlan* lone = nullptr;  // icosphere:level=2 at dt 4e-3: no reference on its mesh
+  for (const CellPlan& p : plans) {
+    const json r = read_json(p.file);
+    const bool on_level1 = p.cell.flow.mesh == "icosphere:level=1";
+    const bool is_reference = p.cell.flow.dt == 1e-3;
+    EXPECT_EQ(r.contains("reference_distance"), on_level1 && !is_reference) << p.cell.flow.mesh;
+    if (!on_level1) lone = &p;
+  }
+  ASSERT_NE(lone, nullptr);
+  // Distances recorded by a run that matched another mesh's reference are dropped on a rerun.
+  json planted = read_json(lone->file);
+  planted["reference_distance"] = json::array();
+  planted["reference_cell"] = json::object();
+  std::ofstream(lone->file) << planted.dump(1) << "\n";
+  RunOptions again = o;
+  again.distances_only = true;
+  run_experiment(e, again);
+  EXPECT_FALSE(read_json(lone->file).contains("reference_distance"));
+  EXPECT_FALSE(read_json(lone->file).contains("reference_cell"));
 }
 
 TEST(Runner, ShardedReferenceDistancesAreFilledInByALaterRun) {
