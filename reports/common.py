@@ -122,11 +122,13 @@ def assignment_key(cell):
 
 
 def cell_identity(study, quick, cell):
-    """What makes a planned cell and a result the same cell: study, quick flag, index, repetition
-    and assignment (not the commit: a planned cell is there when any commit's result is; where
-    several commits ran a cell, the figures draw the newest one's, newest_commits)."""
+    """What makes a planned cell and a result the same cell: study, quick flag, repetition and
+    assignment (not the commit: a planned cell is there when any commit's result is; where several
+    commits ran a cell, the figures draw the newest one's, newest_commits). Not the index: it is
+    the cell's place in the expansion, which an edit of the config's exclusions shifts while the
+    runner rightly keeps the finished cell."""
     cell = cell if isinstance(cell, dict) else {}
-    return (study, bool(quick), cell.get("index"), cell.get("repetition", 0) or 0, assignment_key(cell))
+    return (study, bool(quick), cell.get("repetition", 0) or 0, assignment_key(cell))
 
 
 def result_identity(result):
@@ -263,8 +265,8 @@ def commit_of(result):
 def config_identity(result):
     """Which configuration a result ran, repetitions aside: cell.config_key (bench/cell_hash.cpp:
     the full config and the mesh's fingerprint, without the repetition, as `mcfbench compare`
-    pools repetitions), else (results without it) the cell's study, quick flag, index and
-    assignment, else the file itself (a plain `mcfbench flow` run)."""
+    pools repetitions), else (results without it) the cell's study, quick flag and assignment,
+    else the file itself (a plain `mcfbench flow` run)."""
     cell = result.get("cell")
     if isinstance(cell, dict):
         if cell.get("config_key"):
