@@ -84,6 +84,9 @@ int run_experiment_with_progress(const RunRequest& request) {
   RunProgress progress(line_seconds);
   o.on_step = [&](const StepReport& r) { progress.step(r); };
   o.on_cell = [&](const CellReport& r) { progress.cell(r); };
+  o.on_distance = [](int done, int total, int cell_index) {
+    std::fprintf(stderr, "[distances %d/%d] cell %d\n", done, total, cell_index);
+  };
   const StopSignals signals;
   o.stop_requested = &StopSignals::received;
   RunSummary s;

@@ -280,6 +280,7 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
                             const std::function<int()>& stop_requested) {
   const fs::path out(o.out_dir);
   int added = 0;
+  std::vector<std::pair<const CellPlan*, const CellPlan*>> work;  // (cell, its reference)
   for (const CellPlan& p : plans) {
     if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
     if (const int signal = stop_requested()) throw Interrupt{signal};
@@ -298,14 +299,21 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
     if (!stale || result.value("status", "") == "error") continue;
     const json ref_result = read_json_file(ref->file);
     if (ref_result.value("status", "") == "error") continue;
-    result["reference_distance"] = reference_distances(e, out, p, *ref);
+    work.emplace_back(&p, ref);
+  }
+  // Distances to large references take seconds a frame: the progress says how far they are.
+  for (const auto& [p, ref] : work) {
+    if (const int signal = stop_requested()) throw Interrupt{signal};
+    json result = read_json_file(p->file);
+    result["reference_distance"] = reference_distances(e, out, *p, *ref);
     result["reference_cell"] = {{"index", ref->cell.index},
                                 {"hash", ref->hash},
                                 {"key", ref->key},
                                 {"assignment", ref->cell.assignment},
                                 {"repetition", ref->cell.repetition}};
-    write_file_atomic(p.file, result.dump(1) + "\n");
+    write_file_atomic(p->file, result.dump(1) + "\n");
     ++added;
+    if (o.on_distance) o.on_distance(added, int(work.size()), p->cell.index);
   }
   return added;
 }

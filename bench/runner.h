@@ -68,6 +68,8 @@ struct RunOptions {
   /// this shard would run whose estimated peak exceeds it stops the run before anything is written.
   std::string max_memory;
   std::function<void(const CellReport&)> on_cell;  ///< progress (stderr in the CLI)
+  /// Progress of the reference distances: `done` of `total` cells, the last one's index.
+  std::function<void(int done, int total, int cell_index)> on_distance;
   std::function<void(const StepReport&)>
       on_step;  ///< inside a cell that runs (not for skipped ones)
   /// Asked before each cell and after each step of a running cell: nonzero (the signal that asked,

@@ -183,9 +183,12 @@ TEST(Runner, ReferenceDistancesOnlyToAReferenceOfTheSameMesh) {
   const ExperimentConfig e = parse_experiment_config(j, "r.json", false);
   RunOptions o;
   o.out_dir = out.string();
+  std::vector<std::pair<int, int>> progress;  // (done, total) as the distances are added
+  o.on_distance = [&](int done, int total, int) { progress.emplace_back(done, total); };
   const RunSummary s = run_experiment(e, o);
   ASSERT_EQ(s.ran, 3);
   EXPECT_EQ(s.distances, 1);
+  EXPECT_EQ(progress, (std::vector<std::pair<int, int>>{{1, 1}}));
   MeshCache meshes;
   const auto plans = plan_cells(e, out.string(), meshes);
   const CellPlan* lone = nullptr;  // icosphere:level=2 at dt 4e-3: no reference on its mesh
