@@ -301,7 +301,7 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
     if (ref_result.value("status", "") == "error") continue;
     work.emplace_back(&p, ref);
   }
-  // Distances to large references take seconds a frame: the progress says how far they are.
+  // A large reference makes each frame's distance slow: the progress says how far they are.
   for (const auto& [p, ref] : work) {
     if (const int signal = stop_requested()) throw Interrupt{signal};
     json result = read_json_file(p->file);
