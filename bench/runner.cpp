@@ -280,7 +280,12 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
                             const std::function<int()>& stop_requested) {
   const fs::path out(o.out_dir);
   int added = 0;
-  std::vector<std::pair<const CellPlan*, const CellPlan*>> work;  // (cell, its reference)
+  struct Pending {
+    const CellPlan* cell;
+    const CellPlan* reference;
+    json result;  // the cell's result as read, completed below
+  };
+  std::vector<Pending> work;
   for (const CellPlan& p : plans) {
     if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
     if (const int signal = stop_requested()) throw Interrupt{signal};
@@ -299,12 +304,11 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
     if (!stale || result.value("status", "") == "error") continue;
     const json ref_result = read_json_file(ref->file);
     if (ref_result.value("status", "") == "error") continue;
-    work.emplace_back(&p, ref);
+    work.push_back({&p, ref, std::move(result)});
   }
   // A large reference makes each frame's distance slow: the progress says how far they are.
-  for (const auto& [p, ref] : work) {
+  for (auto& [p, ref, result] : work) {
     if (const int signal = stop_requested()) throw Interrupt{signal};
-    json result = read_json_file(p->file);
     result["reference_distance"] = reference_distances(e, out, *p, *ref);
     result["reference_cell"] = {{"index", ref->cell.index},
                                 {"hash", ref->hash},
