@@ -115,6 +115,16 @@ with tempfile.TemporaryDirectory() as out:
     check("Stopped before the last step" in text, "the stopped cell is not listed")
     check("1 contended point(s) left out" in text, "contended points are not counted")
 
+# A planned cell and its result are the same cell when the index differs: an edit of the config's
+# exclusions shifts the indices of cells a resumed run kept (common.cell_identity).
+planned_cell = {"index": 7, "repetition": 2, "assignment": {"mesh": "m", "solver.cycles": 2}}
+kept = {"cell": dict(planned_cell, index=3, study="s")}
+check(common.cell_identity("s", False, planned_cell) == common.result_identity(kept),
+      "a result whose index shifted is not matched to its planned cell")
+check(common.cell_identity("s", False, planned_cell)
+      != common.cell_identity("s", False, dict(planned_cell, repetition=1)),
+      "two repetitions of one cell are matched to each other")
+
 if failures:
     print("FAIL:\n  " + "\n  ".join(failures))
     sys.exit(1)
