@@ -215,48 +215,6 @@ bool is_unrecorded_default(const std::string& key, const json& value) {
 
 }  // namespace
 
-const std::vector<std::string>& flow_config_keys() {
-  // The schema's keys (flows/config_schema.h) and the objects that hold them: every key a cell
-  // may set, whether or not result.json records it for the cell's solver.
-  static const std::vector<std::string> keys = [] {
-    std::vector<std::string> k;
-    for (const OptionSpec& o : flow_config_schema()) {
-      for (std::size_t dot = o.key.find('.'); dot != std::string::npos;
-           dot = o.key.find('.', dot + 1))
-        k.push_back(o.key.substr(0, dot));
-      k.push_back(o.key);
-    }
-    std::sort(k.begin(), k.end());
-    k.erase(std::unique(k.begin(), k.end()), k.end());
-    return k;
-  }();
-  return keys;
-}
-
-const json* json_at_path(const json& j, const std::string& dotted) {
-  const json* node = &j;
-  size_t start = 0;
-  while (true) {
-    const size_t dot = dotted.find('.', start);
-    const std::string part =
-        dotted.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (!node->is_object() || !node->contains(part)) return nullptr;
-    node = &node->at(part);
-    if (dot == std::string::npos) return node;
-    start = dot + 1;
-  }
-}
-
-void set_json_path(json& j, const std::string& dotted, const json& value) {
-  json* node = &j;
-  size_t start = 0;
-  for (size_t dot = dotted.find('.'); dot != std::string::npos; dot = dotted.find('.', start)) {
-    node = &(*node)[dotted.substr(start, dot - start)];
-    start = dot + 1;
-  }
-  (*node)[dotted.substr(start)] = value;
-}
-
 bool matches_assignment(const Cell& cell, const json& partial) {
   if (!partial.is_object()) return false;
   for (auto it = partial.begin(); it != partial.end(); ++it) {

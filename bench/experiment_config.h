@@ -18,6 +18,7 @@
 // means the same thing in every process that reads the same file.
 
 #include "flows/flow_config.h"
+#include "flows/json_path.h"
 
 #include <nlohmann/json.hpp>
 
@@ -70,12 +71,6 @@ ExperimentConfig parse_experiment_config(const nlohmann::json& j, const std::str
 /// Reads the file (parse errors name it) and calls parse_experiment_config.
 ExperimentConfig load_experiment_config(const std::string& path, bool quick);
 
-/// Every dotted key a flow config has ("mesh", "solver.cycles", "octree", ...).
-const std::vector<std::string>& flow_config_keys();
-/// Value at a dotted path in a JSON object (nullptr if absent).
-const nlohmann::json* json_at_path(const nlohmann::json& j, const std::string& dotted);
-/// Sets a value at a dotted path, creating objects on the way.
-void set_json_path(nlohmann::json& j, const std::string& dotted, const nlohmann::json& value);
 /// True if the cell's full config has every {dotted key: value} of `partial`.
 bool matches_assignment(const Cell& cell, const nlohmann::json& partial);
 

@@ -1,6 +1,6 @@
 #include "bench/timing_summary.h"
 
-#include "bench/experiment_config.h"
+#include "flows/json_path.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,6 +6,7 @@
 #include "flows/integrator.h"
 #include "flows/solver_registry.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 
@@ -238,6 +239,24 @@ std::string flow_options_markdown() {
           cell(option_default(o)) + " | " + cell(meaning) + " |\n";
   }
   return md;
+}
+
+const std::vector<std::string>& flow_config_keys() {
+  // The schema's keys (flows/config_schema.h) and the objects that hold them: every key a cell
+  // may set, whether or not result.json records it for the cell's solver.
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k;
+    for (const OptionSpec& o : flow_config_schema()) {
+      for (std::size_t dot = o.key.find('.'); dot != std::string::npos;
+           dot = o.key.find('.', dot + 1))
+        k.push_back(o.key.substr(0, dot));
+      k.push_back(o.key);
+    }
+    std::sort(k.begin(), k.end());
+    k.erase(std::unique(k.begin(), k.end()), k.end());
+    return k;
+  }();
+  return keys;
 }
 
 }  // namespace mcf

@@ -11,6 +11,11 @@
 
 namespace mcf {
 
+/// Every dotted key a flow config has and the objects that hold them ("mesh", "solver",
+/// "solver.cycles", ...): every key a cell may set, whether or not result.json records it for the
+/// cell's solver. Sorted.
+const std::vector<std::string>& flow_config_keys();
+
 /// The options in reading order: the config reader checks them in this order, so that of two bad
 /// keys the first here is the one an error names. Keys of one object ("solver") are contiguous.
 const std::vector<OptionSpec>& flow_config_schema();

@@ -422,7 +422,7 @@ TEST(Runner, ACellTooLargeForTheMemoryStopsTheRunBeforeAnythingIsWritten) {
       FAIL() << "shard " << shard << " ran";
     } catch (const MemoryLimitError& ex) {
       const std::string what = ex.what();
-      for (const std::string part :
+      for (const std::string& part :
            {"memory.json (cell " + std::to_string(shard), std::string("estimated"),
             "--max-memory " + std::string(budget)})
         EXPECT_NE(what.find(part), std::string::npos) << part << " in: " << what;

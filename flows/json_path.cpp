@@ -1,0 +1,30 @@
+#include "flows/json_path.h"
+
+namespace mcf {
+
+const nlohmann::json* json_at_path(const nlohmann::json& j, const std::string& dotted) {
+  const nlohmann::json* node = &j;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t dot = dotted.find('.', start);
+    const std::string part =
+        dotted.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    if (!node->is_object() || !node->contains(part)) return nullptr;
+    node = &node->at(part);
+    if (dot == std::string::npos) return node;
+    start = dot + 1;
+  }
+}
+
+void set_json_path(nlohmann::json& j, const std::string& dotted, const nlohmann::json& value) {
+  nlohmann::json* node = &j;
+  std::size_t start = 0;
+  for (std::size_t dot = dotted.find('.'); dot != std::string::npos;
+       dot = dotted.find('.', start)) {
+    node = &(*node)[dotted.substr(start, dot - start)];
+    start = dot + 1;
+  }
+  (*node)[dotted.substr(start)] = value;
+}
+
+}  // namespace mcf
