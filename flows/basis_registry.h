@@ -72,4 +72,10 @@ const TrackingRow& tracking_row(const std::string& name);
 /// The octree basis's options for a config; `analytic` shapes get the tight cube under "auto".
 OctreeOptions octree_options(const OctreeConfig& c, bool analytic);
 
+/// Fills in `octree.stabilization_weight` left to the solver (< 0) once the whole config is read,
+/// so that result.json records the weight that ran: the solver row's
+/// default_stabilization_weight where the system carries the term, else 0.5 (inert: the value
+/// such configs recorded before, so their config keys stay). A weight set stays.
+void resolve_stabilization_weight(FlowConfig& c);
+
 }  // namespace mcf

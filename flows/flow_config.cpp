@@ -31,6 +31,7 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   if (child) child->finish();
   top.finish();
   if (c.solver.tolerance < 0) c.solver.tolerance = solver_row(c.solver.name).default_tolerance;
+  resolve_stabilization_weight(c);
   validate_flow_config(c, source);
   return c;
 }

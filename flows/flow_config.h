@@ -21,8 +21,10 @@ struct OctreeConfig {
   /// band's normal-gradient term added, so that multigrid converges (docs/octree-multigrid.md,
   /// "Stabilization") | none: the paper's system.
   std::string stabilization = "normal-gradient";
-  /// c: the term's diagonal is c times the system's (ρ = c tr(a M + b K) / tr(S)).
-  double stabilization_weight = 0.5;
+  /// c: the term's diagonal is c times the system's (ρ = c tr(a M + b K) / tr(S)); -1 = the
+  /// solver's (0.5, which the multigrid cycles need; a direct solver's 1e-6, which only makes the
+  /// system definite), filled in when the config is read (resolve_stabilization_weight).
+  double stabilization_weight = -1;
 };
 
 struct SolverConfig {

@@ -33,6 +33,34 @@ TEST(FlowConfig, DefaultsFilledAndRoundTrip) {
   EXPECT_EQ(mg.solver.tolerance, 0.0);
 }
 
+// octree.stabilization_weight left out is the solver's, filled in when the config is read: the
+// cycles' 0.5 for the iterative solvers, 1e-6 (definite only) for the direct ones; a weight set
+// stays; where no term is added (the hat basis, the paper's system) the 0.5 recorded before the
+// weight became the solver's.
+TEST(FlowConfig, StabilizationWeightIsTheSolversUnlessSet) {
+  const auto weight = [](const json& j) {
+    return flow_config_from_json(j, "cfg.json").octree.stabilization_weight;
+  };
+  const auto octree = [](const json& solver, const json& options) {
+    return json{{"mesh", "x.off"}, {"basis", "octree"}, {"solver", solver}, {"octree", options}};
+  };
+  EXPECT_EQ(weight(octree(json::object(), json::object())), 1e-6);  // CHOLMOD, the default
+  EXPECT_EQ(weight(octree({{"name", "dense"}}, json::object())), 1e-6);
+  EXPECT_EQ(weight(octree({{"name", "multigrid"}}, json::object())), 0.5);
+  EXPECT_EQ(weight(octree({{"name", "pcg"}}, json::object())), 0.5);
+  EXPECT_EQ(weight(octree(json::object(), {{"stabilization_weight", 0.05}})), 0.05);
+  EXPECT_EQ(weight(octree({{"name", "multigrid"}}, {{"stabilization_weight", 0}})), 0.0);
+  EXPECT_EQ(weight(json{{"mesh", "x.off"}, {"basis", "hat"}}), 0.5);
+  EXPECT_EQ(weight(octree(json::object(), {{"stabilization", "none"}})), 0.5);
+  // What ran is what is recorded, and reading the record again changes nothing.
+  const FlowConfig c = flow_config_from_json(octree(json::object(), json::object()), "cfg.json");
+  EXPECT_EQ(to_json(c)["octree"]["stabilization_weight"], 1e-6);
+  EXPECT_EQ(to_json(flow_config_from_json(to_json(c), "again")), to_json(c));
+  EXPECT_NE(error_of(octree(json::object(), {{"stabilization_weight", -1}}))
+                .find("cfg.json: octree.stabilization_weight"),
+            std::string::npos);
+}
+
 TEST(FlowConfig, ErrorsNameFileAndKey) {
   EXPECT_NE(error_of(json::object()).find("cfg.json: mesh: missing"), std::string::npos);
   EXPECT_NE(error_of(json{{"mesh", "a"}, {"solver", {{"cycels", 2}}}})
