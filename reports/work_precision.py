@@ -21,6 +21,12 @@ import common
 # reaches.
 EPSILON_FACTORS = (1.1, 2.0, 10.0)
 
+# Families whose fastest point reaching a level is within this fraction of the winner's time are
+# named beside it as a tie: a setting's step time moved by 2% (median) and 8% (90th percentile)
+# between two full runs of the study on one machine (docs/studies.md), so a closer race is not
+# decided by one run.
+TIE = 0.10
+
 
 # ---------------------------------------------------------------------------------------------
 # Families and knobs, from the config alone
@@ -226,6 +232,49 @@ def describe(p):
     return p["family"] + (" " + p["knob"] if p["knob"] else "")
 
 
+def case_title(case, vertices):
+    kind, mesh, flow, dt = case
+    return "%s: %s, %s, dt %g, %s vertices" % (kind, mesh, flow, dt or 0, vertices)
+
+
+def panels_in_order(points):
+    """[(case, vertices, points)] per case and size: kind order (sphere, model, degenerating), then
+    flow and dt, then size."""
+    kinds = {"sphere": 0, "model": 1, "degenerating": 2}
+    by_case = common.group_by(points, lambda p: (p["case"], p["vertices"]))
+    return [(case, vertices, pts) for (case, vertices), pts in sorted(by_case.items(), key=lambda kv: (
+        kinds.get(kv[0][0][0], 3), str(kv[0][0][2:]), kv[0][1] or 0, kv[0][0][1]))]
+
+
+def tied_families(pts, error, epsilon, best):
+    """[(family, its time / best's)] of the other families whose fastest point reaching epsilon
+    is within TIE of `best`'s time, closest first."""
+    if not best:
+        return []
+    out = []
+    for family in {p["family"] for p in pts} - {best["family"]}:
+        q = fastest_within([p for p in pts if p["family"] == family], error, epsilon)
+        if q and q["time"] <= (1 + TIE) * best["time"]:
+            out.append((family, q["time"] / best["time"]))
+    return sorted(out, key=lambda fr: (fr[1], fr[0]))
+
+
+def error_levels(points):
+    """The rows of the tables "fastest setting to reach error <= eps": one dict per case and size,
+    error and level, {title, error, factor, epsilon, best (a point or None), ties (tied_families),
+    exact_time}."""
+    rows = []
+    for case, vertices, pts in panels_in_order(points):
+        exact_time = next((p["time"] for p in pts if is_exact_point(p["family"])), None)
+        for error in error_names(pts):
+            for factor, eps in zip(EPSILON_FACTORS, epsilons(pts, error)):
+                best = fastest_within(pts, error, eps)
+                rows.append({"title": case_title(case, vertices), "error": error, "factor": factor,
+                             "epsilon": eps, "best": best, "ties": tied_families(pts, error, eps, best),
+                             "exact_time": exact_time})
+    return rows
+
+
 def make(results, out_dir, reference, written):
     """Write work_precision.md, work_precision.png and work_precision_scaling.png."""
     points = points_of(results)
@@ -234,24 +283,21 @@ def make(results, out_dir, reference, written):
         common.warn("work_precision: no results")
         return
     colours, families = family_colours(points)
-    by_case = common.group_by(points, lambda p: (p["case"], p["vertices"]))
     panels, sections, stopped = [], [], []
-    # Cases in kind order (sphere, model, degenerating), then flow and dt, then size.
-    kinds = {"sphere": 0, "model": 1, "degenerating": 2}
-    for (case, vertices), pts in sorted(by_case.items(), key=lambda kv: (
-            kinds.get(kv[0][0][0], 3), str(kv[0][0][2:]), kv[0][1] or 0, kv[0][0][1])):
-        kind, mesh, flow, dt = case
-        title = "%s: %s, %s, dt %g, %s vertices" % (kind, mesh, flow, dt or 0, vertices)
+    levels = error_levels(points)
+    for case, vertices, pts in panels_in_order(points):
+        title = case_title(case, vertices)
         stopped += ["%s — %s: %s" % (title, describe(p), common.get(p["result"], "stop.reason", p["status"]))
                     for p in pts if p["status"] != "ok"]
-        exact_time = next((p["time"] for p in pts if is_exact_point(p["family"])), None)
         for error in error_names(pts):
             panels.append((title, pts, error))
             rows = []
-            for factor, eps in zip(EPSILON_FACTORS, epsilons(pts, error)):
-                best = fastest_within(pts, error, eps)
+            for level in (lv for lv in levels if lv["title"] == title and lv["error"] == error):
+                best, eps, factor, exact_time = level["best"], level["epsilon"], level["factor"], level["exact_time"]
+                tie = "; ".join("%s +%.0f%%" % (f, 100 * (r - 1)) for f, r in level["ties"])
                 rows.append(["%.3g (%gx exact)" % (eps, factor),
-                             describe(best) if best else "none reaches it",
+                             (describe(best) + (" (tie within %.0f%%: %s)" % (100 * TIE, tie) if tie else ""))
+                             if best else "none reaches it",
                              common.fmt(best["time"]) if best else "—",
                              common.fmt(best["time"] / exact_time, "%.2f") if best and common.finite(exact_time) else "—",
                              common.fmt(best["setup"]) if best else "—",

@@ -125,6 +125,52 @@ check(common.cell_identity("s", False, planned_cell)
       != common.cell_identity("s", False, dict(planned_cell, repetition=1)),
       "two repetitions of one cell are matched to each other")
 
+# 6. Two runs compared level by level (reports/work_precision_repeat.py): the same results agree
+# everywhere; a second run where CG overtakes two cycles is named at the levels both reach (1.1x
+# and 2x, of both errors) and nowhere else, with how close each race was.
+import work_precision_repeat as repeat  # noqa: E402
+
+
+def run_folder(folder, cg_time):
+    pcg = {"name": "pcg", "preconditioner": "jacobi", "tolerance": 1e-8}
+    rs = [fake(0, "hat", cg, 1.0, 1e-5), fake(1, "hat", mg(1), 0.2, 5e-5), fake(2, "hat", mg(2), 0.3, 1.05e-5),
+          fake(3, "hat", pcg, cg_time, 1.0e-5)]
+    for r in rs:
+        r["cell"]["study"] = "work_precision"
+        with open(os.path.join(folder, r["_stem"] + ".json"), "w") as f:
+            json.dump({k: v for k, v in r.items() if not k.startswith("_")}, f)
+
+
+with tempfile.TemporaryDirectory() as a, tempfile.TemporaryDirectory() as b, tempfile.TemporaryDirectory() as c:
+    run_folder(a, 0.4)
+    run_folder(b, 0.4)
+    run_folder(c, 0.25)
+    rows, same, tied = repeat.compare(repeat.levels_of(a), repeat.levels_of(b))
+    # Two errors (semi-implicit and continuous radial) x three levels.
+    check(same == tied == len(rows) == 6, "identical runs: %d of %d levels agree" % (same, len(rows)))
+    rows, same, tied = repeat.compare(repeat.levels_of(a), repeat.levels_of(c))
+    differ = [r for r in rows if r[5] != "yes"]
+    check(same == 2 and tied == 2 and len(differ) == 4 and all(r[5] == "**no**" for r in differ),
+          "CG faster in run C: %d agree, %d within the band, differing %s" % (same, tied, differ))
+    check(all(r[2] in ("1.1x exact", "2x exact") and r[3].startswith("hat MG V(2,2)")
+              and r[4].startswith("hat CG (jacobi)") for r in differ), "the differing levels: %s" % differ)
+    # In A, CG reaches the level in 0.4 s against two cycles' 0.3 s; in C two cycles take 0.3 s
+    # against CG's 0.25 s.
+    check(all(r[6] == "1.33" and r[7] == "1.20" for r in differ), "race ratios: %s" % differ)
+    check(repeat.main([a, c, "--require-same"]) == 1 and repeat.main([a, b, "--require-same"]) == 0,
+          "--require-same exit status")
+    # Within the tie band (CG 5% slower than two cycles in run D) the differing levels are ties, and
+    # the report's table names the runner-up beside the winner.
+    d = os.path.join(c, "d")
+    os.mkdir(d)
+    run_folder(d, 0.315)
+    rows, same, tied = repeat.compare(repeat.levels_of(c), repeat.levels_of(d))
+    check(same == 2 and tied == 6 and sum(r[5] == "tie" for r in rows) == 4,
+          "a 5%% race: %d agree, %d within the band: %s" % (same, tied, rows))
+    level = next(lv for lv in repeat.levels_of(d).values() if lv["factor"] == 1.1)
+    check([f for f, _ in level["ties"]] == ["hat CG (jacobi)"] and abs(level["ties"][0][1] - 1.05) < 1e-9,
+          "ties at 1.1x: %s" % level["ties"])
+
 if failures:
     print("FAIL:\n  " + "\n  ".join(failures))
     sys.exit(1)
