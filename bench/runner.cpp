@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 #include <sstream>
@@ -286,6 +287,8 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
     json result;  // the cell's result as read, completed below
   };
   std::vector<Pending> work;
+  // Whether each reference's own flow succeeded: read once, though many cells share it.
+  std::map<const CellPlan*, bool> reference_ok;
   for (const CellPlan& p : plans) {
     if (!in_shard(p.cell.index, o.shard_index, o.shard_count)) continue;
     if (const int signal = stop_requested()) throw Interrupt{signal};
@@ -302,8 +305,12 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
     const bool stale =
         ran_now.count(p.hash) || ran_now.count(ref->hash) || !result.contains("reference_distance");
     if (!stale || result.value("status", "") == "error") continue;
-    const json ref_result = read_json_file(ref->file);
-    if (ref_result.value("status", "") == "error") continue;
+    const auto known = reference_ok.find(ref);
+    const bool ok = known != reference_ok.end()
+                        ? known->second
+                        : reference_ok[ref] =
+                              read_json_file(ref->file).value("status", "") != "error";
+    if (!ok) continue;
     work.push_back({&p, ref, std::move(result)});
   }
   // A large reference makes each frame's distance slow: the progress says how far they are.
