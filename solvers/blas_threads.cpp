@@ -8,12 +8,14 @@ int openblas_get_num_threads(void);
 
 namespace mcf {
 
+// CHOLMOD sets its count around every factorization and solve (each time step): where the count
+// is already the one asked for, OpenBLAS is not called.
 ScopedBlasThreads::ScopedBlasThreads(int threads) : previous_(openblas_get_num_threads()) {
-  if (threads > 0) openblas_set_num_threads(threads);
+  if (threads > 0 && threads != previous_) openblas_set_num_threads(threads);
 }
 
 ScopedBlasThreads::~ScopedBlasThreads() {
-  openblas_set_num_threads(previous_);
+  if (openblas_get_num_threads() != previous_) openblas_set_num_threads(previous_);
 }
 
 int blas_threads() {
