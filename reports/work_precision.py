@@ -246,6 +246,11 @@ def panels_in_order(points):
         kinds.get(kv[0][0][0], 3), str(kv[0][0][2:]), kv[0][1] or 0, kv[0][0][1]))]
 
 
+def fastest_of_family(pts, family, error, epsilon):
+    """The fastest uncontended point of `family` whose error is at most epsilon (None if none)."""
+    return fastest_within([p for p in pts if p["family"] == family], error, epsilon)
+
+
 def tied_families(pts, error, epsilon, best):
     """[(family, its time / best's)] of the other families whose fastest point reaching epsilon
     is within TIE of `best`'s time, closest first."""
@@ -253,7 +258,7 @@ def tied_families(pts, error, epsilon, best):
         return []
     out = []
     for family in {p["family"] for p in pts} - {best["family"]}:
-        q = fastest_within([p for p in pts if p["family"] == family], error, epsilon)
+        q = fastest_of_family(pts, family, error, epsilon)
         if q and q["time"] <= (1 + TIE) * best["time"]:
             out.append((family, q["time"] / best["time"]))
     return sorted(out, key=lambda fr: (fr[1], fr[0]))
@@ -262,7 +267,7 @@ def tied_families(pts, error, epsilon, best):
 def error_levels(points):
     """The rows of the tables "fastest setting to reach error <= eps": one dict per case and size,
     error and level, {title, error, factor, epsilon, best (a point or None), ties (tied_families),
-    exact_time}."""
+    exact_time, points (the case's and size's)}."""
     rows = []
     for case, vertices, pts in panels_in_order(points):
         exact_time = next((p["time"] for p in pts if is_exact_point(p["family"])), None)
@@ -271,7 +276,7 @@ def error_levels(points):
                 best = fastest_within(pts, error, eps)
                 rows.append({"title": case_title(case, vertices), "error": error, "factor": factor,
                              "epsilon": eps, "best": best, "ties": tied_families(pts, error, eps, best),
-                             "exact_time": exact_time})
+                             "exact_time": exact_time, "points": pts})
     return rows
 
 

@@ -28,15 +28,12 @@ STUDY = "work_precision"
 def levels_of(folder):
     """{(title, error, factor): level} of the study's results in `folder` (error_levels' rows)."""
     results = [r for r in common.load_results(folder) if common.study_of(r) == STUDY]
-    points = wp.points_of(results)
-    return {(lv["title"], lv["error"], lv["factor"]): dict(lv, points=points) for lv in wp.error_levels(points)}
+    return {(lv["title"], lv["error"], lv["factor"]): lv for lv in wp.error_levels(wp.points_of(results))}
 
 
 def family_time(level, family):
     """The time the fastest point of `family` needs to reach the level's error, or None."""
-    pts = [p for p in level["points"] if p["family"] == family and (p["case"], p["vertices"]) == (
-        level["best"]["case"], level["best"]["vertices"])] if level["best"] else []
-    best = wp.fastest_within(pts, level["error"], level["epsilon"])
+    best = wp.fastest_of_family(level["points"], family, level["error"], level["epsilon"])
     return best["time"] if best else None
 
 
