@@ -91,7 +91,10 @@ nlohmann::json environment_json(int threads, int blas_threads) {
          v(NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH)},
         {"blas", "openblas"}}}};
   // A run slowed on purpose says so (flows/planted_slowdown.h); the key is absent otherwise.
-  if (const double f = planted_slowdown(); f > 0) env["planted_slowdown"] = f;
+  if (const double f = planted_slowdown(); f > 0) {
+    env["planted_slowdown"] = f;
+    env["planted_phase"] = to_string(planted_phase());
+  }
   return env;
 }
 

@@ -11,9 +11,9 @@ namespace mcf {
 /// {"commit", "cpu", "cores", "threads", "blas_threads", "hostname", "libraries": {...},
 /// "build": {...}}. "threads" is the parallelism the flow had: the request (0 = all) capped at the
 /// cores TBB uses; "blas_threads" the OpenBLAS threads it ran CHOLMOD with (result
-/// "solver_settings.blas_threads"), the same as "threads" where not given; "planted_slowdown" only
-/// when $MCFBENCH_PLANTED_SLOWDOWN slowed the steps on purpose (flows/planted_slowdown.h; throws as
-/// that does on a malformed value).
+/// "solver_settings.blas_threads"), the same as "threads" where not given; "planted_slowdown" and
+/// "planted_phase" only when $MCFBENCH_PLANTED_SLOWDOWN slowed the steps or their updates on
+/// purpose (flows/planted_slowdown.h; throws as that does on a malformed value).
 nlohmann::json environment_json(int threads, int blas_threads = 0);
 /// environment_json for a result that may hold "solver_settings.blas_threads".
 nlohmann::json environment_json(int threads, const nlohmann::json& result);

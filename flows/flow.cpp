@@ -87,6 +87,7 @@ class FlowStepContext final : public StepContext {
     const auto t0 = Clock::now();
     const bool first = !assembled_;
     basis_.update(X, !flow_.keeps_mass || first, !flow_.keeps_stiffness || first);
+    plant_slowdown(PlantedPhase::update, t0);  // a no-op unless planted there
     assembled_ = true;
     tally_.update_seconds += seconds_since(t0);
   }
@@ -320,6 +321,7 @@ void FlowRun::begin_step(int step) {
   if (step > 1) {
     basis_->rebuild(V_);
     ctx_->rebuilt();
+    plant_slowdown(PlantedPhase::update, t0);  // a rebuild is this basis's update
   }
   x_ = basis_->initial_coefficients();
   has_prev_ = false;
@@ -456,7 +458,7 @@ bool FlowRun::advance(int step) {
   }
   x_ = std::move(x_new);  // for a one-step scheme this frees X_{n-1}
   V_ = std::move(V_new);
-  plant_slowdown(step_start);  // a no-op unless $MCFBENCH_PLANTED_SLOWDOWN is set
+  plant_slowdown(PlantedPhase::step, step_start);  // a no-op unless planted there
   record["seconds"] = {{"update", ctx_->tally().update_seconds},
                        {"solve", ctx_->tally().solve_seconds},
                        {"evaluate", evaluate_seconds},

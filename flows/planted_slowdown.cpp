@@ -19,6 +19,14 @@ double parse_planted_slowdown() {
   return f;
 }
 
+PlantedPhase parse_planted_phase() {
+  const char* text = std::getenv("MCFBENCH_PLANTED_PHASE");
+  if (!text || !*text || std::string(text) == "step") return PlantedPhase::step;
+  if (std::string(text) == "update") return PlantedPhase::update;
+  throw std::invalid_argument(std::string("MCFBENCH_PLANTED_PHASE=") + text +
+                              ": expected step or update");
+}
+
 }  // namespace
 
 double planted_slowdown() {
@@ -26,13 +34,22 @@ double planted_slowdown() {
   return f;
 }
 
-void plant_slowdown(std::chrono::steady_clock::time_point step_start) {
+PlantedPhase planted_phase() {
+  static const PlantedPhase p = parse_planted_phase();
+  return p;
+}
+
+const char* to_string(PlantedPhase phase) {
+  return phase == PlantedPhase::update ? "update" : "step";
+}
+
+void plant_slowdown(PlantedPhase phase, std::chrono::steady_clock::time_point start) {
   const double f = planted_slowdown();
-  if (f <= 0) return;
+  if (f <= 0 || phase != planted_phase()) return;
   using Clock = std::chrono::steady_clock;
-  const auto worked = Clock::now() - step_start;
-  const auto until = step_start + worked + std::chrono::duration_cast<Clock::duration>(worked * f);
-  // A busy wait, not a sleep: the delay is held on a core as the step's own work is, and a
+  const auto worked = Clock::now() - start;
+  const auto until = start + worked + std::chrono::duration_cast<Clock::duration>(worked * f);
+  // A busy wait, not a sleep: the delay is held on a core as the phase's own work is, and a
   // sleep's wake-up on a loaded machine would add its own noise.
   while (Clock::now() < until) {
   }

@@ -5,9 +5,11 @@
 #   A/A: $AA_TRIALS gate runs (default 20) of COMMIT against itself; a "regression" is a false
 #        alarm (the target: none in at least 19 of 20).
 #   A/B: $AB_TRIALS gate runs (default 5) of COMMIT against itself with a slowdown of
-#        $PLANTED_SLOWDOWN (default 0.3) planted in every step of the head side only
-#        ($MCFBENCH_PLANTED_SLOWDOWN, flows/planted_slowdown.h, recorded in each result.json and
-#        checked here); each should say "regression".
+#        $PLANTED_SLOWDOWN (default 0.3) planted in $PLANTED_PHASE (default update: the octree's
+#        update, or rebuild, and the hat basis's assembly; `step`: the whole step) of the head
+#        side only ($MCFBENCH_PLANTED_SLOWDOWN and $MCFBENCH_PLANTED_PHASE,
+#        flows/planted_slowdown.h, recorded in each result.json and checked here); each should
+#        say "regression".
 # Each gate run alternates the two sides over $MCFBENCH_GATE_ROUNDS rounds (default 5), as the
 # gate does. Prints a table of the verdicts (pass, regression, inconclusive: the machine was
 # shared, error) and whether the targets were met; exits 0 when every trial gave a verdict, 1
@@ -23,8 +25,9 @@ commit=$(git -C "$repo" rev-parse "${2:-HEAD}^{commit}")
 aa=${AA_TRIALS:-20}
 ab=${AB_TRIALS:-5}
 planted=${PLANTED_SLOWDOWN:-0.3}
+phase=${PLANTED_PHASE:-update}
 out=$(realpath -m "${AA_AB_OUT:-out/history-aa-ab}")
-unset MCFBENCH_PLANTED_SLOWDOWN  # only the A/B head side is slowed, by the runner below
+unset MCFBENCH_PLANTED_SLOWDOWN MCFBENCH_PLANTED_PHASE  # only the A/B head side is slowed, by the runner below
 rm -rf "$out"
 mkdir -p "$out"
 
@@ -33,7 +36,9 @@ runner=${MCFBENCH_GATE_RUNNER:-bash $root/scripts/history_runner.sh}
 cat >"$out/planted_runner.sh" <<RUNNER
 #!/usr/bin/env bash
 # history ab's runner for the A/B trials: the head side runs with a planted slowdown.
-if [ "\${MCFBENCH_HISTORY_SIDE:-}" = head ]; then export MCFBENCH_PLANTED_SLOWDOWN=$planted; fi
+if [ "\${MCFBENCH_HISTORY_SIDE:-}" = head ]; then
+  export MCFBENCH_PLANTED_SLOWDOWN=$planted MCFBENCH_PLANTED_PHASE=$phase
+fi
 exec $runner "\$@"
 RUNNER
 
@@ -44,12 +49,13 @@ verdict() {
 
 # planted_ok DIR: every head result records the plant and no base result does.
 planted_ok() {
-  /usr/bin/python3 - "$1" "$planted" <<'PY'
+  /usr/bin/python3 - "$1" "$planted" "$phase" <<'PY'
 import glob, json, sys
-d, f = sys.argv[1], float(sys.argv[2])
+d, f, phase = sys.argv[1], float(sys.argv[2]), sys.argv[3]
 head = [json.load(open(p)) for p in glob.glob(d + "/head/*.json")]
 base = [json.load(open(p)) for p in glob.glob(d + "/base/*.json")]
-ok = head and all(r.get("environment", {}).get("planted_slowdown") == f for r in head) and \
+ok = head and all(r.get("environment", {}).get("planted_slowdown") == f and
+                  r.get("environment", {}).get("planted_phase") == phase for r in head) and \
     not any(r.get("environment", {}).get("planted_slowdown") for r in base)
 sys.exit(0 if ok else 1)
 PY
@@ -86,7 +92,7 @@ echo
 echo "| experiment | trials | pass | regression | inconclusive | error |"
 echo "|---|---|---|---|---|---|"
 echo "| A/A (the same commit twice) | $aa | $(c aa.pass) | $(c aa.regression) (false alarms) | $(c aa.inconclusive) | $(c aa.error) |"
-echo "| A/B (head +$planted planted per step) | $ab | $(c ab.pass) | $(c ab.regression) (caught) | $(c ab.inconclusive) | $(c ab.error) |"
+echo "| A/B (head +$planted planted in each $phase) | $ab | $(c ab.pass) | $(c ab.regression) (caught) | $(c ab.inconclusive) | $(c ab.error) |"
 echo
 aa_ok=no; ab_ok=no
 # At most one false alarm in 20 (scaled to the trials run); every planted slowdown caught.

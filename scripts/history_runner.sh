@@ -2,8 +2,8 @@
 # The default runner of scripts/history.sh: `history_runner.sh CONFIG OUT`, run in a git
 # worktree checked out at the commit to measure. Builds that commit's mcfbench (Release) into a
 # build folder kept per commit under $MCFBENCH_HISTORY_BUILDS (default
-# ~/.cache/mcfbench-history/<commit>), so a commit is built once however often it is measured,
-# then runs CONFIG's --quick variant with $MCFBENCH_HISTORY_REPETITIONS repetitions (default 5)
+# ~/.cache/mcfbench-history/<commit>; scripts/history_build.sh), so a commit is built once however
+# often it is measured, then runs CONFIG's --quick variant with $MCFBENCH_HISTORY_REPETITIONS repetitions (default 5)
 # into OUT. The config is the caller's file, not the commit's, so every commit runs the same
 # cells.
 set -euo pipefail
@@ -14,13 +14,7 @@ builds=${MCFBENCH_HISTORY_BUILDS:-${XDG_CACHE_HOME:-$HOME/.cache}/mcfbench-histo
 build=$builds/$commit
 reps=${MCFBENCH_HISTORY_REPETITIONS:-5}
 if [ ! -x "$build/mcfbench" ]; then
-  generator=()
-  if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
-  # A half-built folder from a killed build is reconfigured from scratch: its cache names a
-  # worktree that no longer exists.
-  rm -rf "$build"
-  cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release >&2
-  cmake --build "$build" --parallel "${MCFBENCH_JOBS:-$(nproc)}" --target mcfbench >&2
+  bash "$(dirname "$0")/history_build.sh" "$build" mcfbench
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

@@ -19,6 +19,7 @@ TEST(PlantedSlowdown, StepsLastOnePlusFTimesTheirWorkAndTheResultSaysSo) {
   ASSERT_EQ(c.status, 0) << c.err;
   const nlohmann::json r = read_json(dir / "slowed" / "result.json");
   EXPECT_EQ(r["environment"]["planted_slowdown"], 1.0);
+  EXPECT_EQ(r["environment"]["planted_phase"], "step");
   ASSERT_EQ(r["steps"].size(), 3u);
   for (const auto& s : r["steps"]) {
     // The phases are timed inside the step's own work, which the delay then doubles: an
@@ -32,6 +33,21 @@ TEST(PlantedSlowdown, StepsLastOnePlusFTimesTheirWorkAndTheResultSaysSo) {
                "MCFBENCH_PLANTED_SLOWDOWN=lots ");
   EXPECT_NE(c.status, 0);
   EXPECT_NE(c.err.find("MCFBENCH_PLANTED_SLOWDOWN=lots"), std::string::npos) << c.err;
+}
+
+TEST(PlantedSlowdown, PlantedInTheUpdateTheResultNamesThePhase) {
+  const fs::path dir = fresh_dir("planted_update");
+  Command c = mcfbench("flow --mesh icosphere:level=2 --steps 2 --out slowed", dir,
+                       "MCFBENCH_PLANTED_SLOWDOWN=0.5 MCFBENCH_PLANTED_PHASE=update ");
+  ASSERT_EQ(c.status, 0) << c.err;
+  const nlohmann::json r = read_json(dir / "slowed" / "result.json");
+  EXPECT_EQ(r["environment"]["planted_slowdown"], 0.5);
+  EXPECT_EQ(r["environment"]["planted_phase"], "update");
+  c = mcfbench("flow --mesh icosphere:level=2 --steps 2 --out bad", dir,
+               "MCFBENCH_PLANTED_SLOWDOWN=0.5 MCFBENCH_PLANTED_PHASE=solve ");
+  EXPECT_NE(c.status, 0);
+  EXPECT_NE(c.err.find("MCFBENCH_PLANTED_PHASE=solve"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(dir / "bad" / "result.json"));
 }
 
 }  // namespace
