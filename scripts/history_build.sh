@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `history_build.sh BUILD TARGET...`: builds TARGETs (Release) of the commit checked out in the
-# current folder (a history worktree) and copies the executables into the folder BUILD, for the
+# current folder (a history worktree) and copies the executables into the folder BUILD (beside
+# any others there), for the
 # history runners (scripts/history_runner.sh, scripts/history_micro_runner.sh).
 # The compilation happens in one build slot per repository, kept beside BUILD's parent
 # ($builds/slot-<repository hash>/: a git worktree of the repository and its build folder), moved
@@ -35,8 +36,9 @@ if [ ! -f "$slot/build/CMakeCache.txt" ]; then
 fi
 cmake --build "$slot/build" --parallel "${MCFBENCH_JOBS:-$(nproc)}" --target "$@" >&2
 # The executables are linked statically against the project's own libraries: copied, they run
-# after the slot has moved on.
-rm -rf "$build"
-mkdir -p "$build.tmp"
-for t in "$@"; do cp "$slot/build/$t" "$build.tmp/$t"; done
-mv "$build.tmp" "$build"
+# after the slot has moved on. Each lands whole or not at all (a runner takes a present one).
+mkdir -p "$build"
+for t in "$@"; do
+  cp "$slot/build/$t" "$build/$t.tmp"
+  mv "$build/$t.tmp" "$build/$t"
+done
