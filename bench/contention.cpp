@@ -35,9 +35,11 @@ CpuCounters read_cpu_counters() {
     std::string line;
     if (std::getline(in, line)) {
       double busy = 0, steal = 0;
-      if (parse_proc_stat_cpu(line, ::sysconf(_SC_CLK_TCK), busy, steal)) {
+      const long hz = ::sysconf(_SC_CLK_TCK);
+      if (parse_proc_stat_cpu(line, hz, busy, steal)) {
         c.busy = busy;
         c.steal = steal;
+        c.tick = 1.0 / double(hz);
       }
     }
   }
@@ -62,12 +64,14 @@ nlohmann::json contention_json(const CpuCounters& before, const CpuCounters& aft
   if (before.load1 >= 0 && after.load1 >= 0) j["load_average"] = {before.load1, after.load1};
   bool contended = false;
   std::string reason;
+  // The counters of all CPUs each round to a tick: less than that is no evidence.
+  const double resolution = std::max(before.tick, after.tick) * std::max(cores, 1);
   if (wall > 0 && before.busy >= 0 && after.busy >= 0 && before.own >= 0 && after.own >= 0) {
     // The kernel's busy time and this process's CPU time tick at different granularities: the
     // difference is clamped at zero.
     const double other = std::max(0.0, (after.busy - before.busy) - (after.own - before.own));
     j["other_cores"] = other / wall;
-    if (other / wall > kContendedOtherCores) {
+    if (other > kContendedOtherCores * wall + resolution) {
       contended = true;
       char text[96];
       std::snprintf(text, sizeof text, "other processes used %.2f cores", other / wall);
@@ -75,9 +79,10 @@ nlohmann::json contention_json(const CpuCounters& before, const CpuCounters& aft
     }
   }
   if (wall > 0 && before.steal >= 0 && after.steal >= 0) {
-    const double steal = (after.steal - before.steal) / wall;
+    const double stolen = after.steal - before.steal;
+    const double steal = stolen / wall;
     j["steal_cores"] = steal;
-    if (steal > kContendedStealCores) {
+    if (stolen > kContendedStealCores * wall + resolution) {
       char text[96];
       std::snprintf(text, sizeof text, "the hypervisor took %.2f cores", steal);
       reason += (reason.empty() ? "" : "; ") + std::string(text);

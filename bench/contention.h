@@ -18,6 +18,9 @@ struct CpuCounters {
       -1;  ///< user + system time of this process (all its threads) and its waited-for children
   double wall = 0;    ///< a monotonic clock
   double load1 = -1;  ///< /proc/loadavg's one-minute load average
+  /// The resolution of busy and steal: one tick of /proc/stat's clock per CPU (1/CLK_TCK s); 0
+  /// for exact counters.
+  double tick = 0;
 };
 
 /// The fields of /proc/stat's aggregate `cpu` line `text` at `ticks_per_second`: busy and steal
@@ -29,6 +32,8 @@ CpuCounters read_cpu_counters();
 
 /// A contended measurement: other processes used more than this many cores on average, or the
 /// hypervisor took more than this fraction of one core. A quiet guest's daemons use about 0.01.
+/// Either must also exceed what the counters can resolve, one tick per CPU: in a cell of 0.17 s a
+/// single 10 ms tick of steal reads as 0.06 cores, a rounding of the counter, not a measurement.
 inline constexpr double kContendedOtherCores = 0.2;
 inline constexpr double kContendedStealCores = 0.05;
 

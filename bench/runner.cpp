@@ -306,10 +306,10 @@ int add_reference_distances(const ExperimentConfig& e, const RunOptions& o,
         ran_now.count(p.hash) || ran_now.count(ref->hash) || !result.contains("reference_distance");
     if (!stale || result.value("status", "") == "error") continue;
     const auto known = reference_ok.find(ref);
-    const bool ok = known != reference_ok.end()
-                        ? known->second
-                        : reference_ok[ref] =
-                              read_json_file(ref->file).value("status", "") != "error";
+    const bool ok =
+        known != reference_ok.end()
+            ? known->second
+            : (reference_ok[ref] = read_json_file(ref->file).value("status", "") != "error");
     if (!ok) continue;
     work.push_back({&p, ref, std::move(result)});
   }

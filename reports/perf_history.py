@@ -45,6 +45,9 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_RUNNER = os.path.join(ROOT, "scripts", "history_runner.sh")
+# The runner of micro-benchmark configs (a JSON object with a "micro" key): it leaves
+# mcfbench_micro's JSON as OUT/micro.json.
+MICRO_RUNNER = os.path.join(ROOT, "scripts", "history_micro_runner.sh")
 IDENTITY_KEYS = ("cpu", "cores", "threads", "blas_threads", "build", "libraries")
 
 
@@ -456,6 +459,26 @@ def config_name_of(config):
     return os.path.splitext(os.path.basename(config))[0]
 
 
+def is_micro_config(config):
+    """A config of micro-benchmarks (benchmarks/configs/micro_quick.json): a JSON object with a
+    "micro" key, run by mcfbench_micro rather than `mcfbench run`."""
+    try:
+        with open(config) as f:
+            c = json.load(f)
+    except (OSError, ValueError):
+        return False  # the runner reports what is wrong with it
+    return isinstance(c, dict) and "micro" in c
+
+
+def store_run_output(store, config_name, out, info):
+    """Stores what a runner left in `out`: mcfbench_micro's OUT/micro.json, else the cell results
+    of `mcfbench run`."""
+    micro = os.path.join(out, "micro.json")
+    if os.path.isfile(micro):
+        return store_micro_set(store, config_name, micro, info)
+    return store_result_set(store, config_name, out, info)
+
+
 class RunnerFailed(Exception):
     pass
 
@@ -583,7 +606,7 @@ def measure(args, commit, state, log):
     print("history: running %s" % commit[:12], file=sys.stderr)
     work, out = run_commit(args, commit, log)
     try:
-        e = store_result_set(args.store, name, out, commit_info(args.repo, commit))
+        e = store_run_output(args.store, name, out, commit_info(args.repo, commit))
     finally:
         shutil.rmtree(work, ignore_errors=True)
     state["machine"] = e["machine"]
@@ -954,8 +977,10 @@ def dispatch(argv):
                        help="commits a level needs on each side of a step (default 2)")
 
     def runner(p):
-        p.add_argument("--runner", default="bash " + shlex_quote(DEFAULT_RUNNER),
-                       help="command run in a commit's worktree as `RUNNER CONFIG OUT`")
+        p.add_argument("--runner", default="",
+                       help="command run in a commit's worktree as `RUNNER CONFIG OUT` "
+                       "(default scripts/history_runner.sh, for a micro-benchmark config "
+                       "scripts/history_micro_runner.sh)")
         p.add_argument("--repetitions", type=int, default=5,
                        help="repetitions of each cell (default 5)")
         p.add_argument("--machine", default="",
@@ -1020,6 +1045,12 @@ def dispatch(argv):
         except subprocess.CalledProcessError:
             if args.command in ("run", "add", "bisect"):
                 fail("%s: not a git repository" % args.repo)
+    if getattr(args, "runner", None) == "":
+        micro = is_micro_config(args.config)
+        if micro and args.command == "ab":
+            fail("%s: ab compares result sets of `mcfbench run` (mcfbench compare); two builds' "
+                 "micro-benchmarks compare with Google Benchmark's compare.py" % args.config)
+        args.runner = "bash " + shlex_quote(MICRO_RUNNER if micro else DEFAULT_RUNNER)
     return {"run": cmd_run, "add": cmd_add, "detect": cmd_detect, "bisect": cmd_bisect,
             "ab": cmd_ab, "publish": cmd_publish}[args.command](args)
 

@@ -492,7 +492,6 @@ struct MultigridSolver::Impl {
       w.seconds += since(t0);
       return;
     }
-    Level& F = levels[std::size_t(l)];
     Level& C = levels[std::size_t(l) - 1];
     for (int i = 0; i < opt.pre_smooth; ++i) sweep(l, false);
     residual(l);

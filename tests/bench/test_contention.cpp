@@ -35,6 +35,16 @@ TEST(Contention, OtherProcessesTimeMarksACell) {
   EXPECT_NE(busy["reason"].get<std::string>().find("0.90 cores"), std::string::npos);
   // The hypervisor took a tenth of a core.
   EXPECT_TRUE(contention_json(at(0, 0, 0, 0), at(10, 10, 10, 1), 2)["contended"].get<bool>());
+  // A short cell: one 10 ms tick of steal or of other work on each of 2 CPUs in 0.17 s is the
+  // counters' rounding, not evidence (0.06 and 0.12 cores read); five ticks are.
+  CpuCounters b = at(0, 100, 10, 5), e = at(0.17, 100.34, 10.32, 5.01);
+  b.tick = e.tick = 0.01;
+  EXPECT_FALSE(contention_json(b, e, 2)["contended"].get<bool>()) << contention_json(b, e, 2);
+  e.steal = 5.05;
+  EXPECT_TRUE(contention_json(b, e, 2)["contended"].get<bool>());
+  e.steal = 5.01;
+  e.busy = 100.40;  // 0.08 s of others: 0.47 cores
+  EXPECT_TRUE(contention_json(b, e, 2)["contended"].get<bool>());
   // Unknown counters never mark a cell.
   EXPECT_FALSE(contention_json(at(0, -1, -1, -1), at(10, -1, -1, -1), 2)["contended"].get<bool>());
 }

@@ -6,7 +6,9 @@ $MCFBENCH_HISTORY_REPETITIONS repetitions and a deterministic +-1% jitter drawn 
 and repetition, and appends the commit to $FAKE_RUNNER_LOG, so a test counts the runs. A commit
 whose tree holds broken.txt fails as one that does not build would (exit 3, after logging the
 run); with $FAKE_RUNNER_CONTENDED=1 every repetition says it shared the machine; with
-$FAKE_RUNNER_HEAD_THREADS=N the head side of `history ab` ($MCFBENCH_HISTORY_SIDE) ran N threads."""
+$FAKE_RUNNER_HEAD_THREADS=N the head side of `history ab` ($MCFBENCH_HISTORY_SIDE) ran N threads.
+For a micro-benchmark config (a "micro" key, as scripts/history_micro_runner.sh takes) it leaves
+mcfbench_micro's JSON as OUT/micro.json instead: BM_Slowed (speed.txt, in ms) and BM_Steady."""
 
 import hashlib
 import json
@@ -32,6 +34,18 @@ if os.environ.get("MCFBENCH_HISTORY_SIDE") == "head" and os.environ.get("FAKE_RU
     threads = int(os.environ["FAKE_RUNNER_HEAD_THREADS"])
 env = {"commit": commit[:12], "cpu": cpu, "cores": os.cpu_count(), "threads": threads,
        "blas_threads": 2, "build": {"type": "Release", "compiler": "fake"}, "hostname": "h"}
+if "micro" in json.load(open(config)):
+    rows = []
+    for name, base in (("BM_Slowed", speed), ("BM_Steady", 1.0)):
+        for r in range(reps):
+            h = int(hashlib.sha1(("%s/%s/%d" % (commit, name, r)).encode()).hexdigest()[:8], 16)
+            rows.append({"name": name, "run_name": name, "run_type": "iteration",
+                         "repetitions": reps, "repetition_index": r, "iterations": 5,
+                         "real_time": base * (1 + 0.02 * (h / 0xFFFFFFFF - 0.5)),
+                         "cpu_time": base, "time_unit": "ms"})
+    with open(os.path.join(out, "micro.json"), "w") as f:
+        json.dump({"context": {"mcfbench_environment": json.dumps(env)}, "benchmarks": rows}, f)
+    sys.exit(0)
 for cell, base in (("slowed", speed), ("steady", 1.0)):
     for r in range(reps):
         h = int(hashlib.sha1(("%s/%s/%d" % (commit, cell, r)).encode()).hexdigest()[:8], 16)

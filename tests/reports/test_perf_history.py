@@ -334,6 +334,28 @@ def test_micro(work):
     steps = json.load(open(os.path.join(work, "micro_steps.json")))
     check([(s["benchmark"], s["commit"]) for s in steps] == [("BM_Step/8", commits[4])],
           "detect finds the micro step at its commit")
+    # `run` over commits with a micro-benchmark config: the runner's OUT/micro.json is stored
+    # one benchmark per run name, and `detect` finds the planted commit.
+    config = os.path.join(work, "micro_fake.json")
+    with open(config, "w") as f:
+        json.dump({"micro": {"benchmark_filter": "BM_"}}, f)
+    tool(work, "run", config, "--last", "16", "--store", "store_micro_run", "--repetitions", "3",
+         "--repo", repo, "--runner", RUNNER)
+    check(runs(work) == 16, "run --last 16 of a micro config ran 16 commits")
+    series = ph.load_store(os.path.join(work, "store_micro_run"))
+    entries = series.get((list(series)[0][0], "micro_fake"), []) if series else []
+    check(len(entries) == 16 and
+          sorted(entries[0]["benchmarks"]) == ["BM_Slowed", "BM_Steady"] and
+          len(entries[0]["benchmarks"]["BM_Slowed"]["samples"]) == 3 and
+          entries[0]["metric"] == "real_time",
+          "a micro config's runs are stored as mcfbench_micro's benchmarks, a sample a repetition")
+    tool(work, "detect", "--store", "store_micro_run", "--json", "micro_run_steps.json")
+    steps = json.load(open(os.path.join(work, "micro_run_steps.json")))
+    check([(s["benchmark"], s["commit"]) for s in steps] == [("BM_Slowed", commits[PLANTED])],
+          "detect finds the planted commit in a micro config's run")
+    r = tool(work, "ab", config, commits[0], commits[1], "--out", "ab_micro", "--repo", repo,
+             expect=2)
+    check("compare.py" in r.stderr, "ab refuses a micro config, naming what compares those")
     micro_json(path, commits[3], {"BM_Step/8": 1.0}, planted=0.3)
     r = tool(work, "add", "micro", path, "--store", "store_micro", "--repo", repo, expect=2)
     check("planted slowdown" in r.stderr, "a run with a planted slowdown is not stored")

@@ -2,13 +2,18 @@
 # benchmarks/run_micro.sh feeds the history store: one short micro-benchmark (STREAM copy on a
 # 1 MB array) is run, kept under the binary's commit and stored as the series (machine, micro)
 # with one sample per repetition; a binary built from uncommitted code keeps its file and is
-# not stored (a history holds commits).
+# not stored (a history holds commits). The filter of benchmarks/configs/micro_quick.json (the
+# history's quick micro-benchmarks) names exactly the seven benchmarks it describes.
 # usage: test_run_micro.sh MCFBENCH_MICRO
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+filter=$(/usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["micro"]["benchmark_filter"])' \
+  "$root/benchmarks/configs/micro_quick.json")
+n=$("$bin" --benchmark_list_tests --benchmark_filter="$filter" | wc -l)
+[ "$n" = 7 ] || { "$bin" --benchmark_list_tests --benchmark_filter="$filter"; echo "FAIL: micro_quick.json's filter names $n benchmarks, not 7"; exit 1; }
 MCFBENCH_BUILD=$(dirname "$bin") MCFBENCH_MICRO_OUT=$work/micro MCFBENCH_HISTORY_STORE=$work/store \
   MCFBENCH_STREAM_MB=1 bash "$root/benchmarks/run_micro.sh" --benchmark_filter='BM_StreamCopy/1/' \
   --benchmark_repetitions=3 --benchmark_min_time=0.01 >"$work/log" 2>&1 \
