@@ -888,6 +888,29 @@ addEventListener('load', function () {
 </script>"""
 
 
+def study_reports(args):
+    """The reports the page links: --report PATHs, else the repository's own (docs/studies.md,
+    which answers each study, and the reports of full runs kept under benchmarks/results/)."""
+    if args.report:
+        return args.report
+    found = [os.path.join(args.repo, "docs", "studies.md")]
+    found += sorted(os.path.join(d, f)
+                    for d, _, files in os.walk(os.path.join(args.repo, "benchmarks", "results"))
+                    for f in files if f.endswith(".md"))
+    return [p for p in found if os.path.isfile(p)]
+
+
+def report_links(args):
+    """<li> items linking each study report, relative to the page (the page stays offline)."""
+    items = []
+    for path in study_reports(args):
+        href = os.path.relpath(os.path.abspath(path), os.path.abspath(args.out))
+        label = os.path.relpath(os.path.abspath(path), args.repo) \
+            if os.path.abspath(path).startswith(os.path.abspath(args.repo) + os.sep) else path
+        items.append('<li><a href="%s">%s</a></li>' % (html.escape(href), html.escape(label)))
+    return "\n".join(items) or "<li>none given (--report PATH)</li>"
+
+
 def cmd_publish(args):
     series = load_store(args.store)
     os.makedirs(args.out, exist_ok=True)
@@ -938,11 +961,15 @@ commit</th><th>change</th><th>confidence</th></tr>
 %s
 </table>
 <p>%d regressions, %d charts.</p>
+<h2>Study reports</h2>
+<ul id="reports">
+%s
+</ul>
 %s
 %s
 </body></html>
-""" % (html.escape(args.store), rows, len(regressions), charts, "\n".join(sections),
-       RENDER_CHECK)
+""" % (html.escape(args.store), rows, len(regressions), charts, report_links(args),
+       "\n".join(sections), RENDER_CHECK)
     with open(os.path.join(args.out, "index.html"), "w") as f:
         f.write(page)
     print("wrote %s (%d charts, %d regressions)" % (os.path.join(args.out, "index.html"), charts,
@@ -1036,6 +1063,9 @@ def dispatch(argv):
     runner(p)
     p = sub.add_parser("publish", help="write OUT/index.html")
     p.add_argument("out")
+    p.add_argument("--report", action="append", default=[],
+                   help="a study report to link (repeatable; default: the repository's "
+                   "docs/studies.md and the Markdown reports under benchmarks/results/)")
     common(p)
     detector(p)
     args = ap.parse_args(argv)

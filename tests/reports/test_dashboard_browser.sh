@@ -2,8 +2,8 @@
 # The history dashboard in a real browser (ctest `history_dashboard`): a store of 12 commits
 # with a 30% slowdown planted at the eighth is published, headless Chromium loads the page
 # offline and its DOM must report both charts laid out (the page's own check writes
-# data-charts-rendered on <body>) and list the planted commit as a regression; a screenshot
-# must come out. Exit 77 (skipped) when chromium is absent and cannot be installed.
+# data-charts-rendered on <body>) and list the planted commit as a regression and link the study
+# report given; a screenshot must come out. Exit 77 (skipped) when chromium is absent and cannot be installed.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 browser=$(command -v chromium || command -v chromium-browser || true)
@@ -38,7 +38,10 @@ for i in range(12):
     if i == 7:
         open(os.path.join(store, "planted"), "w").write(c[:12])
 PY
-/usr/bin/python3 "$root/reports/perf_history.py" publish "$work/site" --store "$work/store" >/dev/null
+mkdir -p "$work/report"
+echo "# fake study" >"$work/report/index.md"
+/usr/bin/python3 "$root/reports/perf_history.py" publish "$work/site" --store "$work/store" \
+  --report "$work/report/index.md" >/dev/null
 planted=$(cat "$work/store/planted")
 
 flags=(--headless --no-sandbox --disable-gpu --no-first-run --disable-extensions
@@ -49,6 +52,8 @@ fail=0
 grep -q 'data-charts-rendered="2"' "$work/dom.html" || { echo "FAIL: the DOM does not report 2 charts rendered"; grep -o '<body[^>]*>' "$work/dom.html"; fail=1; }
 sed -n '/id="regressions"/,/<\/table>/p' "$work/dom.html" | grep -q "<code>$planted</code>" \
   || { echo "FAIL: the regressions list lacks the planted commit $planted"; fail=1; }
+sed -n '/id="reports"/,/<\/ul>/p' "$work/dom.html" | grep -q 'href="../report/index.md"' \
+  || { echo "FAIL: the study report is not linked"; fail=1; }
 timeout 60 "$browser" "${flags[@]}" --screenshot="$work/shot.png" --window-size=1200,900 "file://$work/site/index.html" >/dev/null 2>&1 || true
 [ "$(stat -c %s "$work/shot.png" 2>/dev/null || echo 0)" -gt 10000 ] || { echo "FAIL: no screenshot"; fail=1; }
 [ $fail = 0 ] && echo "ok: dashboard rendered in $browser, regression $planted listed"
