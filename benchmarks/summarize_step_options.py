@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The table of benchmarks/configs/hat_step_options.json's results (docs/benchmarks.md, "Floors"):
+"""The table of benchmarks/configs/hat_step_options.json's (or galerkin_refresh.json's) results (docs/benchmarks.md, "Floors"):
 per flow and setting, the median over the interleaved repetitions of each repetition's median step
 (steps 2 on), its ratio to CHOLMOD's, the Galerkin refresh's share (set-up of the system per step),
 and the RMS distance of the last frame to the CHOLMOD flow's (the mesh in the unit cube).
@@ -18,8 +18,13 @@ def setting(r):
     if s.get("name") == "cholmod":
         return "CHOLMOD"
     name = "%s(%s,%s) x%s" % (s.get("cycle"), s.get("smooth"), s.get("smooth"), s.get("cycles"))
+    if s.get("name") == "pcg":
+        name = "CG + %s(%s,%s) to %g" % (s.get("cycle"), s.get("smooth"), s.get("smooth"),
+                                        s.get("tolerance"))
+    refresh = s.get("galerkin_refresh", 1) or 1
     extras = [e for e, on in (("by term", s.get("galerkin_by_term")),
-                              ("mixed", s.get("precision") == "mixed")) if on]
+                              ("mixed", s.get("precision") == "mixed"),
+                              ("coarse every %d" % refresh, refresh > 1)) if on]
     return name + (", " + ", ".join(extras) if extras else "")
 
 

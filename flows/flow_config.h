@@ -47,6 +47,9 @@ struct SolverConfig {
   /// multigrid: double | mixed (the finest sweeps in single precision inside a double-precision
   /// residual correction; MultigridOptions::mixed_precision).
   std::string precision = "double";
+  /// multigrid: recompute the coarse operators on every k-th set_matrix of a pattern only
+  /// (MultigridOptions::galerkin_refresh); 1 = every step.
+  int galerkin_refresh = 1;
   /// petsc: PETSc options ("-pc_type hypre -pc_hypre_type boomeramg") over the defaults (CG +
   /// GAMG, solvers/petsc_solver.h), kept verbatim in result.json.
   std::string petsc_options;

@@ -183,8 +183,16 @@ std::vector<OptionSpec> shared_options() {
     return std::vector<Choice>{{"double", "every sweep in double precision"},
                                {"mixed", "the finest sweeps read a single-precision copy"}};
   };
+  OptionSpec refresh = multigrid_option(
+      ranged(bind(
+                 option("solver.galerkin_refresh", OptionType::integer, 1, "--galerkin-refresh",
+                        "Multigrid: recompute the coarse operators on every k-th step only (the "
+                        "finest level, hence the solution, stays exact; the coarse corrections use "
+                        "operators up to k - 1 steps old)"),
+                 [](auto& c) -> auto& { return c.solver.galerkin_refresh; }),
+             1, 1000));
   return {name,   tolerance, max_iterations, preconditioner, cycle,
-          cycles, smooth,    by_term,        precision};
+          cycles, smooth,    by_term,        precision,      refresh};
 }
 
 NamedTable<SolverRow>& table() {
@@ -225,6 +233,7 @@ MultigridOptions multigrid_options(const SolverConfig& c) {
   o.tolerance = c.tolerance;
   o.galerkin_by_term = c.galerkin_by_term;
   o.mixed_precision = c.precision == "mixed";
+  o.galerkin_refresh = c.galerkin_refresh;
   return o;
 }
 

@@ -28,6 +28,7 @@ args=(ab "$config" "$base" "$head" --repo "$repo"
       --out "${MCFBENCH_GATE_OUT:-out/perf-gate}")
 [ -n "${MCFBENCH_GATE_RUNNER:-}" ] && args+=(--runner "$MCFBENCH_GATE_RUNNER")
 [ -n "${MCFBENCH_GATE_COMPARE:-}" ] && args+=(--compare "$MCFBENCH_GATE_COMPARE")
+for m in ${MCFBENCH_GATE_METRICS:-seconds.total seconds.update seconds.solve}; do args+=(--metric "$m"); done
 echo "perf_gate: $(git -C "$repo" rev-parse --short=12 "$base") (base) against $(git -C "$repo" rev-parse --short=12 "$head")" >&2
 status=0
 /usr/bin/python3 "$root/reports/perf_history.py" "${args[@]}" || status=$?

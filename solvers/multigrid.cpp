@@ -125,6 +125,11 @@ struct MultigridSolver::Impl {
   bool ready = false;
   bool fine_single = false;  // the finest level's sweeps read single precision (mixed_precision)
   std::int64_t symbolic_builds = 0, numeric_builds = 0, pattern_comparisons = 0;
+  // galerkin_refresh: set_matrix calls since the coarse operators were last computed, and how
+  // many calls in all kept them; the coarsest level's note (semi-definite) of that computation.
+  int calls_since_refresh = 0;
+  std::int64_t lagged_refreshes = 0;
+  std::string coarse_note;
   std::int64_t term_products = 0;
   // galerkin_by_term: the number of terms the levels' `terms` hold (0: none kept) and which of
   // them changed in this call.
@@ -306,8 +311,9 @@ struct MultigridSolver::Impl {
   /// Returns false when a diagonal entry is negative or not finite.
   /// With `by_term` (the sum's terms set by set_fine_terms), coarse levels are refreshed by
   /// term (coarse_by_term).
-  bool numeric(const MatrixSum* by_term) {
-    for (std::size_t l = levels.size() - 1; l-- > 0;) {
+  /// With `coarse` false (a lagged refresh), only the finest level's diagonal and smoother.
+  bool numeric(const MatrixSum* by_term, bool coarse = true) {
+    for (std::size_t l = levels.size() - 1; coarse && l-- > 0;) {
       Level& C = levels[l];
       if (by_term)
         coarse_by_term(l, *by_term);
@@ -316,7 +322,8 @@ struct MultigridSolver::Impl {
                         C.spa);
     }
     bool ok = true;
-    for (auto& L : levels) {
+    for (std::size_t l = coarse ? 0 : levels.size() - 1; l < levels.size(); ++l) {
+      Level& L = levels[l];
       const Csc A(L.A);
       L.inv_diag.assign(std::size_t(L.n()), 0.0);
       for (int i = 0; i < L.n(); ++i) {
@@ -327,7 +334,7 @@ struct MultigridSolver::Impl {
       }
       smoother_values(L.smoother, L.A, L.diag_pos);
     }
-    ++numeric_builds;
+    if (coarse) ++numeric_builds;
     return ok;
   }
 
@@ -634,6 +641,10 @@ std::int64_t MultigridSolver::symbolic_builds() const {
 std::int64_t MultigridSolver::numeric_builds() const {
   return impl_->numeric_builds;
 }
+
+std::int64_t MultigridSolver::lagged_refreshes() const {
+  return impl_->lagged_refreshes;
+}
 std::int64_t MultigridSolver::term_products() const {
   return impl_->term_products;
 }
@@ -660,6 +671,7 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
                                         HierarchyView hierarchy) {
   SolveReport rep;
   Impl& m = *impl_;
+  const bool was_ready = m.ready;
   m.ready = false;
   auto fail = [&](SolveStatus st, std::string msg) {
     rep.status = st;
@@ -718,7 +730,24 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
   else
     m.drop_terms();
   m.pattern_key = key;
-  const bool diag_ok = m.numeric(by_term ? sum : nullptr);
+  // galerkin_refresh: keep the coarse operators of an earlier successful call on this pattern.
+  // `ready` was true before this call exactly when that call succeeded (it is reset above).
+  const bool lagged = !need_symbolic && !by_term && m.levels.size() > 1 && was_ready &&
+                      options_.galerkin_refresh > 1 &&
+                      m.calls_since_refresh + 1 < options_.galerkin_refresh;
+  const bool diag_ok = m.numeric(by_term ? sum : nullptr, !lagged);
+  if (lagged) {
+    ++m.calls_since_refresh;
+    ++m.lagged_refreshes;
+    if (!diag_ok)
+      return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
+    rep.message = m.coarse_note;
+    m.ready = true;
+    rep.iterations = 0;
+    return rep;
+  }
+  m.calls_since_refresh = 0;
+  m.coarse_note.clear();
 
   if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);
   m.ldlt.factorize(m.levels.front().A);
@@ -740,6 +769,7 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
     if (!m.levels[l].coloured)
       rep.message += (rep.message.empty() ? "" : "; ") + std::string("level ") + std::to_string(l) +
                      " uses serial Gauss-Seidel (no valid colouring)";
+  m.coarse_note = rep.message;  // what a lagged call repeats
   m.ready = true;
   rep.iterations = 0;
   return rep;

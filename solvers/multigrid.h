@@ -111,6 +111,14 @@ struct MultigridOptions {
   /// x += e. The fixed point is the solution of A x = b, as in double precision; only the
   /// contraction per cycle may change. precondition() is a cycle from zero anyway.
   bool mixed_precision = false;
+  /// Lagged Galerkin refresh: with k > 1, a set_matrix on the pattern already set up recomputes
+  /// the coarse operators (Galerkin products, coarsest factorization) only on every k-th call;
+  /// in between only the finest level takes the new values. The finest residual, sweeps and
+  /// hence the solution the cycles converge to are exact; only the coarse correction uses
+  /// operators up to k - 1 calls old (still symmetric positive definite, so the cycle stays a
+  /// valid preconditioner), which may cost contraction per cycle. A new pattern, a failed call,
+  /// galerkin_by_term or a single level always refreshes. 1: every call (the default).
+  int galerkin_refresh = 1;
 };
 
 const char* to_string(MultigridCycle c);
@@ -168,6 +176,8 @@ class MultigridSolver : public LinearSolver {
   std::vector<int> relaxation_blocks(int l) const;
   std::int64_t symbolic_builds() const;  ///< how often the Galerkin pattern was built
   std::int64_t numeric_builds() const;   ///< how often coarse values were computed
+  /// How many set_matrix calls kept the coarse operators of an earlier call (galerkin_refresh).
+  std::int64_t lagged_refreshes() const;
   /// How many Galerkin products of one term on one level galerkin_by_term has computed (a refresh
   /// of a sum of two terms on L levels computes 2 (L - 1) when both changed, L - 1 when one did).
   std::int64_t term_products() const;

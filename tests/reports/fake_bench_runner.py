@@ -6,7 +6,8 @@ $MCFBENCH_HISTORY_REPETITIONS repetitions and a deterministic +-1% jitter drawn 
 and repetition, and appends the commit to $FAKE_RUNNER_LOG, so a test counts the runs. A commit
 whose tree holds broken.txt fails as one that does not build would (exit 3, after logging the
 run); with $FAKE_RUNNER_CONTENDED=1 every repetition says it shared the machine; with
-$FAKE_RUNNER_HEAD_THREADS=N the head side of `history ab` ($MCFBENCH_HISTORY_SIDE) ran N threads.
+$FAKE_RUNNER_HEAD_THREADS=N the head side of `history ab` ($MCFBENCH_HISTORY_SIDE) ran N threads;
+with $FAKE_RUNNER_PHASE=update the slowdown is in the steps' update phase alone.
 For a micro-benchmark config (a "micro" key, as scripts/history_micro_runner.sh takes) it leaves
 mcfbench_micro's JSON as OUT/micro.json instead: BM_Slowed (speed.txt, in ms) and BM_Steady."""
 
@@ -50,8 +51,16 @@ for cell, base in (("slowed", speed), ("steady", 1.0)):
     for r in range(reps):
         h = int(hashlib.sha1(("%s/%s/%d" % (commit, cell, r)).encode()).hexdigest()[:8], 16)
         v = base * (1 + 0.02 * (h / 0xFFFFFFFF - 0.5))
-        steps = [{"step": 1, "seconds": {"total": 3 * v}}] + [
-            {"step": s, "seconds": {"total": v}} for s in range(2, 5)]
+        # The phases: an update of a fifth of the step and a solve of the rest; with
+        # $FAKE_RUNNER_PHASE=update only the update is slowed (the step by a fifth as much).
+        if os.environ.get("FAKE_RUNNER_PHASE") == "update":
+            update, solve = 0.2 * v, 0.8 * (v / base)
+        else:
+            update, solve = 0.2 * v, 0.8 * v
+        v = update + solve
+        steps = [{"step": 1, "seconds": {"total": 3 * v, "update": 3 * update, "solve": 3 * solve}}]
+        steps += [{"step": s, "seconds": {"total": v, "update": update, "solve": solve}}
+                  for s in range(2, 5)]
         res = {"schema": 1, "status": "ok", "stop": {"step": 4, "reason": "completed"},
                "environment": env,
                "cell": {"key": "%s-%d" % (cell, r), "config_key": cell, "repetition": r,

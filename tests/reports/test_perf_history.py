@@ -239,6 +239,17 @@ def test_repository(work, mcfbench):
               "perf_gate.sh fails on the slowdown (exit %d)" % gate.returncode)
         if gate.returncode != 1:
             print(gate.stdout + gate.stderr)
+        # A slowdown of one phase (the update, a fifth of the step: +6% of the step) passes a
+        # gate on the step alone and fails one that compares the phases too.
+        tool(work, "ab", config, commits[0], commits[-1], "--rounds", "5", "--out", "ab_phase",
+             *common, *cmp, expect=0, env={"FAKE_RUNNER_PHASE": "update"})
+        r = tool(work, "ab", config, commits[0], commits[-1], "--rounds", "5", "--out",
+                 "ab_phase_metrics", *common, *cmp, "--metric", "seconds.total", "--metric",
+                 "seconds.update", expect=1, env={"FAKE_RUNNER_PHASE": "update"})
+        check("## seconds.update" in r.stdout and
+              "slower" in r.stdout.split("## seconds.update")[1],
+              "ab with --metric seconds.update finds the slower update")
+        runs(work)
         # Repetitions that shared the machine make the answer inconclusive, not a regression.
         r = tool(work, "ab", config, commits[0], commits[-1], "--rounds", "5", "--out",
                  "ab_contended", *common, *cmp, expect=3, env={"FAKE_RUNNER_CONTENDED": "1"})

@@ -459,6 +459,72 @@ TEST(Multigrid, GalerkinByTermRefreshesOnlyChangedTermsAndMatchesTheSum) {
   EXPECT_EQ(by_term.term_products() - before, two);
 }
 
+// galerkin_refresh = 3: of a sequence of sums on one pattern, only calls 1, 4, 7 recompute the
+// coarse operators; the others keep them (the coarse level of call 2 equals call 1's bitwise)
+// while the finest level takes the new values, so solving to a tolerance gives the direct
+// solution of each call's own matrix. A new pattern refreshes at once.
+TEST(Multigrid, LaggedGalerkinRefreshKeepsCoarseOperatorsAndConvergesToTheNewMatrix) {
+  const Problem pm = make_problem(4, 1, 0.0, Drop::shell);
+  const Problem pk = make_problem(4, 1, 1.0, Drop::shell);
+  const SparseMatrix &M = pm.A, &K = pk.A;
+  const Eigen::MatrixXd B = random_matrix(M.rows(), 3, 7);
+  MultigridOptions o;
+  o.cycles = 100;
+  o.tolerance = 1e-10;
+  o.galerkin_refresh = 3;
+  MultigridSolver mg(o);
+  const int coarse = int(pm.P.size());
+  SparseMatrix first_coarse;
+  for (int call = 0; call < 7; ++call) {
+    SCOPED_TRACE(call);
+    SparseMatrix Mc = M;  // the mass of step `call`: other values on the same pattern
+    for (Eigen::Index p = 0; p < Mc.nonZeros(); ++p)
+      Mc.valuePtr()[p] *= 1.0 + 0.2 * std::sin(double(p + call));
+    Mc = SparseMatrix(0.5 * (Mc + SparseMatrix(Mc.transpose())));
+    const mcf::MatrixSum sum(1.0, Mc, 0.05, K);
+    ASSERT_TRUE(mg.set_matrix_sum(sum, pm.view()).ok());
+    EXPECT_EQ(mg.numeric_builds(), 1 + call / 3);
+    EXPECT_EQ(mg.lagged_refreshes(), call - call / 3);
+    const SparseMatrix A = SparseMatrix(Mc + 0.05 * K);
+    EXPECT_LE(SparseMatrix(mg.level_matrix(coarse) - A).norm(), 1e-14 * A.norm());
+    if (call == 0) first_coarse = mg.level_matrix(coarse - 1);
+    if (call == 1) {
+      EXPECT_TRUE(same_values(mg.level_matrix(coarse - 1), first_coarse));
+    }
+    Eigen::MatrixXd X;
+    const mcf::SolveReport r = mg.solve(B, X);
+    ASSERT_TRUE(r.ok()) << r.message;
+    Eigen::SimplicialLDLT<SparseMatrix> direct(A);
+    EXPECT_LE((X - direct.solve(B)).norm(), 1e-8 * X.norm());
+  }
+  // The same matrix set again: a lagged call's coarse operators are the refreshed ones, so two
+  // cycles give bitwise the result of a solver that refreshes every call.
+  {
+    MultigridOptions two = o;
+    two.cycles = 2;
+    two.tolerance = 0;
+    MultigridOptions every = two;
+    every.galerkin_refresh = 1;
+    MultigridSolver lagging(two), refreshing(every);
+    const mcf::MatrixSum sum(1.0, M, 0.05, K);
+    for (int call = 0; call < 3; ++call) {
+      ASSERT_TRUE(lagging.set_matrix_sum(sum, pm.view()).ok());
+      ASSERT_TRUE(refreshing.set_matrix_sum(sum, pm.view()).ok());
+      Eigen::MatrixXd X1, X2;
+      ASSERT_TRUE(lagging.solve(B, X1).ok());
+      ASSERT_TRUE(refreshing.solve(B, X2).ok());
+      EXPECT_EQ((X1 - X2).norm(), 0.0) << call;
+    }
+    EXPECT_EQ(lagging.lagged_refreshes(), 2);
+  }
+  // Another pattern: the coarse operators are set up anew whatever the count.
+  const std::int64_t builds = mg.numeric_builds();
+  const Problem other = make_problem(5, 2, 1e-2, Drop::shell);
+  ASSERT_TRUE(mg.set_matrix(other.A, other.view()).ok());
+  ASSERT_TRUE(mg.set_matrix(M, pm.view()).ok());
+  EXPECT_EQ(mg.numeric_builds(), builds + 2);
+}
+
 // mixed_precision: single-precision finest sweeps inside a double-precision residual correction
 // converge to the solution of A x = b (a relative residual of 1e-11 and the direct solution), where
 // rounded finest sweeps without the correction would stall near 1e-8.
