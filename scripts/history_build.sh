@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# `history_build.sh BUILD TARGET...`: builds TARGETs (Release) of the commit checked out in the
-# current folder (a history worktree) and copies the executables into the folder BUILD (beside
-# any others there), for the
-# history runners (scripts/history_runner.sh, scripts/history_micro_runner.sh).
-# The compilation happens in one build slot per repository, kept beside BUILD's parent
+# `history_build.sh TARGET...`: the executables TARGET... (Release) of the commit checked out in
+# the current folder (a history worktree), for the history runners (scripts/history_runner.sh,
+# scripts/history_micro_runner.sh). Prints the folder that holds them,
+# $MCFBENCH_HISTORY_BUILDS/<commit> (default ~/.cache/mcfbench-history/<commit>), building those
+# not there yet: a commit is built once however often it is measured.
+# The compilation happens in one build slot per repository, kept beside those folders
 # ($builds/slot-<repository hash>/: a git worktree of the repository and its build folder), moved
 # to each commit with `git checkout`, which rewrites only the files that differ: ninja then
 # recompiles only what those files touch, so a run over consecutive commits costs a few
@@ -12,11 +13,17 @@
 # in use, so two history runs on one machine take turns. A slot whose folder is deleted is
 # forgotten by `git worktree prune`. $MCFBENCH_JOBS: parallel jobs (default: the cores).
 set -euo pipefail
-build=$1
-shift
 commit=$(git rev-parse HEAD)
+builds=$(realpath -m "${MCFBENCH_HISTORY_BUILDS:-${XDG_CACHE_HOME:-$HOME/.cache}/mcfbench-history}")
+build=$builds/$commit
+missing=()
+for t in "$@"; do [ -x "$build/$t" ] || missing+=("$t"); done
+if [ ${#missing[@]} = 0 ]; then
+  echo "$build"
+  exit 0
+fi
+set -- "${missing[@]}"
 common=$(cd "$(git rev-parse --git-common-dir)" && pwd)
-builds=$(dirname "$(realpath -m "$build")")
 slot=$builds/slot-$(printf '%s' "$common" | sha1sum | cut -c1-12)
 mkdir -p "$builds"
 exec 9>"$slot.lock"
@@ -42,3 +49,4 @@ for t in "$@"; do
   cp "$slot/build/$t" "$build/$t.tmp"
   mv "$build/$t.tmp" "$build/$t"
 done
+echo "$build"

@@ -12,13 +12,8 @@
 set -euo pipefail
 config=$1
 out=$2
-commit=${MCFBENCH_HISTORY_COMMIT:-$(git rev-parse HEAD)}
-builds=${MCFBENCH_HISTORY_BUILDS:-${XDG_CACHE_HOME:-$HOME/.cache}/mcfbench-history}
-build=$builds/$commit
 reps=${MCFBENCH_HISTORY_REPETITIONS:-5}
-if [ ! -x "$build/mcfbench_micro" ]; then
-  bash "$(dirname "$0")/history_build.sh" "$build" mcfbench_micro
-fi
+build=$(bash "$(dirname "$0")/history_build.sh" mcfbench_micro)
 # The config's settings as shell words: the filter, then NAME=VALUE pairs for env.
 mapfile -t settings < <(/usr/bin/python3 - "$config" <<'PY'
 import json, sys

@@ -9,13 +9,8 @@
 set -euo pipefail
 config=$1
 out=$2
-commit=${MCFBENCH_HISTORY_COMMIT:-$(git rev-parse HEAD)}
-builds=${MCFBENCH_HISTORY_BUILDS:-${XDG_CACHE_HOME:-$HOME/.cache}/mcfbench-history}
-build=$builds/$commit
 reps=${MCFBENCH_HISTORY_REPETITIONS:-5}
-if [ ! -x "$build/mcfbench" ]; then
-  bash "$(dirname "$0")/history_build.sh" "$build" mcfbench
-fi
+build=$(bash "$(dirname "$0")/history_build.sh" mcfbench)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # Same cells as the config's quick variant, with the repetitions asked for.

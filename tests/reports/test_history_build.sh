@@ -30,8 +30,9 @@ two=$(git rev-parse HEAD)
 builds=$work/builds
 for c in "$one" "$two"; do
   git worktree add -q --detach "$work/wt-$c" "$c"
-  (cd "$work/wt-$c" && bash "$root/scripts/history_build.sh" "$builds/$c" answer) 2>"$work/log-$c" ||
+  folder=$(cd "$work/wt-$c" && MCFBENCH_HISTORY_BUILDS=$builds bash "$root/scripts/history_build.sh" answer 2>"$work/log-$c") ||
     { cat "$work/log-$c"; echo "FAIL: history_build.sh at $c"; exit 1; }
+  [ "$folder" = "$builds/$c" ] || { echo "FAIL: history_build.sh printed $folder, not $builds/$c"; exit 1; }
   git worktree remove --force "$work/wt-$c"
 done
 fail=0
@@ -44,5 +45,10 @@ if grep -q "main.cpp" "$work/log-$two" || ! grep -q "value.cpp" "$work/log-$two"
   fail=1
 fi
 [ "$(ls -d "$builds"/slot-* | grep -vc '\.lock$')" = 1 ] || { echo "FAIL: one slot per repository"; fail=1; }
+# A commit already built is not built again.
+git worktree add -q --detach "$work/wt-again" "$one"
+(cd "$work/wt-again" && MCFBENCH_HISTORY_BUILDS=$builds bash "$root/scripts/history_build.sh" answer >/dev/null 2>"$work/log-again")
+git worktree remove --force "$work/wt-again"
+[ ! -s "$work/log-again" ] || { cat "$work/log-again"; echo "FAIL: a built commit was built again"; fail=1; }
 [ $fail = 0 ] && echo "ok: each commit's own executable; the second build recompiled the changed file only"
 exit $fail
