@@ -85,7 +85,9 @@ TEST(FlowOptions, HelpListsEveryFlagOfTheSchema) {
   ASSERT_EQ(mcfbench("flow --help", help), 0);
   const std::string text = text_of(help);
   for (const OptionSpec& o : flow_config_schema()) {
-    if (!o.flag.empty()) EXPECT_NE(text.find(o.flag + " "), std::string::npos) << o.flag;
+    if (!o.flag.empty()) {
+      EXPECT_NE(text.find(o.flag + " "), std::string::npos) << o.flag;
+    }
   }
   // The example solver's row reaches the help of the binary it is built into.
   EXPECT_NE(text.find("damped-jacobi"), std::string::npos);
