@@ -76,6 +76,32 @@ void BM_CholmodRefactorizeSolve(benchmark::State& state) {
 }
 BENCHMARK(BM_CholmodRefactorizeSolve)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The yardstick of the surface hierarchy's build: CHOLMOD's symbolic analysis of the same mesh
+// (fill-reducing ordering and supernodal structure), timed as a fresh factorization (Arg 1: a
+// new solver each time) less a refactorization on the analysed pattern (Arg 0).
+void BM_CholmodAnalyzeFactorize(benchmark::State& state) {
+  auto& f = HatFixture::get();
+  const bool fresh = state.range(0) == 1;
+  CholmodSolver kept;
+  kept.set_matrix(f.system);
+  for (auto _ : state) {
+    if (fresh) {
+      CholmodSolver solver;
+      solver.set_matrix(f.system);
+      benchmark::DoNotOptimize(solver.factor_nonzeros());
+    } else {
+      kept.set_matrix(f.system);
+    }
+  }
+  label(state, f);
+}
+BENCHMARK(BM_CholmodAnalyzeFactorize)
+    ->ArgName("fresh")
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 void BM_PcgSolve(benchmark::State& state) {
   auto& f = HatFixture::get();
   PcgOptions o;
