@@ -1,5 +1,7 @@
 #include "bases/surface_hierarchy.h"
 
+#include "core/undirected_graph.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,20 +23,7 @@ struct LevelMesh {
 
 /// CSR of the undirected graph of `pairs` (each given once or twice) on n vertices.
 void build_graph(int n, std::vector<std::pair<int, int>>& pairs, LevelMesh& level) {
-  std::vector<std::pair<int, int>> both;
-  both.reserve(2 * pairs.size());
-  for (const auto& [a, b] : pairs) {
-    if (a == b) continue;
-    both.emplace_back(a, b);
-    both.emplace_back(b, a);
-  }
-  std::sort(both.begin(), both.end());
-  both.erase(std::unique(both.begin(), both.end()), both.end());
-  level.start.assign(std::size_t(n) + 1, 0);
-  for (const auto& e : both) ++level.start[std::size_t(e.first) + 1];
-  for (int v = 0; v < n; ++v) level.start[std::size_t(v) + 1] += level.start[std::size_t(v)];
-  level.neighbour.resize(both.size());
-  for (std::size_t k = 0; k < both.size(); ++k) level.neighbour[k] = both[k].second;
+  undirected_graph(n, pairs, level.start, level.neighbour);
 }
 
 LevelMesh finest_level(const Positions& vertices, const Triangles& faces) {

@@ -1,5 +1,7 @@
 #include "bases/vertex_ordering.h"
 
+#include "core/undirected_graph.h"
+
 #include <algorithm>
 
 namespace mcf {
@@ -12,21 +14,11 @@ struct Graph {
 
 Graph vertex_graph(const Triangles& faces, int n) {
   std::vector<std::pair<int, int>> e;
-  e.reserve(std::size_t(6 * faces.rows()));
+  e.reserve(std::size_t(3 * faces.rows()));
   for (Eigen::Index f = 0; f < faces.rows(); ++f)
-    for (int c = 0; c < 3; ++c) {
-      const int a = faces(f, c), b = faces(f, (c + 1) % 3);
-      e.emplace_back(a, b);
-      e.emplace_back(b, a);
-    }
-  std::sort(e.begin(), e.end());
-  e.erase(std::unique(e.begin(), e.end()), e.end());
+    for (int c = 0; c < 3; ++c) e.emplace_back(faces(f, c), faces(f, (c + 1) % 3));
   Graph g;
-  g.start.assign(std::size_t(n) + 1, 0);
-  for (const auto& p : e) ++g.start[std::size_t(p.first) + 1];
-  for (int v = 0; v < n; ++v) g.start[std::size_t(v) + 1] += g.start[std::size_t(v)];
-  g.neighbour.resize(e.size());
-  for (std::size_t k = 0; k < e.size(); ++k) g.neighbour[k] = e[k].second;
+  undirected_graph(n, e, g.start, g.neighbour);
   return g;
 }
 
