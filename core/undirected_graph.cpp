@@ -6,8 +6,8 @@
 
 namespace mcf {
 
-void undirected_graph(int n, const std::vector<std::pair<int, int>>& pairs,
-                      std::vector<int>& start, std::vector<int>& neighbour) {
+void undirected_graph(int n, const std::vector<std::pair<int, int>>& pairs, std::vector<int>& start,
+                      std::vector<int>& neighbour) {
   const auto N = std::size_t(n);
   // Every pair in both directions, bucketed by its first vertex (duplicates still in).
   std::vector<int> first(N + 1, 0);

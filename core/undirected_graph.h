@@ -17,7 +17,7 @@ namespace mcf {
 /// The same arrays as sorting every directed pair and removing duplicates, in linear time: one
 /// counting pass, then a sort of each vertex's few neighbours, in parallel over vertices
 /// (deterministic: no vertex's output depends on another's).
-void undirected_graph(int n, const std::vector<std::pair<int, int>>& pairs,
-                      std::vector<int>& start, std::vector<int>& neighbour);
+void undirected_graph(int n, const std::vector<std::pair<int, int>>& pairs, std::vector<int>& start,
+                      std::vector<int>& neighbour);
 
 }  // namespace mcf

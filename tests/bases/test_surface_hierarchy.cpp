@@ -11,6 +11,7 @@
 #include "test_meshes.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -166,10 +167,15 @@ TEST(SurfaceHierarchy, ColouringsAreValidOnTheGalerkinPatterns) {
   EXPECT_GE(coloured, 1);
 }
 
+// The same hierarchy twice, and on one thread as on all (the prolongation rows are found in
+// parallel).
 TEST(SurfaceHierarchy, TheBuildIsDeterministic) {
   const TriangleMesh m = load_mesh_spec("dumbbell").mesh;
   const SurfaceHierarchy a = build_surface_hierarchy(m.vertices, m.faces, {300, 16});
-  const SurfaceHierarchy b = build_surface_hierarchy(m.vertices, m.faces, {300, 16});
+  const SurfaceHierarchy b = [&] {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    return build_surface_hierarchy(m.vertices, m.faces, {300, 16});
+  }();
   ASSERT_EQ(a.levels(), b.levels());
   EXPECT_EQ(a.colours, b.colours);
   for (std::size_t l = 0; l < a.prolongations.size(); ++l) {
