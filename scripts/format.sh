@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Formats the C++ sources (*.h, *.cpp tracked by git) with the repository's .clang-format.
+# Formats the C++ sources (*.h, *.cpp tracked by git, and new ones git does not ignore) with the
+# repository's .clang-format, so a file not yet added is formatted before its first commit.
 #   scripts/format.sh           rewrites them in place
 #   scripts/format.sh --check   changes nothing: lists the files that are not formatted, exits 1
 # Exits 77 when clang-format is missing (scripts/setup.sh installs it): the `format` test then
@@ -17,7 +18,7 @@ if ! command -v clang-format >/dev/null 2>&1; then
   exit 77
 fi
 cd "$root"
-mapfile -t files < <(git ls-files -- '*.h' '*.cpp')
+mapfile -t files < <(git ls-files --cached --others --exclude-standard -- '*.h' '*.cpp')
 [ ${#files[@]} -gt 0 ] || { echo "format.sh: no tracked C++ sources under $root" >&2; exit 1; }
 if [ $check = 0 ]; then
   clang-format -i -- "${files[@]}"
