@@ -48,6 +48,7 @@ int severity(SolveStatus s) {
 /// What one step's solves did, for the step's record in result.json.
 struct StepTally {
   double update_seconds = 0, solve_seconds = 0;
+  double planted_seconds = 0;  ///< added by $MCFBENCH_PLANTED_SLOWDOWN (flows/planted_slowdown.h)
   int solves = 0, iterations = 0;
   double contraction = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
   int fallbacks = 0, fallback_iterations = 0;  ///< solves whose stalled cycles CG took over
@@ -87,7 +88,7 @@ class FlowStepContext final : public StepContext {
     const auto t0 = Clock::now();
     const bool first = !assembled_;
     basis_.update(X, !flow_.keeps_mass || first, !flow_.keeps_stiffness || first);
-    plant_slowdown(PlantedPhase::update, t0);  // a no-op unless planted there
+    tally_.planted_seconds += plant_slowdown(PlantedPhase::update, t0);  // 0 unless planted
     assembled_ = true;
     tally_.update_seconds += seconds_since(t0);
   }
@@ -150,6 +151,7 @@ class FlowStepContext final : public StepContext {
     assembled_ = false;
   }
   void add_update_seconds(double s) { tally_.update_seconds += s; }
+  void add_planted_seconds(double s) { tally_.planted_seconds += s; }
   /// ρ of the last stabilized solve (0 without stabilization).
   double stabilization_rho() const { return stabilized_ ? stabilized_->rho() : 0.0; }
   /// The current step's solves so far.
@@ -318,15 +320,17 @@ void FlowRun::begin_step(int step) {
   // step's update is then one build (a step 1 recorded as ~0 made Table 1's rebuilt mean 20%
   // low over 5 steps, 33% over the quick run's 3), and X_0 is not built twice.
   const auto t0 = Clock::now();
+  double planted = 0;
   if (step > 1) {
     basis_->rebuild(V_);
     ctx_->rebuilt();
-    plant_slowdown(PlantedPhase::update, t0);  // a rebuild is this basis's update
+    planted = plant_slowdown(PlantedPhase::update, t0);  // a rebuild is this basis's update
   }
   x_ = basis_->initial_coefficients();
   has_prev_ = false;
   ctx_->begin_step(x_, nullptr);
   ctx_->add_update_seconds(step > 1 ? seconds_since(t0) : build_seconds_);
+  ctx_->add_planted_seconds(planted);
 }
 
 nlohmann::json FlowRun::solver_record(int step, double t) const {
@@ -458,11 +462,13 @@ bool FlowRun::advance(int step) {
   }
   x_ = std::move(x_new);  // for a one-step scheme this frees X_{n-1}
   V_ = std::move(V_new);
-  plant_slowdown(PlantedPhase::step, step_start);  // a no-op unless planted there
+  ctx_->add_planted_seconds(plant_slowdown(PlantedPhase::step, step_start));  // 0 unless planted
   record["seconds"] = {{"update", ctx_->tally().update_seconds},
                        {"solve", ctx_->tally().solve_seconds},
                        {"evaluate", evaluate_seconds},
                        {"total", seconds_since(step_start)}};
+  // A planted run says how long it waited on purpose, and in which phase's time that lies.
+  if (planted_slowdown() > 0) record["seconds"]["planted"] = ctx_->tally().planted_seconds;
   steps_.push_back(std::move(record));
   return true;
 }

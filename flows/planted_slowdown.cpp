@@ -43,16 +43,17 @@ const char* to_string(PlantedPhase phase) {
   return phase == PlantedPhase::update ? "update" : "step";
 }
 
-void plant_slowdown(PlantedPhase phase, std::chrono::steady_clock::time_point start) {
+double plant_slowdown(PlantedPhase phase, std::chrono::steady_clock::time_point start) {
   const double f = planted_slowdown();
-  if (f <= 0 || phase != planted_phase()) return;
+  if (f <= 0 || phase != planted_phase()) return 0;
   using Clock = std::chrono::steady_clock;
-  const auto worked = Clock::now() - start;
-  const auto until = start + worked + std::chrono::duration_cast<Clock::duration>(worked * f);
+  const auto reached = Clock::now();
+  const auto until = reached + std::chrono::duration_cast<Clock::duration>((reached - start) * f);
   // A busy wait, not a sleep: the delay is held on a core as the phase's own work is, and a
   // sleep's wake-up on a loaded machine would add its own noise.
   while (Clock::now() < until) {
   }
+  return std::chrono::duration<double>(Clock::now() - reached).count();
 }
 
 }  // namespace mcf

@@ -28,6 +28,7 @@ const char* to_string(PlantedPhase phase);
 ///   start  when that phase's work began (steady clock)
 /// With f = planted_slowdown() > 0 and phase = planted_phase(), returns only once (1 + f) times
 /// the time from start to the call has passed since start; otherwise at once.
-void plant_slowdown(PlantedPhase phase, std::chrono::steady_clock::time_point start);
+/// Returns the seconds it added (0 when it added none), which a planted run records.
+double plant_slowdown(PlantedPhase phase, std::chrono::steady_clock::time_point start);
 
 }  // namespace mcf

@@ -1,5 +1,6 @@
-// $MCFBENCH_PLANTED_SLOWDOWN (flows/planted_slowdown.h): each step lasts (1 + f) times its own
-// work, the result records f, and a malformed value stops the flow naming the variable.
+// $MCFBENCH_PLANTED_SLOWDOWN (flows/planted_slowdown.h): each step (or, with
+// $MCFBENCH_PLANTED_PHASE=update, each update) lasts (1 + f) times its own work, the result records
+// f, the phase and each step's wait, and a malformed value stops the flow naming the variable.
 
 #include "bench_test_util.h"
 
@@ -28,7 +29,10 @@ TEST(PlantedSlowdown, StepsLastOnePlusFTimesTheirWorkAndTheResultSaysSo) {
     const double work =
         t["update"].get<double>() + t["solve"].get<double>() + t["evaluate"].get<double>();
     EXPECT_GE(t["total"].get<double>(), 2 * work) << s.dump();
+    EXPECT_GT(t["planted"].get<double>(), 0.0) << s.dump();  // the wait, recorded
   }
+  for (const auto& s : read_json(dir / "plain" / "result.json")["steps"])
+    EXPECT_FALSE(s["seconds"].contains("planted")) << s.dump();
   c = mcfbench("flow --mesh icosphere:level=2 --steps 3 --out bad", dir,
                "MCFBENCH_PLANTED_SLOWDOWN=lots ");
   EXPECT_NE(c.status, 0);
@@ -43,6 +47,16 @@ TEST(PlantedSlowdown, PlantedInTheUpdateTheResultNamesThePhase) {
   const nlohmann::json r = read_json(dir / "slowed" / "result.json");
   EXPECT_EQ(r["environment"]["planted_slowdown"], 0.5);
   EXPECT_EQ(r["environment"]["planted_phase"], "update");
+  ASSERT_EQ(r["steps"].size(), 2u);
+  for (const auto& s : r["steps"]) {
+    // The wait lies inside the update's own time (each update call lasts its work plus the
+    // wait), so the update's seconds hold the planted seconds: inequalities that hold whatever
+    // the machine's speed.
+    const auto& t = s["seconds"];
+    EXPECT_GT(t["planted"].get<double>(), 0.0) << s.dump();
+    EXPECT_GE(t["update"].get<double>(), t["planted"].get<double>()) << s.dump();
+    EXPECT_GE(t["total"].get<double>(), t["update"].get<double>()) << s.dump();
+  }
   c = mcfbench("flow --mesh icosphere:level=2 --steps 2 --out bad", dir,
                "MCFBENCH_PLANTED_SLOWDOWN=0.5 MCFBENCH_PLANTED_PHASE=solve ");
   EXPECT_NE(c.status, 0);
