@@ -739,37 +739,35 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
   if (lagged) {
     ++m.calls_since_refresh;
     ++m.lagged_refreshes;
-    if (!diag_ok)
-      return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
-    rep.message = m.coarse_note;
-    m.ready = true;
-    rep.iterations = 0;
-    return rep;
+  } else {
+    m.calls_since_refresh = 0;
+    if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);
+    m.ldlt.factorize(m.levels.front().A);
   }
-  m.calls_since_refresh = 0;
-  m.coarse_note.clear();
-
-  if (need_symbolic) m.ldlt.analyzePattern(m.levels.front().A);
-  m.ldlt.factorize(m.levels.front().A);
   if (!diag_ok)
     return fail(SolveStatus::not_positive_definite, "negative or non-finite diagonal entry");
-  m.coarse_pinv.resize(0, 0);
-  if (!m.coarsest_factor_is_sound()) {
-    // The octree's functions on a flat face parallel to a grid plane (the cubical spiral, a
-    // box) are linearly dependent on the surface: A is then only semi-definite, on every level.
-    // Gauss–Seidel relaxes such a consistent system as it does a definite one (the paper's
-    // solver never factors the fine matrix); the coarsest level needs a generalized inverse.
-    int null_dimension = 0;
-    const std::string why = m.coarsest_pseudo_inverse(null_dimension);
-    if (!why.empty()) return fail(SolveStatus::not_positive_definite, why);
-    rep.message = "coarsest level semi-definite (null space of dimension " +
-                  std::to_string(null_dimension) + "): solved by its pseudo-inverse";
+  if (!lagged) {
+    // The coarse levels' notes, which a lagged call repeats with their operators.
+    m.coarse_note.clear();
+    m.coarse_pinv.resize(0, 0);
+    if (!m.coarsest_factor_is_sound()) {
+      // The octree's functions on a flat face parallel to a grid plane (the cubical spiral, a
+      // box) are linearly dependent on the surface: A is then only semi-definite, on every
+      // level. Gauss–Seidel relaxes such a consistent system as it does a definite one (the
+      // paper's solver never factors the fine matrix); the coarsest level needs a generalized
+      // inverse.
+      int null_dimension = 0;
+      const std::string why = m.coarsest_pseudo_inverse(null_dimension);
+      if (!why.empty()) return fail(SolveStatus::not_positive_definite, why);
+      m.coarse_note = "coarsest level semi-definite (null space of dimension " +
+                      std::to_string(null_dimension) + "): solved by its pseudo-inverse";
+    }
+    for (std::size_t l = 1; l < m.levels.size(); ++l)
+      if (!m.levels[l].coloured)
+        m.coarse_note += (m.coarse_note.empty() ? "" : "; ") + std::string("level ") +
+                         std::to_string(l) + " uses serial Gauss-Seidel (no valid colouring)";
   }
-  for (std::size_t l = 1; l < m.levels.size(); ++l)
-    if (!m.levels[l].coloured)
-      rep.message += (rep.message.empty() ? "" : "; ") + std::string("level ") + std::to_string(l) +
-                     " uses serial Gauss-Seidel (no valid colouring)";
-  m.coarse_note = rep.message;  // what a lagged call repeats
+  rep.message = m.coarse_note;
   m.ready = true;
   rep.iterations = 0;
   return rep;
