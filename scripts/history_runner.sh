@@ -1,10 +1,8 @@
 #!/usr/bin/env bash
 # The default runner of scripts/history.sh: `history_runner.sh CONFIG OUT`, run in a git
-# worktree checked out at the commit to measure. Builds that commit's mcfbench (Release) into a
-# build folder kept per commit under $MCFBENCH_HISTORY_BUILDS (default
-# ~/.cache/mcfbench-history/<commit>; scripts/history_build.sh), so a commit is built once however
-# often it is measured, then runs CONFIG's --quick variant with $MCFBENCH_HISTORY_REPETITIONS repetitions (default 5)
-# into OUT. The config is the caller's file, not the commit's, so every commit runs the same
+# worktree checked out at the commit to measure. Takes that commit's mcfbench (Release) from the
+# build cache, building it there first if need be (scripts/history_build.sh), then runs CONFIG's
+# --quick variant with $MCFBENCH_HISTORY_REPETITIONS repetitions (default 5) into OUT. The config is the caller's file, not the commit's, so every commit runs the same
 # cells.
 set -euo pipefail
 config=$1

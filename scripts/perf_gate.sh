@@ -5,8 +5,9 @@
 # U test of `compare` can reach its p < 0.05 is 4), and answers (docs/benchmarks.md "The gate"):
 #   exit 0  pass: no cell of CONFIG's quick variant is slower beyond the threshold;
 #   exit 1  regression: a cell is slower by more than $MCFBENCH_GATE_THRESHOLD (default 0.1)
-#           with the U test over the rounds agreeing (`mcfbench compare`), or failed, or lost
-#           accuracy;
+#           with the U test over the rounds agreeing (`mcfbench compare`) in any metric of
+#           $MCFBENCH_GATE_METRICS (default: seconds.total seconds.update seconds.solve, the step
+#           and its phases), or failed, or lost accuracy;
 #   exit 3  inconclusive: a repetition of either side shared the machine with other work
 #           (contention.contended), so its timings judge the machine, not the code;
 #   exit 2  an error: usage, a side that does not build or run, or sides whose machine, threads

@@ -8,11 +8,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$1
-head=$(git -C "$root" rev-parse HEAD 2>/dev/null) || { echo "SKIP: not a git checkout"; exit 77; }
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-mkdir -p "$work/builds/$head"
-ln -s "$bin" "$work/builds/$head/mcfbench_micro"
+exe=mcfbench_micro
+. "$(dirname "$0")/history_head_setup.sh"
 cat >"$work/micro_tiny.json" <<'JSON'
 {"micro": {"benchmark_filter": "^BM_StreamCopy/1/", "environment": {"MCFBENCH_STREAM_MB": "1"}}}
 JSON
