@@ -227,7 +227,7 @@ class FlowRun {
   void begin_step(int step);
   nlohmann::json solver_record(int step, double t) const;
   std::optional<std::string> stop_rule(const Positions& V_new, const Coefficients& x_new,
-                                       double& area, nlohmann::json& record) const;
+                                       SurfaceMoments& moments, nlohmann::json& record) const;
   void stop(int step, Clock::time_point step_start, const std::string& reason,
             nlohmann::json& record);
   void record_references(const Positions& V_new, double t, nlohmann::json& record);
@@ -366,9 +366,11 @@ nlohmann::json FlowRun::solver_record(int step, double t) const {
 }
 
 std::optional<std::string> FlowRun::stop_rule(const Positions& V_new, const Coefficients& x_new,
-                                              double& area, nlohmann::json& record) const {
+                                              SurfaceMoments& moments,
+                                              nlohmann::json& record) const {
   if (!all_finite(V_new) || !x_new.allFinite()) return "non-finite vertex positions";
-  area = surface_area(TriangleMesh{V_new, mesh_.faces});
+  moments = surface_moments(V_new, mesh_.faces);
+  const double area = moments.area;
   if (!(area > 1e-12 * area0_)) {
     record["area"] = area;
     return "collapsed area (" + std::to_string(area) + ")";
@@ -435,13 +437,14 @@ bool FlowRun::advance(int step) {
 
   const auto eval_start = Clock::now();
   Positions V_new = basis_->evaluate_vertices(x_new);
-  double area = 0;
-  if (const std::optional<std::string> reason = stop_rule(V_new, x_new, area, record)) {
+  SurfaceMoments moments;
+  if (const std::optional<std::string> reason = stop_rule(V_new, x_new, moments, record)) {
     stop(step, step_start, *reason, record);
     return false;
   }
+  const double area = moments.area;
   if (config_.normalize_area) {
-    const Normalization n = unit_area_normalization(V_new, mesh_.faces);
+    const Normalization n = unit_area_normalization(moments);
     apply(n, V_new);
     apply(n, x_new);
     apply(n, x_);  // becomes X_{n-1}: same frame as X_n for two-step schemes
@@ -484,21 +487,17 @@ TriangleMesh FlowRun::finish() {
 
 }  // namespace
 
-Normalization unit_area_normalization(const Positions& V, const Triangles& F) {
-  double area = 0;
-  Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::RowVector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), d = V.row(F(f, 2));
-    const double A = 0.5 * (b - a).cross(d - a).norm();
-    area += A;
-    c += A * (a + b + d) / 3.0;
-  }
+Normalization unit_area_normalization(const SurfaceMoments& s) {
   Normalization n;
-  if (area > 0) {
-    n.centroid = c / area;
-    n.scale = 1.0 / std::sqrt(area);
+  if (s.area > 0) {
+    n.centroid = s.weighted_centroid / s.area;
+    n.scale = 1.0 / std::sqrt(s.area);
   }
   return n;
+}
+
+Normalization unit_area_normalization(const Positions& V, const Triangles& F) {
+  return unit_area_normalization(surface_moments(V, F));
 }
 
 FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,

@@ -5,6 +5,7 @@
 
 #include "datasets/mesh_spec.h"
 #include "flows/flow_config.h"
+#include "flows/surface_moments.h"
 
 #include <nlohmann/json.hpp>
 
@@ -33,5 +34,7 @@ struct Normalization {
   Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
 };
 Normalization unit_area_normalization(const Positions& V, const Triangles& F);
+/// The same from the surface's moments (flows/surface_moments.h), when they are at hand.
+Normalization unit_area_normalization(const SurfaceMoments& moments);
 
 }  // namespace mcf
