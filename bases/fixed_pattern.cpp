@@ -4,6 +4,7 @@
 
 #include <tbb/parallel_sort.h>
 
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -14,11 +15,13 @@ FixedPattern::FixedPattern(Eigen::Index n, const std::vector<int>& rows,
   if (rows.size() != cols.size())
     throw std::invalid_argument("FixedPattern: rows/cols size mismatch");
   const std::size_t slots = rows.size();
+  if (slots > std::size_t(std::numeric_limits<int>::max()))
+    throw std::length_error("FixedPattern: more than 2^31 - 1 slots");
   // Sort slots by (col, row, slot) — column-major order of the target — to find the nonzeros.
-  std::vector<std::int64_t> order(slots);
+  std::vector<int> order(slots);
   std::iota(order.begin(), order.end(), 0);
-  auto key = [&](std::int64_t s) { return std::int64_t(cols[s]) * n + rows[s]; };
-  tbb::parallel_sort(order.begin(), order.end(), [&](std::int64_t a, std::int64_t b) {
+  auto key = [&](int s) { return std::int64_t(cols[std::size_t(s)]) * n + rows[std::size_t(s)]; };
+  tbb::parallel_sort(order.begin(), order.end(), [&](int a, int b) {
     const auto ka = key(a), kb = key(b);
     return ka != kb ? ka < kb : a < b;
   });
@@ -31,13 +34,13 @@ FixedPattern::FixedPattern(Eigen::Index n, const std::vector<int>& rows,
   for (std::size_t i = 0; i < slots; ++i) {
     const auto k = key(order[i]);
     if (k != prev) {
-      first_.push_back(std::int64_t(i));
+      first_.push_back(int(i));
       inner.push_back(rows[order[i]]);
       ++outer[cols[order[i]] + 1];
       prev = k;
     }
   }
-  first_.push_back(std::int64_t(slots));
+  first_.push_back(int(slots));
   for (Eigen::Index c = 0; c < n; ++c) outer[c + 1] += outer[c];
   slot_of_ = std::move(order);
 
@@ -50,7 +53,8 @@ void FixedPattern::gather(const std::vector<double>& local, std::vector<double>&
   double* out = values.data();
   parallel_for_indices<Eigen::Index>(non_zeros(), 4096, [&](Eigen::Index nz) {
     double sum = 0.0;
-    for (std::int64_t i = first_[nz]; i < first_[nz + 1]; ++i) sum += local[slot_of_[i]];
+    for (int i = first_[std::size_t(nz)]; i < first_[std::size_t(nz) + 1]; ++i)
+      sum += local[std::size_t(slot_of_[std::size_t(i)])];
     out[nz] = sum;
   });
 }

@@ -8,6 +8,7 @@
 #include <Eigen/SparseCore>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace mcf {
@@ -15,7 +16,8 @@ namespace mcf {
 class FixedPattern {
  public:
   FixedPattern() = default;
-  /// rows/cols: one entry per local slot (element e, slot s stored at e * slots + s).
+  /// rows/cols: one entry per local slot (element e, slot s stored at e * slots + s); at most
+  /// 2^31 - 1 slots (std::length_error otherwise).
   FixedPattern(Eigen::Index dimension, const std::vector<int>& rows, const std::vector<int>& cols);
 
   Eigen::Index non_zeros() const { return Eigen::Index(inner_.size()); }
@@ -32,10 +34,19 @@ class FixedPattern {
 
   std::size_t num_slots() const { return slot_of_.size(); }
 
+  /// The slots that land on nonzero nz, ascending: for element-aware gathers that read fewer
+  /// bytes than one local value per slot (HatBasis::update reads per-face values).
+  std::span<const int> slots(Eigen::Index nz) const {
+    return {slot_of_.data() + first_[std::size_t(nz)],
+            std::size_t(first_[std::size_t(nz) + 1] - first_[std::size_t(nz)])};
+  }
+  const std::vector<int>& outer() const { return outer_; }
+  const std::vector<int>& inner() const { return inner_; }
+
  private:
-  std::vector<int> outer_, inner_;     // the pattern: column starts and row indices
-  std::vector<std::int64_t> first_;    // per nonzero: range into slot_of_
-  std::vector<std::int64_t> slot_of_;  // slots grouped by nonzero, ascending slot order
+  std::vector<int> outer_, inner_;  // the pattern: column starts and row indices
+  std::vector<int> first_;          // per nonzero: range into slot_of_
+  std::vector<int> slot_of_;        // slots grouped by nonzero, ascending slot order
 };
 
 }  // namespace mcf

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include <chrono>
+#include <span>
 
 namespace mcf {
 
@@ -82,46 +83,72 @@ Positions HatBasis::evaluate_vertices(const Coefficients& x) const {
   if (order_.empty())
     return output_vertices_ == x.rows() ? Positions(x) : x.topRows(output_vertices_);
   Positions V(output_vertices_, 3);
-  for (std::size_t k = 0; k < order_.size(); ++k)
+  parallel_for_indices<std::size_t>(order_.size(), 4096, [&](std::size_t k) {
     if (order_[k] < output_vertices_) V.row(order_[k]) = x.row(Eigen::Index(k));
+  });
   return V;
 }
 
 void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiffness) {
   if (!update_mass && !update_stiffness) return;
   const Eigen::Index m = faces_.rows();
-  // Per-face local matrices, kept between steps (no 2 x 72 bytes per face of allocation per step).
-  std::vector<double>& local_m = local_mass_;
-  std::vector<double>& local_k = local_stiffness_;
-  if (update_mass) local_m.resize(9 * m);
-  if (update_stiffness) local_k.resize(9 * m);
-  const bool lumped = mass_kind_ == MassKind::lumped;
+  // One pass over the faces writes what each face contributes, compactly: its area (the mass)
+  // and half the cotangent at each corner (the stiffness); the gathers below then sum, per
+  // nonzero, the values of the faces whose slots land on it (9 slots a face, slot 3a + b for
+  // corners a, b). Reading one area per slot instead of a 3 x 3 block per face keeps the gather's
+  // random reads within a ninth of the bytes (docs/benchmarks.md, "Floors").
+  if (update_mass) face_area_.resize(std::size_t(m));
+  if (update_stiffness) corner_weight_.resize(3 * std::size_t(m));
   parallel_for_indices<Eigen::Index>(m, 2048, [&](Eigen::Index f) {
     const Eigen::Vector3d p[3] = {x.row(faces_(f, 0)).transpose(), x.row(faces_(f, 1)).transpose(),
                                   x.row(faces_(f, 2)).transpose()};
-    if (update_mass) {
-      const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-      // Consistent P1 mass: A/6 on the diagonal, A/12 off it; lumped: A/3 on the diagonal.
-      const double diag = lumped ? area / 3.0 : area / 6.0, off = lumped ? 0.0 : area / 12.0;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) local_m[9 * f + 3 * a + b] = a == b ? diag : off;
-    }
+    if (update_mass) face_area_[std::size_t(f)] = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
     if (update_stiffness) {
       // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite
       // edge.
       const Eigen::Vector3d cot = corner_cotangents(p[0], p[1], p[2]);
-      double* k = &local_k[9 * f];
-      for (int c = 0; c < 3; ++c) {
-        const int i = (c + 1) % 3, j = (c + 2) % 3;
-        const double w = 0.5 * cot[c];
-        k[3 * i + j] = -w;
-        k[3 * j + i] = -w;
-      }
-      for (int a = 0; a < 3; ++a) k[4 * a] = -(k[3 * a + (a + 1) % 3] + k[3 * a + (a + 2) % 3]);
+      for (int c = 0; c < 3; ++c)
+        corner_weight_[3 * std::size_t(f) + std::size_t(c)] = 0.5 * cot[c];
     }
   });
-  if (update_mass) pattern_.gather(local_m, mass_);
-  if (update_stiffness) pattern_.gather(local_k, stiffness_);
+  const auto is_diagonal_slot = [](int slot) { return (slot % 9) % 4 == 0; };  // 3a + a
+  if (update_mass) {
+    // Consistent P1 mass: A/6 on the diagonal, A/12 off it; lumped: A/3 on the diagonal, 0 off it.
+    const bool lumped = mass_kind_ == MassKind::lumped;
+    mass_.resize(std::size_t(pattern_.non_zeros()));
+    parallel_for_indices<Eigen::Index>(pattern_.non_zeros(), 4096, [&](Eigen::Index nz) {
+      const std::span<const int> slots = pattern_.slots(nz);
+      const bool diagonal = is_diagonal_slot(slots.front());
+      double area = 0.0;
+      for (const int slot : slots) area += face_area_[std::size_t(slot / 9)];
+      mass_[std::size_t(nz)] = diagonal ? area / (lumped ? 3.0 : 6.0) : lumped ? 0.0 : area / 12.0;
+    });
+  }
+  if (update_stiffness) {
+    // Off the diagonal, -Σ w over the faces sharing the edge (w of the corner opposite it, the
+    // third corner 3 - a - b); on it, minus the column's off-diagonal sum (rows sum to zero).
+    stiffness_.resize(std::size_t(pattern_.non_zeros()));
+    const std::vector<int>& outer = pattern_.outer();
+    parallel_for_indices<Eigen::Index>(Eigen::Index(outer.size()) - 1, 1024, [&](Eigen::Index j) {
+      double off_sum = 0.0;
+      int diagonal = -1;
+      for (int nz = outer[std::size_t(j)]; nz < outer[std::size_t(j) + 1]; ++nz) {
+        const std::span<const int> slots = pattern_.slots(nz);
+        if (is_diagonal_slot(slots.front())) {
+          diagonal = nz;
+          continue;
+        }
+        double w = 0.0;
+        for (const int slot : slots) {
+          const int a = (slot % 9) / 3, b = slot % 3;
+          w += corner_weight_[3 * std::size_t(slot / 9) + std::size_t(3 - a - b)];
+        }
+        stiffness_[std::size_t(nz)] = -w;
+        off_sum -= w;
+      }
+      if (diagonal >= 0) stiffness_[std::size_t(diagonal)] = -off_sum;
+    });
+  }
 }
 
 }  // namespace mcf

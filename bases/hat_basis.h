@@ -51,9 +51,10 @@ class HatBasis final : public Basis {
   std::vector<int> order_;        // function k is vertex order_[k]; empty: the mesh's own order
   Eigen::Index output_vertices_;  // evaluate_vertices returns the mesh's first this many
   MassKind mass_kind_;
-  FixedPattern pattern_;                              // 9 slots per face, gathered per nonzero
-  std::vector<double> mass_, stiffness_;              // values on pattern_
-  std::vector<double> local_mass_, local_stiffness_;  // per-face 3x3 blocks, reused every step
+  FixedPattern pattern_;                  // 9 slots per face, gathered per nonzero
+  std::vector<double> mass_, stiffness_;  // values on pattern_
+  std::vector<double> face_area_;         // per face, reused every step (update)
+  std::vector<double> corner_weight_;     // per face and corner: half its cotangent (update)
   std::vector<int> boundary_;
   SurfaceHierarchy hierarchy_;  // empty unless asked for
   BasisStats stats_;
