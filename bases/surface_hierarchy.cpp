@@ -211,7 +211,7 @@ SparseMatrix graph_pattern(const LevelMesh& level) {
 std::vector<std::uint8_t> solver_colours(const SparseMatrix& pattern) {
   int count = 0;
   const std::vector<int> c = greedy_colouring(pattern, &count);
-  if (count > 8) return {};
+  if (count > kMaxSurfaceColours) return {};
   return std::vector<std::uint8_t>(c.begin(), c.end());
 }
 
