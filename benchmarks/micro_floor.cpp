@@ -257,17 +257,23 @@ void BM_Floor_HatGalerkin(benchmark::State& state) {
   SparseMatrix C = SparseMatrix(SparseMatrix(f.mg->level_matrix(l).transpose()).transpose());
   const std::vector<int> transpose_pos = multigrid_detail::transpose_positions(C);
   multigrid_detail::Spa spa;
+  // As the solver computes it: through the product's plan unless `dense` (galerkin.h).
+  const bool dense = state.range(2) != 0;
+  const multigrid_detail::GalerkinPlan plan =
+      dense ? multigrid_detail::GalerkinPlan{}
+            : multigrid_detail::galerkin_plan(multigrid_detail::Csc(A), P, C, {});
   for (auto _ : state) {
     multigrid_detail::galerkin_values(multigrid_detail::Csc(A), P, C, C.valuePtr(), transpose_pos,
-                                      {}, spa);
+                                      {}, spa, &plan);
     benchmark::DoNotOptimize(C.valuePtr());
   }
   report(state, galerkin_floor(A, P, C), threads);
   state.counters["coarse_rows"] = double(C.rows());
+  state.counters["plan_bytes"] = double(plan.bytes());
 }
 BENCHMARK(BM_Floor_HatGalerkin)
-    ->ArgNames({"threads", "below"})
-    ->ArgsProduct({{1, 2}, {0, 1, 2, 3}})
+    ->ArgNames({"threads", "below", "dense"})
+    ->ArgsProduct({{1, 2}, {0, 1, 2, 3}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -63,13 +63,131 @@ std::vector<int> transpose_positions(const SparseMatrix& C) {
   return transpose_pos;
 }
 
+GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm,
+                           const std::vector<int>& column_order) {
+  const Csc P(Pm);
+  const int m = A.rows, q = P.cols;
+  const int* Couter = Cm.outerIndexPtr();
+  const int* Cinner = Cm.innerIndexPtr();
+  const auto column = [&](int jj) {
+    return column_order.empty() ? jj : column_order[std::size_t(jj)];
+  };
+  GalerkinPlan plan;
+  plan.scatter_start.assign(std::size_t(q) + 1, 0);
+  plan.dot_start.assign(std::size_t(q) + 1, 0);
+  std::vector<int> support(std::size_t(q), 0);
+  // Local numbering of column J's fine rows in pass `pass`: slot[i] for rows with
+  // stamp[i] == 2 J + pass (a thread may meet a column in both passes; the second numbers anew).
+  struct Marks {
+    std::vector<int> stamp, slot;
+  };
+  tbb::enumerable_thread_specific<Marks> marks([m] {
+    return Marks{std::vector<int>(std::size_t(m), -1), std::vector<int>(std::size_t(m))};
+  });
+  // Walks column jj: numbers its support, then calls scatter(slot) and dot(slot) in the order
+  // galerkin_values visits the terms.
+  const auto walk = [&](int jj, int pass, Marks& mk, auto&& scatter, auto&& dot) {
+    const int J = column(jj);
+    const int mark = 2 * J + pass;
+    int ns = 0;
+    for (int p = P.outer[J]; p < P.outer[J + 1]; ++p) {
+      const int t = P.inner[p];
+      for (int a = A.outer[t]; a < A.outer[t + 1]; ++a) {
+        const std::size_t i = std::size_t(A.inner[a]);
+        if (mk.stamp[i] != mark) {
+          mk.stamp[i] = mark;
+          mk.slot[i] = ns++;
+        }
+        scatter(mk.slot[i]);
+      }
+    }
+    for (int e = Couter[J]; e < Couter[J + 1]; ++e) {
+      const int I = Cinner[e];
+      if (I > J) break;
+      for (int r = P.outer[I]; r < P.outer[I + 1]; ++r) {
+        const std::size_t i = std::size_t(P.inner[r]);
+        dot(mk.stamp[i] == mark ? mk.slot[i] : -1);
+      }
+    }
+    return ns;
+  };
+  // Pass 1: counts and supports.
+  tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
+    Marks& mk = marks.local();
+    for (int jj = r.begin(); jj < r.end(); ++jj) {
+      std::int64_t ns_scatter = 0, ns_dot = 0;
+      support[std::size_t(jj)] = walk(
+          jj, 0, mk, [&](int) { ++ns_scatter; }, [&](int) { ++ns_dot; });
+      plan.scatter_start[std::size_t(jj) + 1] = ns_scatter;
+      plan.dot_start[std::size_t(jj) + 1] = ns_dot;
+    }
+  });
+  const int largest = q ? *std::max_element(support.begin(), support.end()) : 0;
+  for (std::size_t j = 0; j < std::size_t(q); ++j) {
+    plan.scatter_start[j + 1] += plan.scatter_start[j];
+    plan.dot_start[j + 1] += plan.dot_start[j];
+  }
+  const std::size_t terms = std::size_t(plan.scatter_start.back() + plan.dot_start.back());
+  const std::size_t a_bytes = std::size_t(A.outer[A.cols]) * (sizeof(int) + sizeof(double));
+  // The zero slot is numbered `support` and must fit 16 bits too.
+  if (largest >= 65535 || 2 * terms > a_bytes) return {};
+  plan.max_support = largest;
+  plan.support.assign(support.begin(), support.end());
+  plan.scatter_slot.resize(std::size_t(plan.scatter_start.back()));
+  plan.dot_slot.resize(std::size_t(plan.dot_start.back()));
+  // Pass 2: the slots.
+  tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
+    Marks& mk = marks.local();
+    for (int jj = r.begin(); jj < r.end(); ++jj) {
+      std::uint16_t* sc = plan.scatter_slot.data() + plan.scatter_start[std::size_t(jj)];
+      std::uint16_t* dt = plan.dot_slot.data() + plan.dot_start[std::size_t(jj)];
+      const std::uint16_t zero = plan.support[std::size_t(jj)];
+      walk(
+          jj, 1, mk, [&](int s) { *sc++ = std::uint16_t(s); },
+          [&](int s) { *dt++ = s < 0 ? zero : std::uint16_t(s); });
+    }
+  });
+  return plan;
+}
+
 void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm, double* Cval,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
-                     Spa& spa) {
+                     Spa& spa, const GalerkinPlan* plan) {
   const Csc P(Pm);
   const int m = A.rows;
   const int* Couter = Cm.outerIndexPtr();
   const int* Cinner = Cm.innerIndexPtr();
+  if (plan != nullptr && !plan->empty()) {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, P.cols, 64), [&](const tbb::blocked_range<int>& r) {
+          auto& v = spa.local();
+          if (v.size() < std::size_t(plan->max_support) + 1)
+            v.assign(std::size_t(plan->max_support) + 1, 0.0);
+          double* b = v.data();
+          for (int jj = r.begin(); jj < r.end(); ++jj) {
+            const int J = column_order.empty() ? jj : column_order[std::size_t(jj)];
+            std::fill(b, b + plan->support[std::size_t(jj)] + 1, 0.0);  // the zero slot included
+            const std::uint16_t* sc =
+                plan->scatter_slot.data() + plan->scatter_start[std::size_t(jj)];
+            for (int p = P.outer[J]; p < P.outer[J + 1]; ++p) {
+              const int t = P.inner[p];
+              const double w = P.val[p];
+              for (int a = A.outer[t]; a < A.outer[t + 1]; ++a) b[*sc++] += A.val[a] * w;
+            }
+            const std::uint16_t* dt = plan->dot_slot.data() + plan->dot_start[std::size_t(jj)];
+            for (int e = Couter[J]; e < Couter[J + 1]; ++e) {
+              const int I = Cinner[e];
+              if (I > J) break;
+              double sum = 0.0;
+              for (int q = P.outer[I]; q < P.outer[I + 1]; ++q) sum += P.val[q] * b[*dt++];
+              Cval[e] = sum;
+              const int t = transpose_pos[std::size_t(e)];
+              if (t >= 0) Cval[t] = sum;
+            }
+          }
+        });
+    return;
+  }
   tbb::parallel_for(tbb::blocked_range<int>(0, P.cols, 64), [&](const tbb::blocked_range<int>& r) {
     auto& v = spa.local();
     if (v.size() < std::size_t(m)) v.assign(std::size_t(m), 0.0);

@@ -16,6 +16,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <cstdint>
 #include <vector>
 
 namespace mcf::multigrid_detail {
@@ -31,6 +32,32 @@ std::vector<int> transpose_positions(const SparseMatrix& C);
 /// smaller; all zero between columns).
 using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 
+/// The visits of galerkin_values laid out once per pattern. Per coarse column J, in visit order
+/// (column_order): the distinct fine rows of A P e_J numbered locally in order of first touch,
+/// then the local slot of every scatter term A(i, t) P(t, J) and of every dot-product term
+/// P(q, I) v_q (I <= J; a row q outside A P e_J's support reads the zero slot, numbered
+/// `support`). With a plan, galerkin_values accumulates each column in a buffer of a few dozen
+/// entries (in L1) instead of a dense vector of the fine level's size, and walks no fine-sized
+/// state to clear it: the same terms in the same order, hence bitwise the same values.
+/// Empty (no plan) when a column's support does not fit 16-bit slots or the plan would take
+/// more bytes than A itself (then galerkin_values keeps its dense accumulator).
+struct GalerkinPlan {
+  std::vector<std::int64_t> scatter_start, dot_start;  // per visited column, offsets (+1 at end)
+  std::vector<std::uint16_t> scatter_slot, dot_slot;   // local slots, in visit order
+  std::vector<std::uint16_t> support;                  // per visited column: its fine rows
+  int max_support = 0;
+  bool empty() const { return support.empty(); }
+  std::size_t bytes() const {
+    return 8 * (scatter_start.size() + dot_start.size()) +
+           2 * (scatter_slot.size() + dot_slot.size() + support.size());
+  }
+};
+
+/// The plan of galerkin_values(A, P, C, ..., column_order) for A's, P's and C's patterns (C
+/// sorted, as symbolic_product makes it). Parallel over columns; deterministic.
+GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm,
+                           const std::vector<int>& column_order);
+
 /// Values of the Galerkin operator A_c = Pᵀ A P on its precomputed (sorted, symmetric) pattern.
 /// Per coarse column J, v = A P e_J is accumulated in a thread-local dense vector, and each entry
 /// (I, J) with I <= J is the sparse dot product P e_I · v, written to (I, J) and to its mirror
@@ -42,8 +69,10 @@ using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 /// "Measurements behind implementation choices").
 /// A is a view (its values may be one term's, on the level's pattern); the values are written to
 /// `Cval`, on Cm's pattern (Cm's own values when Cval is Cm.valuePtr()).
+/// With a non-empty `plan` (galerkin_plan of the same patterns and column_order), the columns
+/// accumulate in the plan's local slots; the values are bitwise those without it.
 void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm, double* Cval,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
-                     Spa& spa);
+                     Spa& spa, const GalerkinPlan* plan = nullptr);
 
 }  // namespace mcf::multigrid_detail

@@ -102,9 +102,10 @@ struct MultigridSolver::Impl {
     // in the finest numbering; coarse levels: their Galerkin products). Empty otherwise.
     std::vector<std::vector<double>> terms;
     // Transfer to the next finer level (absent on the finest level).
-    SparseMatrix P;   // n_{l+1} x n_l
-    SparseMatrix PT;  // n_l x n_{l+1}
-    Spa spa;          // dense accumulators of the Galerkin product
+    SparseMatrix P;     // n_{l+1} x n_l
+    SparseMatrix PT;    // n_l x n_{l+1}
+    Spa spa;            // accumulators of the Galerkin product
+    GalerkinPlan plan;  // its visits laid out once per pattern (may be empty: galerkin_plan)
     // Work buffers (interleaved n x k, row stride padded to a multiple of 4).
     Buffer x, b, r;
     // Finest level, mixed precision: the iterate and right-hand side kept while a cycle runs on
@@ -186,6 +187,7 @@ struct MultigridSolver::Impl {
       C.A = symbolic_product(C.PT, symbolic_product(levels[l + 1].A, C.P));  // pattern of Pᵀ (A P)
       // Positions of transposed entries, to symmetrize the computed values exactly.
       C.transpose_pos = transpose_positions(C.A);
+      C.plan = galerkin_plan(Csc(levels[l + 1].A), C.P, C.A, C.inv);
     }
     for (std::size_t l = 0; l < nl; ++l) {
       Level& L = levels[l];
@@ -292,7 +294,8 @@ struct MultigridSolver::Impl {
       if (!term_changed[std::size_t(t)]) continue;
       Csc A(F.A);
       A.val = F.terms[std::size_t(t)].data();
-      galerkin_values(A, C.P, C.A, C.terms[std::size_t(t)].data(), C.transpose_pos, C.inv, C.spa);
+      galerkin_values(A, C.P, C.A, C.terms[std::size_t(t)].data(), C.transpose_pos, C.inv, C.spa,
+                      &C.plan);
       ++term_products;
     }
     const double* mv = C.terms[0].data();
@@ -319,7 +322,7 @@ struct MultigridSolver::Impl {
         coarse_by_term(l, *by_term);
       else
         galerkin_values(Csc(levels[l + 1].A), C.P, C.A, C.A.valuePtr(), C.transpose_pos, C.inv,
-                        C.spa);
+                        C.spa, &C.plan);
     }
     bool ok = true;
     for (std::size_t l = coarse ? 0 : levels.size() - 1; l < levels.size(); ++l) {
