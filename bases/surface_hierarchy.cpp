@@ -1,6 +1,9 @@
 #include "bases/surface_hierarchy.h"
 
+#include "core/parallel.h"
 #include "core/undirected_graph.h"
+
+#include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
 #include <array>
@@ -192,19 +195,57 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
   return {std::move(coarse), std::move(P)};
 }
 
-/// The symmetric pattern (ones) of a level's graph with its diagonal.
+/// Sets over [0, universe) for the indices [0, n), in compressed rows: body(i, mark, out) appends
+/// set i's members to `out`, each once (mark[x] == i: x already appended; `mark` is the calling
+/// thread's, never reset); each set is then sorted if `sorted`. Fixed chunks of indices, each
+/// written by one task, so the arrays are the same for any thread count.
+template <class Body>
+void gather_sets(int n, int universe, bool sorted, Body&& body, std::vector<int>& start,
+                 std::vector<int>& member) {
+  constexpr int chunk = 1024;
+  const int chunks = (n + chunk - 1) / chunk;
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(chunks));
+  start.assign(std::size_t(n) + 1, 0);
+  tbb::enumerable_thread_specific<std::vector<int>> marks(
+      [universe] { return std::vector<int>(std::size_t(universe), -1); });
+  parallel_for_chunks(n, chunk, [&](int c, int begin, int end) {
+    std::vector<int>& mark = marks.local();
+    std::vector<int>& out = members[std::size_t(c)];
+    for (int i = begin; i < end; ++i) {
+      const std::size_t first = out.size();
+      body(i, mark, out);
+      if (sorted) std::sort(out.begin() + std::ptrdiff_t(first), out.end());
+      start[std::size_t(i) + 1] = int(out.size() - first);
+    }
+  });
+  for (int i = 0; i < n; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
+  member.resize(std::size_t(start.back()));
+  parallel_for_indices(chunks, 1, [&](int c) {
+    std::copy(members[std::size_t(c)].begin(), members[std::size_t(c)].end(),
+              member.begin() + start[std::size_t(c) * chunk]);
+  });
+}
+
+/// The symmetric pattern (ones) of a level's graph with its diagonal, written straight into the
+/// compressed arrays (each column: the neighbours below, the vertex, the neighbours above; sorted,
+/// as the graph's rows are).
 SparseMatrix graph_pattern(const LevelMesh& level) {
   const int n = level.size();
-  std::vector<Eigen::Triplet<double, int>> t;
-  t.reserve(level.neighbour.size() + std::size_t(n));
-  for (int v = 0; v < n; ++v) {
-    t.emplace_back(v, v, 1.0);
-    for (int k = level.start[std::size_t(v)]; k < level.start[std::size_t(v) + 1]; ++k)
-      t.emplace_back(level.neighbour[std::size_t(k)], v, 1.0);
-  }
   SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  A.makeCompressed();
+  A.resizeNonZeros(Eigen::Index(level.neighbour.size()) + n);
+  int* outer = A.outerIndexPtr();
+  int* inner = A.innerIndexPtr();
+  for (int v = 0; v <= n; ++v) outer[v] = level.start[std::size_t(v)] + v;
+  parallel_for_indices(n, 4096, [&](int v) {
+    int* out = inner + outer[v];
+    const int* b = level.neighbour.data() + level.start[std::size_t(v)];
+    const int* e = level.neighbour.data() + level.start[std::size_t(v) + 1];
+    const int* mid = std::lower_bound(b, e, v);
+    out = std::copy(b, mid, out);
+    *out++ = v;
+    std::copy(mid, e, out);
+  });
+  std::fill(A.valuePtr(), A.valuePtr() + A.nonZeros(), 1.0);
   return A;
 }
 
@@ -216,6 +257,66 @@ std::vector<std::uint8_t> solver_colours(const SparseMatrix& pattern) {
 }
 
 }  // namespace
+
+SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A) {
+  const int n = int(P.rows()), nc = int(P.cols());
+  const int* Pouter = P.outerIndexPtr();
+  const int* Pinner = P.innerIndexPtr();
+  const int* Aouter = A.outerIndexPtr();
+  const int* Ainner = A.innerIndexPtr();
+  // P's rows: the coarse vertices each fine vertex takes values from (ascending).
+  std::vector<int> row_start(std::size_t(n) + 1, 0), row_coarse(std::size_t(P.nonZeros()));
+  for (int p = 0; p < Pouter[nc]; ++p) ++row_start[std::size_t(Pinner[p]) + 1];
+  for (int i = 0; i < n; ++i) row_start[std::size_t(i) + 1] += row_start[std::size_t(i)];
+  {
+    std::vector<int> fill(row_start.begin(), row_start.end() - 1);
+    for (int J = 0; J < nc; ++J)
+      for (int p = Pouter[J]; p < Pouter[J + 1]; ++p)
+        row_coarse[std::size_t(fill[std::size_t(Pinner[p])]++)] = J;
+  }
+  // Two set products, as the numeric product takes them: first the coarse vertices next to each
+  // fine one (the pattern of P^T A, column j: every I with P(i, I) A(i, j) stored), then column J
+  // of the product: the union of those sets over the fine vertices of P's column J. Taking the
+  // union per fine vertex first does each repeated I once.
+  std::vector<int> near_start, near;
+  gather_sets(
+      n, nc, false,
+      [&](int j, std::vector<int>& mark, std::vector<int>& out) {
+        for (int a = Aouter[j]; a < Aouter[j + 1]; ++a) {
+          const int i = Ainner[a];
+          for (int r = row_start[std::size_t(i)]; r < row_start[std::size_t(i) + 1]; ++r) {
+            const int I = row_coarse[std::size_t(r)];
+            if (mark[std::size_t(I)] != j) {
+              mark[std::size_t(I)] = j;
+              out.push_back(I);
+            }
+          }
+        }
+      },
+      near_start, near);
+  std::vector<int> outer, inner;
+  gather_sets(
+      nc, nc, true,
+      [&](int J, std::vector<int>& mark, std::vector<int>& out) {
+        for (int p = Pouter[J]; p < Pouter[J + 1]; ++p) {
+          const int j = Pinner[p];
+          for (int r = near_start[std::size_t(j)]; r < near_start[std::size_t(j) + 1]; ++r) {
+            const int I = near[std::size_t(r)];
+            if (mark[std::size_t(I)] != J) {
+              mark[std::size_t(I)] = J;
+              out.push_back(I);
+            }
+          }
+        }
+      },
+      outer, inner);
+  SparseMatrix C(nc, nc);
+  C.resizeNonZeros(Eigen::Index(inner.size()));
+  std::copy(outer.begin(), outer.end(), C.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), C.innerIndexPtr());
+  std::fill(C.valuePtr(), C.valuePtr() + C.nonZeros(), 1.0);
+  return C;
+}
 
 std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
   const int n = int(A.cols());
@@ -279,9 +380,7 @@ SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triang
   SparseMatrix pattern = graph_pattern(levels.front());
   colours[0] = solver_colours(pattern);
   for (std::size_t k = 0; k < P.size(); ++k) {
-    SparseMatrix next = SparseMatrix(P[k].transpose()) * pattern * P[k];
-    next.makeCompressed();
-    pattern = std::move(next);
+    pattern = galerkin_pattern(P[k], pattern);
     colours[k + 1] = solver_colours(pattern);
   }
   SurfaceHierarchy h;

@@ -59,6 +59,13 @@ struct SurfaceHierarchy {
 SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triangles& faces,
                                          const SurfaceHierarchyOptions& options = {});
 
+/// The pattern (ones, sorted row indices) of the Galerkin product P^T A P of a fine pattern A
+/// (square, symmetric, compressed) and a prolongation P (fine x coarse): entry (I, J) wherever
+/// P(i, I) A(i, j) P(j, J) is stored for some i, j. The same pattern as Eigen's
+/// SparseMatrix(P^T) * A * P with positive values, in time linear in the triple products' terms,
+/// without values and in parallel over the coarse columns (deterministic).
+SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A);
+
 /// A smallest-last greedy colouring of a symmetric pattern (the pattern's diagonal is ignored):
 /// colours[i] differs from the colour of every j with A(i, j) stored, j != i. Returns the colours;
 /// `count` receives the number used.

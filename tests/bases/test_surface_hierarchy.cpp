@@ -167,6 +167,40 @@ TEST(SurfaceHierarchy, ColouringsAreValidOnTheGalerkinPatterns) {
   EXPECT_GE(coloured, 1);
 }
 
+// The symbolic Galerkin product has the pattern of Eigen's numeric one, level by level, with
+// sorted row indices, on one thread as on all.
+TEST(SurfaceHierarchy, GalerkinPatternIsTheProductsPattern) {
+  const TriangleMesh m = load_mesh_spec("cgal:armadillo").mesh;
+  const SurfaceHierarchy h = build_surface_hierarchy(m.vertices, m.faces, {200, 16});
+  ASSERT_GE(h.levels(), 3);
+  SparseMatrix pattern = adjacency(m);
+  for (int l = h.levels() - 1; l > 0; --l) {
+    const SparseMatrix& P = h.prolongations[std::size_t(l - 1)];
+    SparseMatrix product = SparseMatrix(P.transpose()) * pattern * P;
+    product.makeCompressed();
+    const SparseMatrix symbolic = galerkin_pattern(P, pattern);
+    const SparseMatrix serial = [&] {
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      return galerkin_pattern(P, pattern);
+    }();
+    ASSERT_TRUE(symbolic.isCompressed());
+    ASSERT_EQ(symbolic.rows(), product.rows());
+    ASSERT_EQ(symbolic.cols(), product.cols());
+    ASSERT_EQ(symbolic.nonZeros(), product.nonZeros()) << "level " << l;
+    EXPECT_TRUE(std::equal(symbolic.outerIndexPtr(), symbolic.outerIndexPtr() + P.cols() + 1,
+                           product.outerIndexPtr()))
+        << "level " << l;
+    EXPECT_TRUE(std::equal(symbolic.innerIndexPtr(), symbolic.innerIndexPtr() + product.nonZeros(),
+                           product.innerIndexPtr()))
+        << "level " << l;
+    EXPECT_TRUE(std::equal(serial.innerIndexPtr(), serial.innerIndexPtr() + serial.nonZeros(),
+                           symbolic.innerIndexPtr()))
+        << "level " << l;
+    for (Eigen::Index k = 0; k < symbolic.nonZeros(); ++k) ASSERT_EQ(symbolic.valuePtr()[k], 1.0);
+    pattern = product;
+  }
+}
+
 // The same hierarchy twice, and on one thread as on all (the prolongation rows are found in
 // parallel).
 TEST(SurfaceHierarchy, TheBuildIsDeterministic) {
