@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -60,6 +61,128 @@ bool barycentric(const Eigen::RowVector3d& x, const Eigen::RowVector3d& a,
   return true;
 }
 
+/// A cell's key at a vertex: the distance to its sample and the sample's index, ordered
+/// lexicographically (ties in distance go to the smaller sample index).
+struct CellKey {
+  double distance;
+  int sample;
+  bool operator<(const CellKey& o) const {
+    return distance < o.distance || (distance == o.distance && sample < o.sample);
+  }
+  bool operator==(const CellKey& o) const = default;
+};
+
+/// graph_voronoi_cells by multi-source Dijkstra: the definition, and the fallback of the parallel
+/// search.
+std::vector<int> graph_voronoi_dijkstra(const std::vector<int>& start,
+                                        const std::vector<int>& neighbour, const Positions& points,
+                                        const std::vector<int>& sample) {
+  const int n = int(points.rows());
+  std::vector<double> dist(std::size_t(n), std::numeric_limits<double>::infinity());
+  std::vector<int> label(std::size_t(n), std::numeric_limits<int>::max());
+  using Entry = std::tuple<double, int, int>;  // distance, label, vertex
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (int v = 0; v < n; ++v)
+    if (sample[std::size_t(v)] >= 0) {
+      dist[std::size_t(v)] = 0;
+      label[std::size_t(v)] = sample[std::size_t(v)];
+      queue.emplace(0.0, label[std::size_t(v)], v);
+    }
+  while (!queue.empty()) {
+    const auto [d, lab, v] = queue.top();
+    queue.pop();
+    if (d != dist[std::size_t(v)] || lab != label[std::size_t(v)]) continue;
+    for (int k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+      const int w = neighbour[std::size_t(k)];
+      const double nd = d + (points.row(v) - points.row(w)).norm();
+      if (nd < dist[std::size_t(w)] ||
+          (nd == dist[std::size_t(w)] && lab < label[std::size_t(w)])) {
+        dist[std::size_t(w)] = nd;
+        label[std::size_t(w)] = lab;
+        queue.emplace(nd, lab, w);
+      }
+    }
+  }
+  return label;
+}
+
+}  // namespace
+
+std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
+                                     const std::vector<int>& neighbour, const Positions& points,
+                                     const std::vector<int>& sample) {
+  const int n = int(points.rows());
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  auto initial = [&](int v) {
+    const int s = sample[std::size_t(v)];
+    return s >= 0 ? CellKey{0.0, s} : CellKey{inf, std::numeric_limits<int>::max()};
+  };
+  // Edge lengths per stored entry (|p_v - p_w| is the same number either way round).
+  std::vector<double> length(neighbour.size());
+  parallel_for_indices(n, 2048, [&](int v) {
+    for (int k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k)
+      length[std::size_t(k)] = (points.row(v) - points.row(neighbour[std::size_t(k)])).norm();
+  });
+  // Jacobi sweeps of the equations that Dijkstra's keys satisfy,
+  //   key(w) = min(initial(w), min over neighbours v of (key(v).distance + |p_v - p_w|,
+  //   key(v).sample)),
+  // each vertex recomputed from its neighbours' keys of the sweep before (so each sweep is
+  // deterministic), and only when one of them changed. A sweep that changes nothing leaves a
+  // solution of the equations.
+  std::vector<CellKey> key(static_cast<std::size_t>(n)), next(static_cast<std::size_t>(n));
+  std::vector<char> changed(static_cast<std::size_t>(n), 1),
+      changed_next(static_cast<std::size_t>(n));
+  for (int v = 0; v < n; ++v) key[std::size_t(v)] = initial(v);
+  constexpr int max_sweeps = 64;  // beyond a few hops of paths, the priority queue is the cheaper
+  bool converged = false;
+  for (int sweep = 0; sweep < max_sweeps && !converged; ++sweep) {
+    std::atomic<bool> any{false};
+    parallel_for_indices(n, 2048, [&](int w) {
+      const int b = start[std::size_t(w)], e = start[std::size_t(w) + 1];
+      bool stale = false;
+      for (int k = b; k < e && !stale; ++k) stale = changed[std::size_t(neighbour[std::size_t(k)])];
+      CellKey best = key[std::size_t(w)];
+      if (stale) {
+        best = initial(w);
+        for (int k = b; k < e; ++k) {
+          const CellKey& kv = key[std::size_t(neighbour[std::size_t(k)])];
+          const CellKey r{kv.distance + length[std::size_t(k)], kv.sample};
+          if (r < best) best = r;
+        }
+      }
+      next[std::size_t(w)] = best;
+      const bool c = !(best == key[std::size_t(w)]);
+      changed_next[std::size_t(w)] = c;
+      if (c) any.store(true, std::memory_order_relaxed);
+    });
+    key.swap(next);
+    changed.swap(changed_next);
+    converged = !any.load();
+  }
+  // The equations have one solution when every vertex off its initial key takes it from a
+  // neighbour strictly nearer its sample (an edge too short to add to a distance, e.g. between
+  // coincident points, can break that): then it is Dijkstra's. Otherwise Dijkstra decides.
+  std::atomic<bool> unique{converged};
+  if (converged)
+    parallel_for_indices(n, 2048, [&](int w) {
+      const CellKey kw = key[std::size_t(w)];
+      if (kw == initial(w)) return;
+      for (int k = start[std::size_t(w)]; k < start[std::size_t(w) + 1]; ++k) {
+        const CellKey& kv = key[std::size_t(neighbour[std::size_t(k)])];
+        if (kv.distance < kw.distance &&
+            CellKey{kv.distance + length[std::size_t(k)], kv.sample} == kw)
+          return;
+      }
+      unique.store(false, std::memory_order_relaxed);
+    });
+  if (!unique.load()) return graph_voronoi_dijkstra(start, neighbour, points, sample);
+  std::vector<int> label(static_cast<std::size_t>(n));
+  parallel_for_indices(n, 4096, [&](int v) { label[std::size_t(v)] = key[std::size_t(v)].sample; });
+  return label;
+}
+
+namespace {
+
 /// One coarsening step (header, steps 1-4): the coarse level and the prolongation (fine x coarse).
 std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
   const int n = fine.size();
@@ -74,33 +197,9 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
     for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k)
       blocked[std::size_t(fine.neighbour[std::size_t(k)])] = 1;
   }
-  // 2. Graph Voronoi cells: (distance, sample) ordered lexicographically, so ties go to the
-  // smaller coarse index whatever the order of the queue.
-  std::vector<double> dist(std::size_t(n), std::numeric_limits<double>::infinity());
-  std::vector<int> label(std::size_t(n), std::numeric_limits<int>::max());
-  using Entry = std::tuple<double, int, int>;  // distance, label, vertex
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
-  for (int v = 0; v < n; ++v)
-    if (coarse_index[std::size_t(v)] >= 0) {
-      dist[std::size_t(v)] = 0;
-      label[std::size_t(v)] = coarse_index[std::size_t(v)];
-      queue.emplace(0.0, label[std::size_t(v)], v);
-    }
-  while (!queue.empty()) {
-    const auto [d, lab, v] = queue.top();
-    queue.pop();
-    if (d != dist[std::size_t(v)] || lab != label[std::size_t(v)]) continue;
-    for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
-      const int w = fine.neighbour[std::size_t(k)];
-      const double nd = d + (fine.points.row(v) - fine.points.row(w)).norm();
-      if (nd < dist[std::size_t(w)] ||
-          (nd == dist[std::size_t(w)] && lab < label[std::size_t(w)])) {
-        dist[std::size_t(w)] = nd;
-        label[std::size_t(w)] = lab;
-        queue.emplace(nd, lab, w);
-      }
-    }
-  }
+  // 2. Graph Voronoi cells.
+  const std::vector<int> label =
+      graph_voronoi_cells(fine.start, fine.neighbour, fine.points, coarse_index);
   // 3. The coarse level.
   LevelMesh coarse;
   coarse.points.resize(nc, 3);

@@ -59,6 +59,18 @@ struct SurfaceHierarchy {
 SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triangles& faces,
                                          const SurfaceHierarchyOptions& options = {});
 
+/// Graph Voronoi cells (header, step 2): for a graph in compressed rows (neighbours of v in
+/// neighbour[start[v] .. start[v+1]), symmetric, no self loops) with edge lengths |p_v - p_w|
+/// between its points, and sample[v] >= 0 the index of the sample at v (-1 elsewhere): per vertex,
+/// the index of the nearest sample by graph distance, ties to the smaller index
+/// (std::numeric_limits<int>::max() where no sample is reached). Exactly the labels of a
+/// multi-source Dijkstra that orders (distance, index) lexicographically, computed by parallel
+/// sweeps (deterministic) and checked to be those; where the check cannot tell (zero-length
+/// edges), by that Dijkstra.
+std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
+                                     const std::vector<int>& neighbour, const Positions& points,
+                                     const std::vector<int>& sample);
+
 /// The pattern (ones, sorted row indices) of the Galerkin product P^T A P of a fine pattern A
 /// (square, symmetric, compressed) and a prolongation P (fine x coarse): entry (I, J) wherever
 /// P(i, I) A(i, j) P(j, J) is stored for some i, j. The same pattern as Eigen's

@@ -15,6 +15,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <tuple>
 
 namespace mcf {
 namespace {
@@ -165,6 +169,101 @@ TEST(SurfaceHierarchy, ColouringsAreValidOnTheGalerkinPatterns) {
   EXPECT_LE(count, 6);
   EXPECT_FALSE(h.colours.back().empty());
   EXPECT_GE(coloured, 1);
+}
+
+/// The vertex graph of a mesh in compressed rows (sorted, no self loops).
+void vertex_graph(const TriangleMesh& m, std::vector<int>& start, std::vector<int>& neighbour) {
+  const int n = int(m.vertices.rows());
+  std::vector<std::vector<int>> adj(static_cast<std::size_t>(n));
+  for (Eigen::Index f = 0; f < m.faces.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int a = m.faces(f, c), b = m.faces(f, (c + 1) % 3);
+      adj[std::size_t(a)].push_back(b);
+      adj[std::size_t(b)].push_back(a);
+    }
+  start.assign(1, 0);
+  neighbour.clear();
+  for (auto& a : adj) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+    neighbour.insert(neighbour.end(), a.begin(), a.end());
+    start.push_back(int(neighbour.size()));
+  }
+}
+
+/// The definition of the graph Voronoi cells: multi-source Dijkstra on (distance, sample index).
+std::vector<int> voronoi_by_dijkstra(const std::vector<int>& start,
+                                     const std::vector<int>& neighbour, const Positions& p,
+                                     const std::vector<int>& sample) {
+  const std::size_t n = std::size_t(p.rows());
+  std::vector<double> dist(n, std::numeric_limits<double>::infinity());
+  std::vector<int> label(n, std::numeric_limits<int>::max());
+  using Entry = std::tuple<double, int, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (std::size_t v = 0; v < n; ++v)
+    if (sample[v] >= 0) {
+      dist[v] = 0;
+      label[v] = sample[v];
+      queue.emplace(0.0, sample[v], int(v));
+    }
+  while (!queue.empty()) {
+    const auto [d, lab, v] = queue.top();
+    queue.pop();
+    if (d != dist[std::size_t(v)] || lab != label[std::size_t(v)]) continue;
+    for (int k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+      const int w = neighbour[std::size_t(k)];
+      const double nd = d + (p.row(v) - p.row(w)).norm();
+      if (std::tie(nd, lab) < std::tie(dist[std::size_t(w)], label[std::size_t(w)])) {
+        dist[std::size_t(w)] = nd;
+        label[std::size_t(w)] = lab;
+        queue.emplace(nd, lab, w);
+      }
+    }
+  }
+  return label;
+}
+
+/// Samples at every `stride`-th vertex from `offset` (indices in vertex order).
+std::vector<int> every(int n, int stride, int offset) {
+  std::vector<int> sample(static_cast<std::size_t>(n), -1);
+  int c = 0;
+  for (int v = offset; v < n; v += stride) sample[std::size_t(v)] = c++;
+  return sample;
+}
+
+// The parallel sweeps find Dijkstra's cells exactly: with ties (a grid's equal edges), with cells
+// many hops wide (few samples: the sweeps give up and Dijkstra decides), with coincident points
+// (zero-length edges), on one thread as on all.
+TEST(SurfaceHierarchy, GraphVoronoiCellsAreDijkstras) {
+  struct Case {
+    TriangleMesh mesh;
+    const char* name;
+  };
+  std::vector<Case> cases;
+  cases.push_back({flat_grid(40), "grid"});
+  cases.push_back({load_mesh_spec("cgal:armadillo").mesh, "armadillo"});
+  {
+    // The grid with its first vertex's point copied onto its neighbours in the first face.
+    TriangleMesh m = flat_grid(20);
+    m.vertices.row(m.faces(0, 1)) = m.vertices.row(m.faces(0, 0));
+    m.vertices.row(m.faces(0, 2)) = m.vertices.row(m.faces(0, 0));
+    cases.push_back({m, "coincident"});
+  }
+  for (const Case& c : cases) {
+    std::vector<int> start, neighbour;
+    vertex_graph(c.mesh, start, neighbour);
+    const int n = int(c.mesh.vertices.rows());
+    for (const auto& [stride, offset] : {std::pair{2, 0}, {5, 1}, {7, 3}, {n / 3, 0}, {n, 0}}) {
+      const std::vector<int> sample = every(n, stride, offset);
+      const std::vector<int> expected =
+          voronoi_by_dijkstra(start, neighbour, c.mesh.vertices, sample);
+      EXPECT_EQ(graph_voronoi_cells(start, neighbour, c.mesh.vertices, sample), expected)
+          << c.name << " stride " << stride;
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      EXPECT_EQ(graph_voronoi_cells(start, neighbour, c.mesh.vertices, sample), expected)
+          << c.name << " stride " << stride << ", one thread";
+    }
+  }
 }
 
 // The symbolic Galerkin product has the pattern of Eigen's numeric one, level by level, with
