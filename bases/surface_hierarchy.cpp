@@ -241,15 +241,17 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
     for (std::size_t t = 0; t < coarse.triangles.size(); ++t)
       for (int c : coarse.triangles[t]) tri_of[std::size_t(fill[std::size_t(c)]++)] = int(t);
   }
-  // 4. Prolongation.
-  std::vector<Eigen::Triplet<double, int>> entries;
-  entries.reserve(std::size_t(3 * n));
-  for (int v = 0; v < n; ++v) {
+  // 4. Prolongation: each row's columns and weights (at most three; column -1 unused), found in
+  // parallel (a row by one task), then gathered into compressed columns in row order.
+  std::vector<std::array<int, 3>> row_column(static_cast<std::size_t>(n));
+  std::vector<std::array<double, 3>> row_weight(static_cast<std::size_t>(n));
+  parallel_for_indices(n, 1024, [&](int v) {
+    std::array<int, 3>& columns = row_column[std::size_t(v)];
+    std::array<double, 3>& weights = row_weight[std::size_t(v)];
     const int s = label[std::size_t(v)];
-    if (coarse_index[std::size_t(v)] >= 0) {
-      entries.emplace_back(v, s, 1.0);
-      continue;
-    }
+    columns = {s, -1, -1};
+    weights = {1.0, 0.0, 0.0};
+    if (coarse_index[std::size_t(v)] >= 0) return;
     double best = -std::numeric_limits<double>::infinity();
     std::array<double, 3> best_w{};
     int best_t = -1;
@@ -277,20 +279,36 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
         const int c = label[std::size_t(fine.neighbour[std::size_t(k)])];
         if (c != s) consider(c);
       }
-    if (best_t < 0) {
-      entries.emplace_back(v, s, 1.0);
-      continue;
-    }
+    if (best_t < 0) return;
     double sum = 0;
     for (double& w : best_w) sum += (w = std::max(w, 0.0));
     const auto& t = coarse.triangles[std::size_t(best_t)];
+    int kept = 0;
     for (int c = 0; c < 3; ++c)
-      if (best_w[std::size_t(c)] > 0)
-        entries.emplace_back(v, t[std::size_t(c)], best_w[std::size_t(c)] / sum);
-  }
+      if (best_w[std::size_t(c)] > 0) {
+        columns[std::size_t(kept)] = t[std::size_t(c)];
+        weights[std::size_t(kept++)] = best_w[std::size_t(c)] / sum;
+      }
+    for (; kept < 3; ++kept) columns[std::size_t(kept)] = -1;
+  });
   SparseMatrix P(n, nc);
-  P.setFromTriplets(entries.begin(), entries.end());
-  P.makeCompressed();
+  {
+    int* outer = P.outerIndexPtr();
+    for (const auto& columns : row_column)
+      for (int c : columns)
+        if (c >= 0) ++outer[c + 1];
+    for (int c = 0; c < nc; ++c) outer[c + 1] += outer[c];
+    P.resizeNonZeros(outer[nc]);
+    std::vector<int> fill(outer, outer + nc);
+    for (int v = 0; v < n; ++v)
+      for (int k = 0; k < 3; ++k) {
+        const int c = row_column[std::size_t(v)][std::size_t(k)];
+        if (c < 0) continue;
+        const int e = fill[std::size_t(c)]++;
+        P.innerIndexPtr()[e] = v;
+        P.valuePtr()[e] = row_weight[std::size_t(v)][std::size_t(k)];
+      }
+  }
   return {std::move(coarse), std::move(P)};
 }
 
