@@ -436,17 +436,26 @@ SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A) {
 }
 
 std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
+  if (!A.isCompressed()) {
+    SparseMatrix compressed = A;
+    compressed.makeCompressed();
+    return greedy_colouring(compressed, count);
+  }
   const int n = int(A.cols());
-  std::vector<int> degree(std::size_t(n), 0);
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  std::vector<int> degree(static_cast<std::size_t>(n), 0);
   for (int j = 0; j < n; ++j)
-    for (SparseMatrix::InnerIterator it(A, j); it; ++it)
-      if (it.row() != j) ++degree[std::size_t(j)];
+    for (int k = outer[j]; k < outer[j + 1]; ++k)
+      if (inner[k] != j) ++degree[std::size_t(j)];
   // Smallest-last order: repeatedly remove a vertex of least remaining degree (lazy buckets: a
-  // vertex is pushed again whenever its degree drops, stale entries are skipped).
+  // vertex is pushed again whenever its degree drops, stale entries are skipped). The vertices
+  // visit the pattern in no local order: the columns of the vertices just pushed, the likeliest
+  // to be removed next, are fetched ahead.
   const int max_degree = n ? *std::max_element(degree.begin(), degree.end()) : 0;
   std::vector<std::vector<int>> bucket(std::size_t(max_degree) + 1);
   for (int v = n - 1; v >= 0; --v) bucket[std::size_t(degree[std::size_t(v)])].push_back(v);
-  std::vector<char> removed(std::size_t(n), 0);
+  std::vector<char> removed(static_cast<std::size_t>(n), 0);
   std::vector<int> order;
   order.reserve(std::size_t(n));
   int low = 0;
@@ -457,21 +466,32 @@ std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
     if (removed[std::size_t(v)] || degree[std::size_t(v)] != low) continue;
     removed[std::size_t(v)] = 1;
     order.push_back(v);
-    for (SparseMatrix::InnerIterator it(A, v); it; ++it) {
-      const int w = int(it.row());
+    for (int k = outer[v]; k < outer[v + 1]; ++k) {
+      const int w = inner[k];
       if (w == v || removed[std::size_t(w)]) continue;
+      __builtin_prefetch(inner + outer[w]);
       bucket[std::size_t(--degree[std::size_t(w)])].push_back(w);
     }
     low = std::max(0, low - 1);
   }
-  std::vector<int> colour(std::size_t(n), -1);
+  // Greedy colours in the reverse order, which is known: each vertex's column is fetched a few
+  // vertices ahead, and its neighbours' colours a few after that.
+  std::vector<int> colour(static_cast<std::size_t>(n), -1);
   std::vector<int> used_by(std::size_t(max_degree) + 2, -1);  // colour -> last vertex that saw it
   int colours = 0;
-  for (auto it = order.rbegin(); it != order.rend(); ++it) {
-    const int v = *it;
-    for (SparseMatrix::InnerIterator e(A, v); e; ++e)
-      if (e.row() != v && colour[std::size_t(e.row())] >= 0)
-        used_by[std::size_t(colour[std::size_t(e.row())])] = v;
+  constexpr int ahead = 8;
+  for (int i = n - 1; i >= 0; --i) {
+    if (i >= 2 * ahead) __builtin_prefetch(inner + outer[order[std::size_t(i - 2 * ahead)]]);
+    if (i >= ahead) {
+      const int u = order[std::size_t(i - ahead)];
+      for (int k = outer[u]; k < outer[u + 1]; ++k)
+        __builtin_prefetch(&colour[std::size_t(inner[k])]);
+    }
+    const int v = order[std::size_t(i)];
+    for (int k = outer[v]; k < outer[v + 1]; ++k) {
+      const int w = inner[k];
+      if (w != v && colour[std::size_t(w)] >= 0) used_by[std::size_t(colour[std::size_t(w)])] = v;
+    }
     int c = 0;
     while (used_by[std::size_t(c)] == v) ++c;
     colour[std::size_t(v)] = c;
