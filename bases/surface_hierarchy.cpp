@@ -312,12 +312,13 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
   return {std::move(coarse), std::move(P)};
 }
 
-/// Sets over [0, universe) for the indices [0, n), in compressed rows: body(i, mark, out) appends
-/// set i's members to `out`, each once (mark[x] == i: x already appended; `mark` is the calling
-/// thread's, never reset); each set is then sorted if `sorted`. Fixed chunks of indices, each
-/// written by one task, so the arrays are the same for any thread count.
-template <class Body>
-void gather_sets(int n, int universe, bool sorted, Body&& body, std::vector<int>& start,
+/// Sets over [0, universe) for the indices [0, n), in compressed rows, unsorted: body(i, mark,
+/// out) writes set i's members to out[0 ..) and returns their number, where bound(i) is at least
+/// that number and mark[x] == i says x is already written (`mark` is the calling thread's, never
+/// reset). Fixed chunks of indices, each written by one task, so the arrays are the same for any
+/// thread count.
+template <class Bound, class Body>
+void gather_sets(int n, int universe, Bound&& bound, Body&& body, std::vector<int>& start,
                  std::vector<int>& member) {
   constexpr int chunk = 1024;
   const int chunks = (n + chunk - 1) / chunk;
@@ -330,9 +331,10 @@ void gather_sets(int n, int universe, bool sorted, Body&& body, std::vector<int>
     std::vector<int>& out = members[std::size_t(c)];
     for (int i = begin; i < end; ++i) {
       const std::size_t first = out.size();
-      body(i, mark, out);
-      if (sorted) std::sort(out.begin() + std::ptrdiff_t(first), out.end());
-      start[std::size_t(i) + 1] = int(out.size() - first);
+      out.resize(first + std::size_t(bound(i)));
+      const int count = body(i, mark.data(), out.data() + first);
+      out.resize(first + std::size_t(count));
+      start[std::size_t(i) + 1] = count;
     }
   });
   for (int i = 0; i < n; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
@@ -391,46 +393,63 @@ SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A) {
       for (int p = Pouter[J]; p < Pouter[J + 1]; ++p)
         row_coarse[std::size_t(fill[std::size_t(Pinner[p])]++)] = J;
   }
+  int longest_row = 0;
+  for (int i = 0; i < n; ++i)
+    longest_row = std::max(longest_row, row_start[std::size_t(i) + 1] - row_start[std::size_t(i)]);
   // Two set products, as the numeric product takes them: first the coarse vertices next to each
   // fine one (the pattern of P^T A, column j: every I with P(i, I) A(i, j) stored), then column J
   // of the product: the union of those sets over the fine vertices of P's column J. Taking the
-  // union per fine vertex first does each repeated I once.
+  // union per fine vertex first does each repeated I once. (Members are written whether new or
+  // not and kept by the count: no branch on the mark.)
   std::vector<int> near_start, near;
   gather_sets(
-      n, nc, false,
-      [&](int j, std::vector<int>& mark, std::vector<int>& out) {
+      n, nc, [&](int j) { return (Aouter[j + 1] - Aouter[j]) * longest_row; },
+      [&](int j, int* mark, int* out) {
+        int count = 0;
         for (int a = Aouter[j]; a < Aouter[j + 1]; ++a) {
           const int i = Ainner[a];
           for (int r = row_start[std::size_t(i)]; r < row_start[std::size_t(i) + 1]; ++r) {
             const int I = row_coarse[std::size_t(r)];
-            if (mark[std::size_t(I)] != j) {
-              mark[std::size_t(I)] = j;
-              out.push_back(I);
-            }
+            out[count] = I;
+            count += mark[I] != j;
+            mark[I] = j;
           }
         }
+        return count;
       },
       near_start, near);
+  int most_near = 0;
+  for (int j = 0; j < n; ++j)
+    most_near = std::max(most_near, near_start[std::size_t(j) + 1] - near_start[std::size_t(j)]);
   std::vector<int> outer, inner;
   gather_sets(
-      nc, nc, true,
-      [&](int J, std::vector<int>& mark, std::vector<int>& out) {
+      nc, nc, [&](int J) { return (Pouter[J + 1] - Pouter[J]) * most_near; },
+      [&](int J, int* mark, int* out) {
+        int count = 0;
         for (int p = Pouter[J]; p < Pouter[J + 1]; ++p) {
           const int j = Pinner[p];
           for (int r = near_start[std::size_t(j)]; r < near_start[std::size_t(j) + 1]; ++r) {
             const int I = near[std::size_t(r)];
-            if (mark[std::size_t(I)] != J) {
-              mark[std::size_t(I)] = J;
-              out.push_back(I);
-            }
+            out[count] = I;
+            count += mark[I] != J;
+            mark[I] = J;
           }
         }
+        return count;
       },
       outer, inner);
+  // The product is symmetric (A is): its transpose, taken by one counting pass over the columns in
+  // order, is the product with each column's rows ascending (row I's entries are column I's).
   SparseMatrix C(nc, nc);
   C.resizeNonZeros(Eigen::Index(inner.size()));
   std::copy(outer.begin(), outer.end(), C.outerIndexPtr());
-  std::copy(inner.begin(), inner.end(), C.innerIndexPtr());
+  {
+    int* sorted = C.innerIndexPtr();
+    std::vector<int> fill(outer.begin(), outer.end() - 1);
+    for (int J = 0; J < nc; ++J)
+      for (int e = outer[std::size_t(J)]; e < outer[std::size_t(J) + 1]; ++e)
+        sorted[fill[std::size_t(inner[std::size_t(e)])]++] = J;
+  }
   std::fill(C.valuePtr(), C.valuePtr() + C.nonZeros(), 1.0);
   return C;
 }

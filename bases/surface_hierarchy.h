@@ -72,7 +72,8 @@ std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
                                      const std::vector<int>& sample);
 
 /// The pattern (ones, sorted row indices) of the Galerkin product P^T A P of a fine pattern A
-/// (square, symmetric, compressed) and a prolongation P (fine x coarse): entry (I, J) wherever
+/// (square, symmetric — the result's rows are read off its columns —, compressed) and a
+/// prolongation P (fine x coarse, compressed): entry (I, J) wherever
 /// P(i, I) A(i, j) P(j, J) is stored for some i, j. The same pattern as Eigen's
 /// SparseMatrix(P^T) * A * P with positive values, in time linear in the triple products' terms,
 /// without values and in parallel over the coarse columns (deterministic).
