@@ -25,6 +25,52 @@ struct LevelMesh {
   int size() const { return int(points.rows()); }
 };
 
+/// Sets over [0, universe) for the indices [0, n), in compressed rows, unsorted: body(i, mark,
+/// out) writes set i's members to out[0 ..) and returns their number, where bound(i) is at least
+/// that number and mark[x] == i says x is already written (`mark` is the calling thread's, never
+/// reset). Fixed chunks of indices, each written by one task, so the arrays are the same for any
+/// thread count.
+template <class Bound, class Body>
+void gather_sets(int n, int universe, Bound&& bound, Body&& body, std::vector<int>& start,
+                 std::vector<int>& member) {
+  constexpr int chunk = 1024;
+  const int chunks = (n + chunk - 1) / chunk;
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(chunks));
+  start.assign(std::size_t(n) + 1, 0);
+  tbb::enumerable_thread_specific<std::vector<int>> marks(
+      [universe] { return std::vector<int>(std::size_t(universe), -1); });
+  parallel_for_chunks(n, chunk, [&](int c, int begin, int end) {
+    std::vector<int>& mark = marks.local();
+    std::vector<int>& out = members[std::size_t(c)];
+    for (int i = begin; i < end; ++i) {
+      const std::size_t first = out.size();
+      out.resize(first + std::size_t(bound(i)));
+      const int count = body(i, mark.data(), out.data() + first);
+      out.resize(first + std::size_t(count));
+      start[std::size_t(i) + 1] = count;
+    }
+  });
+  for (int i = 0; i < n; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
+  member.resize(std::size_t(start.back()));
+  parallel_for_indices(chunks, 1, [&](int c) {
+    std::copy(members[std::size_t(c)].begin(), members[std::size_t(c)].end(),
+              member.begin() + start[std::size_t(c) * chunk]);
+  });
+}
+
+/// Sorts the sets of a symmetric relation in compressed rows (x in set y exactly when y is in set
+/// x): its transpose, taken by one counting pass over the sets in order, is the relation with each
+/// set ascending (set x's members are the sets that hold x).
+void sort_symmetric_sets(const std::vector<int>& start, std::vector<int>& member) {
+  std::vector<int> sorted(member.size());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  const int n = int(start.size()) - 1;
+  for (int y = 0; y < n; ++y)
+    for (int e = start[std::size_t(y)]; e < start[std::size_t(y) + 1]; ++e)
+      sorted[std::size_t(fill[std::size_t(member[std::size_t(e)])]++)] = y;
+  member.swap(sorted);
+}
+
 /// CSR of the undirected graph of `pairs` (each given once or twice) on n vertices.
 void build_graph(int n, std::vector<std::pair<int, int>>& pairs, LevelMesh& level) {
   undirected_graph(n, pairs, level.start, level.neighbour);
@@ -206,30 +252,90 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
   for (int v = 0; v < n; ++v)
     if (coarse_index[std::size_t(v)] >= 0)
       coarse.points.row(coarse_index[std::size_t(v)]) = fine.points.row(v);
-  std::vector<std::pair<int, int>> edges;
-  for (int v = 0; v < n; ++v)
-    for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
-      const int a = label[std::size_t(v)], b = label[std::size_t(fine.neighbour[std::size_t(k)])];
-      if (a < b) edges.emplace_back(a, b);
-    }
-  build_graph(nc, edges, coarse);
+  // Its graph: cells joined by a fine edge. Each cell's fine vertices (in index order), then per
+  // cell the other cells its vertices' neighbours lie in.
+  std::vector<int> cell_start(std::size_t(nc) + 1, 0), cell_vertex(static_cast<std::size_t>(n));
+  for (int v = 0; v < n; ++v) ++cell_start[std::size_t(label[std::size_t(v)]) + 1];
+  for (int c = 0; c < nc; ++c) cell_start[std::size_t(c) + 1] += cell_start[std::size_t(c)];
+  {
+    std::vector<int> fill(cell_start.begin(), cell_start.end() - 1);
+    for (int v = 0; v < n; ++v)
+      cell_vertex[std::size_t(fill[std::size_t(label[std::size_t(v)])]++)] = v;
+  }
+  gather_sets(
+      nc, nc,
+      [&](int c) {
+        int degrees = 0;
+        for (int k = cell_start[std::size_t(c)]; k < cell_start[std::size_t(c) + 1]; ++k) {
+          const int v = cell_vertex[std::size_t(k)];
+          degrees += fine.start[std::size_t(v) + 1] - fine.start[std::size_t(v)];
+        }
+        return degrees;
+      },
+      [&](int c, int* mark, int* out) {
+        int count = 0;
+        for (int k = cell_start[std::size_t(c)]; k < cell_start[std::size_t(c) + 1]; ++k) {
+          const int v = cell_vertex[std::size_t(k)];
+          for (int e = fine.start[std::size_t(v)]; e < fine.start[std::size_t(v) + 1]; ++e) {
+            const int d = label[std::size_t(fine.neighbour[std::size_t(e)])];
+            out[count] = d;
+            count += d != c && mark[d] != c;
+            mark[d] = c;
+          }
+        }
+        return count;
+      },
+      coarse.start, coarse.neighbour);
+  sort_symmetric_sets(coarse.start, coarse.neighbour);
   // Triangles with three distinct cells, rotated to start at their smallest index (orientation
-  // kept); the first of several fine triangles that map to one coarse triangle is kept.
-  std::vector<std::pair<std::array<int, 3>, std::array<int, 3>>> keyed;  // sorted key, rotated
-  for (const auto& t : fine.triangles) {
+  // kept), in the order of their sorted corners; the first of several fine triangles that map to
+  // one coarse triangle is kept. They are bucketed by their first corner in fine order, and each
+  // bucket (a few triangles) is sorted stably by the other two corners.
+  const auto F = fine.triangles.size();
+  std::vector<std::array<int, 3>> rotated(F);
+  parallel_for_indices(F, 4096, [&](std::size_t f) {
+    const auto& t = fine.triangles[f];
     std::array<int, 3> c = {label[std::size_t(t[0])], label[std::size_t(t[1])],
                             label[std::size_t(t[2])]};
-    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+      rotated[f][0] = -1;
+      return;
+    }
     const int r = int(std::min_element(c.begin(), c.end()) - c.begin());
     std::rotate(c.begin(), c.begin() + r, c.end());
-    std::array<int, 3> key = c;
-    std::sort(key.begin(), key.end());
-    keyed.emplace_back(key, c);
+    rotated[f] = c;
+  });
+  std::vector<int> first_start(std::size_t(nc) + 1, 0);
+  for (const auto& c : rotated)
+    if (c[0] >= 0) ++first_start[std::size_t(c[0]) + 1];
+  for (int c = 0; c < nc; ++c) first_start[std::size_t(c) + 1] += first_start[std::size_t(c)];
+  std::vector<std::array<int, 3>> bucketed(std::size_t(first_start.back()));
+  {
+    std::vector<int> fill(first_start.begin(), first_start.end() - 1);
+    for (const auto& c : rotated)
+      if (c[0] >= 0) bucketed[std::size_t(fill[std::size_t(c[0])]++)] = c;
   }
-  std::stable_sort(keyed.begin(), keyed.end(),
-                   [](const auto& x, const auto& y) { return x.first < y.first; });
-  for (std::size_t k = 0; k < keyed.size(); ++k)
-    if (k == 0 || keyed[k].first != keyed[k - 1].first) coarse.triangles.push_back(keyed[k].second);
+  std::vector<int> kept(std::size_t(nc) + 1, 0);
+  parallel_for_indices(nc, 1024, [&](int c) {
+    const auto b = bucketed.begin() + first_start[std::size_t(c)];
+    const auto e = bucketed.begin() + first_start[std::size_t(c) + 1];
+    auto rest = [](const std::array<int, 3>& t) {
+      return std::pair{std::min(t[1], t[2]), std::max(t[1], t[2])};
+    };
+    for (auto i = b; i != e; ++i)  // stable insertion sort
+      for (auto j = i; j != b && rest(*j) < rest(*(j - 1)); --j) std::iter_swap(j, j - 1);
+    auto out = b;
+    for (auto i = b; i != e; ++i)
+      if (i == b || rest(*i) != rest(*(i - 1))) *out++ = *i;
+    kept[std::size_t(c) + 1] = int(out - b);
+  });
+  for (int c = 0; c < nc; ++c) kept[std::size_t(c) + 1] += kept[std::size_t(c)];
+  coarse.triangles.resize(std::size_t(kept.back()));
+  parallel_for_indices(nc, 1024, [&](int c) {
+    std::copy_n(bucketed.begin() + first_start[std::size_t(c)],
+                kept[std::size_t(c) + 1] - kept[std::size_t(c)],
+                coarse.triangles.begin() + kept[std::size_t(c)]);
+  });
   // Triangles around each coarse vertex.
   std::vector<int> tri_start(std::size_t(nc) + 1, 0), tri_of;
   for (const auto& t : coarse.triangles)
@@ -310,39 +416,6 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
       }
   }
   return {std::move(coarse), std::move(P)};
-}
-
-/// Sets over [0, universe) for the indices [0, n), in compressed rows, unsorted: body(i, mark,
-/// out) writes set i's members to out[0 ..) and returns their number, where bound(i) is at least
-/// that number and mark[x] == i says x is already written (`mark` is the calling thread's, never
-/// reset). Fixed chunks of indices, each written by one task, so the arrays are the same for any
-/// thread count.
-template <class Bound, class Body>
-void gather_sets(int n, int universe, Bound&& bound, Body&& body, std::vector<int>& start,
-                 std::vector<int>& member) {
-  constexpr int chunk = 1024;
-  const int chunks = (n + chunk - 1) / chunk;
-  std::vector<std::vector<int>> members(static_cast<std::size_t>(chunks));
-  start.assign(std::size_t(n) + 1, 0);
-  tbb::enumerable_thread_specific<std::vector<int>> marks(
-      [universe] { return std::vector<int>(std::size_t(universe), -1); });
-  parallel_for_chunks(n, chunk, [&](int c, int begin, int end) {
-    std::vector<int>& mark = marks.local();
-    std::vector<int>& out = members[std::size_t(c)];
-    for (int i = begin; i < end; ++i) {
-      const std::size_t first = out.size();
-      out.resize(first + std::size_t(bound(i)));
-      const int count = body(i, mark.data(), out.data() + first);
-      out.resize(first + std::size_t(count));
-      start[std::size_t(i) + 1] = count;
-    }
-  });
-  for (int i = 0; i < n; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
-  member.resize(std::size_t(start.back()));
-  parallel_for_indices(chunks, 1, [&](int c) {
-    std::copy(members[std::size_t(c)].begin(), members[std::size_t(c)].end(),
-              member.begin() + start[std::size_t(c) * chunk]);
-  });
 }
 
 /// The symmetric pattern (ones) of a level's graph with its diagonal, written straight into the
@@ -438,18 +511,12 @@ SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A) {
         return count;
       },
       outer, inner);
-  // The product is symmetric (A is): its transpose, taken by one counting pass over the columns in
-  // order, is the product with each column's rows ascending (row I's entries are column I's).
+  // The product is symmetric (A is).
+  sort_symmetric_sets(outer, inner);
   SparseMatrix C(nc, nc);
   C.resizeNonZeros(Eigen::Index(inner.size()));
   std::copy(outer.begin(), outer.end(), C.outerIndexPtr());
-  {
-    int* sorted = C.innerIndexPtr();
-    std::vector<int> fill(outer.begin(), outer.end() - 1);
-    for (int J = 0; J < nc; ++J)
-      for (int e = outer[std::size_t(J)]; e < outer[std::size_t(J) + 1]; ++e)
-        sorted[fill[std::size_t(inner[std::size_t(e)])]++] = J;
-  }
+  std::copy(inner.begin(), inner.end(), C.innerIndexPtr());
   std::fill(C.valuePtr(), C.valuePtr() + C.nonZeros(), 1.0);
   return C;
 }
