@@ -27,7 +27,9 @@
 // the multigrid can relax colour by colour in parallel; a level that needs more than the eight
 // colours the solver takes gets no colouring and is relaxed serially.
 //
-// Everything is deterministic: serial loops in fixed orders, ties broken by index.
+// Everything is deterministic: serial loops in fixed orders, ties broken by index, and parallel
+// loops whose iterations write disjoint outputs, over fixed chunks where they gather (the same
+// hierarchy for any thread count).
 
 #include "core/sparse.h"
 #include "datasets/mesh.h"
