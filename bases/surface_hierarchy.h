@@ -67,8 +67,9 @@ SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triang
 /// the index of the nearest sample by graph distance, ties to the smaller index
 /// (std::numeric_limits<int>::max() where no sample is reached). Exactly the labels of a
 /// multi-source Dijkstra that orders (distance, index) lexicographically, computed by parallel
-/// sweeps (deterministic) and checked to be those; where the check cannot tell (zero-length
-/// edges), by that Dijkstra.
+/// sweeps (deterministic) and checked to be those; where the check cannot tell (an edge too short
+/// to add to a distance, e.g. between coincident points) or the sweeps do not settle within 64
+/// (cells many edges wide), by that Dijkstra.
 std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
                                      const std::vector<int>& neighbour, const Positions& points,
                                      const std::vector<int>& sample);
