@@ -1,9 +1,13 @@
 #include "bases/surface_hierarchy.h"
 
+#include "core/parallel.h"
 #include "core/undirected_graph.h"
+
+#include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -20,6 +24,52 @@ struct LevelMesh {
   std::vector<std::array<int, 3>> triangles;
   int size() const { return int(points.rows()); }
 };
+
+/// Sets over [0, universe) for the indices [0, n), in compressed rows, unsorted: body(i, mark,
+/// out) writes set i's members to out[0 ..) and returns their number, where bound(i) is at least
+/// that number and mark[x] == i says x is already written (`mark` is the calling thread's, never
+/// reset). Fixed chunks of indices, each written by one task, so the arrays are the same for any
+/// thread count.
+template <class Bound, class Body>
+void gather_sets(int n, int universe, Bound&& bound, Body&& body, std::vector<int>& start,
+                 std::vector<int>& member) {
+  constexpr int chunk = 1024;
+  const int chunks = (n + chunk - 1) / chunk;
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(chunks));
+  start.assign(std::size_t(n) + 1, 0);
+  tbb::enumerable_thread_specific<std::vector<int>> marks(
+      [universe] { return std::vector<int>(std::size_t(universe), -1); });
+  parallel_for_chunks(n, chunk, [&](int c, int begin, int end) {
+    std::vector<int>& mark = marks.local();
+    std::vector<int>& out = members[std::size_t(c)];
+    for (int i = begin; i < end; ++i) {
+      const std::size_t first = out.size();
+      out.resize(first + std::size_t(bound(i)));
+      const int count = body(i, mark.data(), out.data() + first);
+      out.resize(first + std::size_t(count));
+      start[std::size_t(i) + 1] = count;
+    }
+  });
+  for (int i = 0; i < n; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
+  member.resize(std::size_t(start.back()));
+  parallel_for_indices(chunks, 1, [&](int c) {
+    std::copy(members[std::size_t(c)].begin(), members[std::size_t(c)].end(),
+              member.begin() + start[std::size_t(c) * chunk]);
+  });
+}
+
+/// Sorts the sets of a symmetric relation in compressed rows (x in set y exactly when y is in set
+/// x): its transpose, taken by one counting pass over the sets in order, is the relation with each
+/// set ascending (set x's members are the sets that hold x).
+void sort_symmetric_sets(const std::vector<int>& start, std::vector<int>& member) {
+  std::vector<int> sorted(member.size());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  const int n = int(start.size()) - 1;
+  for (int y = 0; y < n; ++y)
+    for (int e = start[std::size_t(y)]; e < start[std::size_t(y) + 1]; ++e)
+      sorted[std::size_t(fill[std::size_t(member[std::size_t(e)])]++)] = y;
+  member.swap(sorted);
+}
 
 /// CSR of the undirected graph of `pairs` (each given once or twice) on n vertices.
 void build_graph(int n, std::vector<std::pair<int, int>>& pairs, LevelMesh& level) {
@@ -57,6 +107,128 @@ bool barycentric(const Eigen::RowVector3d& x, const Eigen::RowVector3d& a,
   return true;
 }
 
+/// A cell's key at a vertex: the distance to its sample and the sample's index, ordered
+/// lexicographically (ties in distance go to the smaller sample index).
+struct CellKey {
+  double distance;
+  int sample;
+  bool operator<(const CellKey& o) const {
+    return distance < o.distance || (distance == o.distance && sample < o.sample);
+  }
+  bool operator==(const CellKey& o) const = default;
+};
+
+/// graph_voronoi_cells by multi-source Dijkstra: the definition, and the fallback of the parallel
+/// search.
+std::vector<int> graph_voronoi_dijkstra(const std::vector<int>& start,
+                                        const std::vector<int>& neighbour, const Positions& points,
+                                        const std::vector<int>& sample) {
+  const int n = int(points.rows());
+  std::vector<double> dist(std::size_t(n), std::numeric_limits<double>::infinity());
+  std::vector<int> label(std::size_t(n), std::numeric_limits<int>::max());
+  using Entry = std::tuple<double, int, int>;  // distance, label, vertex
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (int v = 0; v < n; ++v)
+    if (sample[std::size_t(v)] >= 0) {
+      dist[std::size_t(v)] = 0;
+      label[std::size_t(v)] = sample[std::size_t(v)];
+      queue.emplace(0.0, label[std::size_t(v)], v);
+    }
+  while (!queue.empty()) {
+    const auto [d, lab, v] = queue.top();
+    queue.pop();
+    if (d != dist[std::size_t(v)] || lab != label[std::size_t(v)]) continue;
+    for (int k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+      const int w = neighbour[std::size_t(k)];
+      const double nd = d + (points.row(v) - points.row(w)).norm();
+      if (nd < dist[std::size_t(w)] ||
+          (nd == dist[std::size_t(w)] && lab < label[std::size_t(w)])) {
+        dist[std::size_t(w)] = nd;
+        label[std::size_t(w)] = lab;
+        queue.emplace(nd, lab, w);
+      }
+    }
+  }
+  return label;
+}
+
+}  // namespace
+
+std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
+                                     const std::vector<int>& neighbour, const Positions& points,
+                                     const std::vector<int>& sample) {
+  const int n = int(points.rows());
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  auto initial = [&](int v) {
+    const int s = sample[std::size_t(v)];
+    return s >= 0 ? CellKey{0.0, s} : CellKey{inf, std::numeric_limits<int>::max()};
+  };
+  // Edge lengths per stored entry (|p_v - p_w| is the same number either way round).
+  std::vector<double> length(neighbour.size());
+  parallel_for_indices(n, 2048, [&](int v) {
+    for (int k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k)
+      length[std::size_t(k)] = (points.row(v) - points.row(neighbour[std::size_t(k)])).norm();
+  });
+  // Jacobi sweeps of the equations that Dijkstra's keys satisfy,
+  //   key(w) = min(initial(w), min over neighbours v of (key(v).distance + |p_v - p_w|,
+  //   key(v).sample)),
+  // each vertex recomputed from its neighbours' keys of the sweep before (so each sweep is
+  // deterministic), and only when one of them changed. A sweep that changes nothing leaves a
+  // solution of the equations.
+  std::vector<CellKey> key(static_cast<std::size_t>(n)), next(static_cast<std::size_t>(n));
+  std::vector<char> changed(static_cast<std::size_t>(n), 1),
+      changed_next(static_cast<std::size_t>(n));
+  for (int v = 0; v < n; ++v) key[std::size_t(v)] = initial(v);
+  constexpr int max_sweeps = 64;  // beyond a few hops of paths, the priority queue is the cheaper
+  bool converged = false;
+  for (int sweep = 0; sweep < max_sweeps && !converged; ++sweep) {
+    std::atomic<bool> any{false};
+    parallel_for_indices(n, 2048, [&](int w) {
+      const int b = start[std::size_t(w)], e = start[std::size_t(w) + 1];
+      bool stale = false;
+      for (int k = b; k < e && !stale; ++k) stale = changed[std::size_t(neighbour[std::size_t(k)])];
+      CellKey best = key[std::size_t(w)];
+      if (stale) {
+        best = initial(w);
+        for (int k = b; k < e; ++k) {
+          const CellKey& kv = key[std::size_t(neighbour[std::size_t(k)])];
+          const CellKey r{kv.distance + length[std::size_t(k)], kv.sample};
+          if (r < best) best = r;
+        }
+      }
+      next[std::size_t(w)] = best;
+      const bool c = !(best == key[std::size_t(w)]);
+      changed_next[std::size_t(w)] = c;
+      if (c) any.store(true, std::memory_order_relaxed);
+    });
+    key.swap(next);
+    changed.swap(changed_next);
+    converged = !any.load();
+  }
+  // The equations have one solution when every vertex off its initial key takes it from a
+  // neighbour strictly nearer its sample (an edge too short to add to a distance, e.g. between
+  // coincident points, can break that): then it is Dijkstra's. Otherwise Dijkstra decides.
+  std::atomic<bool> unique{converged};
+  if (converged)
+    parallel_for_indices(n, 2048, [&](int w) {
+      const CellKey kw = key[std::size_t(w)];
+      if (kw == initial(w)) return;
+      for (int k = start[std::size_t(w)]; k < start[std::size_t(w) + 1]; ++k) {
+        const CellKey& kv = key[std::size_t(neighbour[std::size_t(k)])];
+        if (kv.distance < kw.distance &&
+            CellKey{kv.distance + length[std::size_t(k)], kv.sample} == kw)
+          return;
+      }
+      unique.store(false, std::memory_order_relaxed);
+    });
+  if (!unique.load()) return graph_voronoi_dijkstra(start, neighbour, points, sample);
+  std::vector<int> label(static_cast<std::size_t>(n));
+  parallel_for_indices(n, 4096, [&](int v) { label[std::size_t(v)] = key[std::size_t(v)].sample; });
+  return label;
+}
+
+namespace {
+
 /// One coarsening step (header, steps 1-4): the coarse level and the prolongation (fine x coarse).
 std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
   const int n = fine.size();
@@ -71,63 +243,99 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
     for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k)
       blocked[std::size_t(fine.neighbour[std::size_t(k)])] = 1;
   }
-  // 2. Graph Voronoi cells: (distance, sample) ordered lexicographically, so ties go to the
-  // smaller coarse index whatever the order of the queue.
-  std::vector<double> dist(std::size_t(n), std::numeric_limits<double>::infinity());
-  std::vector<int> label(std::size_t(n), std::numeric_limits<int>::max());
-  using Entry = std::tuple<double, int, int>;  // distance, label, vertex
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
-  for (int v = 0; v < n; ++v)
-    if (coarse_index[std::size_t(v)] >= 0) {
-      dist[std::size_t(v)] = 0;
-      label[std::size_t(v)] = coarse_index[std::size_t(v)];
-      queue.emplace(0.0, label[std::size_t(v)], v);
-    }
-  while (!queue.empty()) {
-    const auto [d, lab, v] = queue.top();
-    queue.pop();
-    if (d != dist[std::size_t(v)] || lab != label[std::size_t(v)]) continue;
-    for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
-      const int w = fine.neighbour[std::size_t(k)];
-      const double nd = d + (fine.points.row(v) - fine.points.row(w)).norm();
-      if (nd < dist[std::size_t(w)] ||
-          (nd == dist[std::size_t(w)] && lab < label[std::size_t(w)])) {
-        dist[std::size_t(w)] = nd;
-        label[std::size_t(w)] = lab;
-        queue.emplace(nd, lab, w);
-      }
-    }
-  }
+  // 2. Graph Voronoi cells.
+  const std::vector<int> label =
+      graph_voronoi_cells(fine.start, fine.neighbour, fine.points, coarse_index);
   // 3. The coarse level.
   LevelMesh coarse;
   coarse.points.resize(nc, 3);
   for (int v = 0; v < n; ++v)
     if (coarse_index[std::size_t(v)] >= 0)
       coarse.points.row(coarse_index[std::size_t(v)]) = fine.points.row(v);
-  std::vector<std::pair<int, int>> edges;
-  for (int v = 0; v < n; ++v)
-    for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k) {
-      const int a = label[std::size_t(v)], b = label[std::size_t(fine.neighbour[std::size_t(k)])];
-      if (a < b) edges.emplace_back(a, b);
-    }
-  build_graph(nc, edges, coarse);
+  // Its graph: cells joined by a fine edge. Each cell's fine vertices (in index order), then per
+  // cell the other cells its vertices' neighbours lie in.
+  std::vector<int> cell_start(std::size_t(nc) + 1, 0), cell_vertex(static_cast<std::size_t>(n));
+  for (int v = 0; v < n; ++v) ++cell_start[std::size_t(label[std::size_t(v)]) + 1];
+  for (int c = 0; c < nc; ++c) cell_start[std::size_t(c) + 1] += cell_start[std::size_t(c)];
+  {
+    std::vector<int> fill(cell_start.begin(), cell_start.end() - 1);
+    for (int v = 0; v < n; ++v)
+      cell_vertex[std::size_t(fill[std::size_t(label[std::size_t(v)])]++)] = v;
+  }
+  gather_sets(
+      nc, nc,
+      [&](int c) {
+        int degrees = 0;
+        for (int k = cell_start[std::size_t(c)]; k < cell_start[std::size_t(c) + 1]; ++k) {
+          const int v = cell_vertex[std::size_t(k)];
+          degrees += fine.start[std::size_t(v) + 1] - fine.start[std::size_t(v)];
+        }
+        return degrees;
+      },
+      [&](int c, int* mark, int* out) {
+        int count = 0;
+        for (int k = cell_start[std::size_t(c)]; k < cell_start[std::size_t(c) + 1]; ++k) {
+          const int v = cell_vertex[std::size_t(k)];
+          for (int e = fine.start[std::size_t(v)]; e < fine.start[std::size_t(v) + 1]; ++e) {
+            const int d = label[std::size_t(fine.neighbour[std::size_t(e)])];
+            out[count] = d;
+            count += d != c && mark[d] != c;
+            mark[d] = c;
+          }
+        }
+        return count;
+      },
+      coarse.start, coarse.neighbour);
+  sort_symmetric_sets(coarse.start, coarse.neighbour);
   // Triangles with three distinct cells, rotated to start at their smallest index (orientation
-  // kept); the first of several fine triangles that map to one coarse triangle is kept.
-  std::vector<std::pair<std::array<int, 3>, std::array<int, 3>>> keyed;  // sorted key, rotated
-  for (const auto& t : fine.triangles) {
+  // kept), in the order of their sorted corners; the first of several fine triangles that map to
+  // one coarse triangle is kept. They are bucketed by their first corner in fine order, and each
+  // bucket (a few triangles) is sorted stably by the other two corners.
+  const auto F = fine.triangles.size();
+  std::vector<std::array<int, 3>> rotated(F);
+  parallel_for_indices(F, 4096, [&](std::size_t f) {
+    const auto& t = fine.triangles[f];
     std::array<int, 3> c = {label[std::size_t(t[0])], label[std::size_t(t[1])],
                             label[std::size_t(t[2])]};
-    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+      rotated[f][0] = -1;
+      return;
+    }
     const int r = int(std::min_element(c.begin(), c.end()) - c.begin());
     std::rotate(c.begin(), c.begin() + r, c.end());
-    std::array<int, 3> key = c;
-    std::sort(key.begin(), key.end());
-    keyed.emplace_back(key, c);
+    rotated[f] = c;
+  });
+  std::vector<int> first_start(std::size_t(nc) + 1, 0);
+  for (const auto& c : rotated)
+    if (c[0] >= 0) ++first_start[std::size_t(c[0]) + 1];
+  for (int c = 0; c < nc; ++c) first_start[std::size_t(c) + 1] += first_start[std::size_t(c)];
+  std::vector<std::array<int, 3>> bucketed(std::size_t(first_start.back()));
+  {
+    std::vector<int> fill(first_start.begin(), first_start.end() - 1);
+    for (const auto& c : rotated)
+      if (c[0] >= 0) bucketed[std::size_t(fill[std::size_t(c[0])]++)] = c;
   }
-  std::stable_sort(keyed.begin(), keyed.end(),
-                   [](const auto& x, const auto& y) { return x.first < y.first; });
-  for (std::size_t k = 0; k < keyed.size(); ++k)
-    if (k == 0 || keyed[k].first != keyed[k - 1].first) coarse.triangles.push_back(keyed[k].second);
+  std::vector<int> kept(std::size_t(nc) + 1, 0);
+  parallel_for_indices(nc, 1024, [&](int c) {
+    const auto b = bucketed.begin() + first_start[std::size_t(c)];
+    const auto e = bucketed.begin() + first_start[std::size_t(c) + 1];
+    auto rest = [](const std::array<int, 3>& t) {
+      return std::pair{std::min(t[1], t[2]), std::max(t[1], t[2])};
+    };
+    for (auto i = b; i != e; ++i)  // stable insertion sort
+      for (auto j = i; j != b && rest(*j) < rest(*(j - 1)); --j) std::iter_swap(j, j - 1);
+    auto out = b;
+    for (auto i = b; i != e; ++i)
+      if (i == b || rest(*i) != rest(*(i - 1))) *out++ = *i;
+    kept[std::size_t(c) + 1] = int(out - b);
+  });
+  for (int c = 0; c < nc; ++c) kept[std::size_t(c) + 1] += kept[std::size_t(c)];
+  coarse.triangles.resize(std::size_t(kept.back()));
+  parallel_for_indices(nc, 1024, [&](int c) {
+    std::copy_n(bucketed.begin() + first_start[std::size_t(c)],
+                kept[std::size_t(c) + 1] - kept[std::size_t(c)],
+                coarse.triangles.begin() + kept[std::size_t(c)]);
+  });
   // Triangles around each coarse vertex.
   std::vector<int> tri_start(std::size_t(nc) + 1, 0), tri_of;
   for (const auto& t : coarse.triangles)
@@ -139,15 +347,17 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
     for (std::size_t t = 0; t < coarse.triangles.size(); ++t)
       for (int c : coarse.triangles[t]) tri_of[std::size_t(fill[std::size_t(c)]++)] = int(t);
   }
-  // 4. Prolongation.
-  std::vector<Eigen::Triplet<double, int>> entries;
-  entries.reserve(std::size_t(3 * n));
-  for (int v = 0; v < n; ++v) {
+  // 4. Prolongation: each row's columns and weights (at most three; column -1 unused), found in
+  // parallel (a row by one task), then gathered into compressed columns in row order.
+  std::vector<std::array<int, 3>> row_column(static_cast<std::size_t>(n));
+  std::vector<std::array<double, 3>> row_weight(static_cast<std::size_t>(n));
+  parallel_for_indices(n, 1024, [&](int v) {
+    std::array<int, 3>& columns = row_column[std::size_t(v)];
+    std::array<double, 3>& weights = row_weight[std::size_t(v)];
     const int s = label[std::size_t(v)];
-    if (coarse_index[std::size_t(v)] >= 0) {
-      entries.emplace_back(v, s, 1.0);
-      continue;
-    }
+    columns = {s, -1, -1};
+    weights = {1.0, 0.0, 0.0};
+    if (coarse_index[std::size_t(v)] >= 0) return;
     double best = -std::numeric_limits<double>::infinity();
     std::array<double, 3> best_w{};
     int best_t = -1;
@@ -175,36 +385,59 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
         const int c = label[std::size_t(fine.neighbour[std::size_t(k)])];
         if (c != s) consider(c);
       }
-    if (best_t < 0) {
-      entries.emplace_back(v, s, 1.0);
-      continue;
-    }
+    if (best_t < 0) return;
     double sum = 0;
     for (double& w : best_w) sum += (w = std::max(w, 0.0));
     const auto& t = coarse.triangles[std::size_t(best_t)];
+    int kept = 0;
     for (int c = 0; c < 3; ++c)
-      if (best_w[std::size_t(c)] > 0)
-        entries.emplace_back(v, t[std::size_t(c)], best_w[std::size_t(c)] / sum);
-  }
+      if (best_w[std::size_t(c)] > 0) {
+        columns[std::size_t(kept)] = t[std::size_t(c)];
+        weights[std::size_t(kept++)] = best_w[std::size_t(c)] / sum;
+      }
+    for (; kept < 3; ++kept) columns[std::size_t(kept)] = -1;
+  });
   SparseMatrix P(n, nc);
-  P.setFromTriplets(entries.begin(), entries.end());
-  P.makeCompressed();
+  {
+    int* outer = P.outerIndexPtr();
+    for (const auto& columns : row_column)
+      for (int c : columns)
+        if (c >= 0) ++outer[c + 1];
+    for (int c = 0; c < nc; ++c) outer[c + 1] += outer[c];
+    P.resizeNonZeros(outer[nc]);
+    std::vector<int> fill(outer, outer + nc);
+    for (int v = 0; v < n; ++v)
+      for (int k = 0; k < 3; ++k) {
+        const int c = row_column[std::size_t(v)][std::size_t(k)];
+        if (c < 0) continue;
+        const int e = fill[std::size_t(c)]++;
+        P.innerIndexPtr()[e] = v;
+        P.valuePtr()[e] = row_weight[std::size_t(v)][std::size_t(k)];
+      }
+  }
   return {std::move(coarse), std::move(P)};
 }
 
-/// The symmetric pattern (ones) of a level's graph with its diagonal.
+/// The symmetric pattern (ones) of a level's graph with its diagonal, written straight into the
+/// compressed arrays (each column: the neighbours below, the vertex, the neighbours above; sorted,
+/// as the graph's rows are).
 SparseMatrix graph_pattern(const LevelMesh& level) {
   const int n = level.size();
-  std::vector<Eigen::Triplet<double, int>> t;
-  t.reserve(level.neighbour.size() + std::size_t(n));
-  for (int v = 0; v < n; ++v) {
-    t.emplace_back(v, v, 1.0);
-    for (int k = level.start[std::size_t(v)]; k < level.start[std::size_t(v) + 1]; ++k)
-      t.emplace_back(level.neighbour[std::size_t(k)], v, 1.0);
-  }
   SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  A.makeCompressed();
+  A.resizeNonZeros(Eigen::Index(level.neighbour.size()) + n);
+  int* outer = A.outerIndexPtr();
+  int* inner = A.innerIndexPtr();
+  for (int v = 0; v <= n; ++v) outer[v] = level.start[std::size_t(v)] + v;
+  parallel_for_indices(n, 4096, [&](int v) {
+    int* out = inner + outer[v];
+    const int* b = level.neighbour.data() + level.start[std::size_t(v)];
+    const int* e = level.neighbour.data() + level.start[std::size_t(v) + 1];
+    const int* mid = std::lower_bound(b, e, v);
+    out = std::copy(b, mid, out);
+    *out++ = v;
+    std::copy(mid, e, out);
+  });
+  std::fill(A.valuePtr(), A.valuePtr() + A.nonZeros(), 1.0);
   return A;
 }
 
@@ -217,18 +450,98 @@ std::vector<std::uint8_t> solver_colours(const SparseMatrix& pattern) {
 
 }  // namespace
 
-std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
-  const int n = int(A.cols());
-  std::vector<int> degree(std::size_t(n), 0);
+SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A) {
+  const int n = int(P.rows()), nc = int(P.cols());
+  const int* Pouter = P.outerIndexPtr();
+  const int* Pinner = P.innerIndexPtr();
+  const int* Aouter = A.outerIndexPtr();
+  const int* Ainner = A.innerIndexPtr();
+  // P's rows: the coarse vertices each fine vertex takes values from (ascending).
+  std::vector<int> row_start(std::size_t(n) + 1, 0), row_coarse(std::size_t(P.nonZeros()));
+  for (int p = 0; p < Pouter[nc]; ++p) ++row_start[std::size_t(Pinner[p]) + 1];
+  for (int i = 0; i < n; ++i) row_start[std::size_t(i) + 1] += row_start[std::size_t(i)];
+  {
+    std::vector<int> fill(row_start.begin(), row_start.end() - 1);
+    for (int J = 0; J < nc; ++J)
+      for (int p = Pouter[J]; p < Pouter[J + 1]; ++p)
+        row_coarse[std::size_t(fill[std::size_t(Pinner[p])]++)] = J;
+  }
+  int longest_row = 0;
+  for (int i = 0; i < n; ++i)
+    longest_row = std::max(longest_row, row_start[std::size_t(i) + 1] - row_start[std::size_t(i)]);
+  // Two set products, as the numeric product takes them: first the coarse vertices next to each
+  // fine one (the pattern of P^T A, column j: every I with P(i, I) A(i, j) stored), then column J
+  // of the product: the union of those sets over the fine vertices of P's column J. Taking the
+  // union per fine vertex first does each repeated I once. (Members are written whether new or
+  // not and kept by the count: no branch on the mark.)
+  std::vector<int> near_start, near;
+  gather_sets(
+      n, nc, [&](int j) { return (Aouter[j + 1] - Aouter[j]) * longest_row; },
+      [&](int j, int* mark, int* out) {
+        int count = 0;
+        for (int a = Aouter[j]; a < Aouter[j + 1]; ++a) {
+          const int i = Ainner[a];
+          for (int r = row_start[std::size_t(i)]; r < row_start[std::size_t(i) + 1]; ++r) {
+            const int I = row_coarse[std::size_t(r)];
+            out[count] = I;
+            count += mark[I] != j;
+            mark[I] = j;
+          }
+        }
+        return count;
+      },
+      near_start, near);
+  int most_near = 0;
   for (int j = 0; j < n; ++j)
-    for (SparseMatrix::InnerIterator it(A, j); it; ++it)
-      if (it.row() != j) ++degree[std::size_t(j)];
+    most_near = std::max(most_near, near_start[std::size_t(j) + 1] - near_start[std::size_t(j)]);
+  std::vector<int> outer, inner;
+  gather_sets(
+      nc, nc, [&](int J) { return (Pouter[J + 1] - Pouter[J]) * most_near; },
+      [&](int J, int* mark, int* out) {
+        int count = 0;
+        for (int p = Pouter[J]; p < Pouter[J + 1]; ++p) {
+          const int j = Pinner[p];
+          for (int r = near_start[std::size_t(j)]; r < near_start[std::size_t(j) + 1]; ++r) {
+            const int I = near[std::size_t(r)];
+            out[count] = I;
+            count += mark[I] != J;
+            mark[I] = J;
+          }
+        }
+        return count;
+      },
+      outer, inner);
+  // The product is symmetric (A is).
+  sort_symmetric_sets(outer, inner);
+  SparseMatrix C(nc, nc);
+  C.resizeNonZeros(Eigen::Index(inner.size()));
+  std::copy(outer.begin(), outer.end(), C.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), C.innerIndexPtr());
+  std::fill(C.valuePtr(), C.valuePtr() + C.nonZeros(), 1.0);
+  return C;
+}
+
+std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
+  if (!A.isCompressed()) {
+    SparseMatrix compressed = A;
+    compressed.makeCompressed();
+    return greedy_colouring(compressed, count);
+  }
+  const int n = int(A.cols());
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  std::vector<int> degree(static_cast<std::size_t>(n), 0);
+  for (int j = 0; j < n; ++j)
+    for (int k = outer[j]; k < outer[j + 1]; ++k)
+      if (inner[k] != j) ++degree[std::size_t(j)];
   // Smallest-last order: repeatedly remove a vertex of least remaining degree (lazy buckets: a
-  // vertex is pushed again whenever its degree drops, stale entries are skipped).
+  // vertex is pushed again whenever its degree drops, stale entries are skipped). The vertices
+  // visit the pattern in no local order: the columns of the vertices just pushed, the likeliest
+  // to be removed next, are fetched ahead.
   const int max_degree = n ? *std::max_element(degree.begin(), degree.end()) : 0;
   std::vector<std::vector<int>> bucket(std::size_t(max_degree) + 1);
   for (int v = n - 1; v >= 0; --v) bucket[std::size_t(degree[std::size_t(v)])].push_back(v);
-  std::vector<char> removed(std::size_t(n), 0);
+  std::vector<char> removed(static_cast<std::size_t>(n), 0);
   std::vector<int> order;
   order.reserve(std::size_t(n));
   int low = 0;
@@ -239,21 +552,32 @@ std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
     if (removed[std::size_t(v)] || degree[std::size_t(v)] != low) continue;
     removed[std::size_t(v)] = 1;
     order.push_back(v);
-    for (SparseMatrix::InnerIterator it(A, v); it; ++it) {
-      const int w = int(it.row());
+    for (int k = outer[v]; k < outer[v + 1]; ++k) {
+      const int w = inner[k];
       if (w == v || removed[std::size_t(w)]) continue;
+      __builtin_prefetch(inner + outer[w]);
       bucket[std::size_t(--degree[std::size_t(w)])].push_back(w);
     }
     low = std::max(0, low - 1);
   }
-  std::vector<int> colour(std::size_t(n), -1);
+  // Greedy colours in the reverse order, which is known: each vertex's column is fetched a few
+  // vertices ahead, and its neighbours' colours a few after that.
+  std::vector<int> colour(static_cast<std::size_t>(n), -1);
   std::vector<int> used_by(std::size_t(max_degree) + 2, -1);  // colour -> last vertex that saw it
   int colours = 0;
-  for (auto it = order.rbegin(); it != order.rend(); ++it) {
-    const int v = *it;
-    for (SparseMatrix::InnerIterator e(A, v); e; ++e)
-      if (e.row() != v && colour[std::size_t(e.row())] >= 0)
-        used_by[std::size_t(colour[std::size_t(e.row())])] = v;
+  constexpr int ahead = 8;
+  for (int i = n - 1; i >= 0; --i) {
+    if (i >= 2 * ahead) __builtin_prefetch(inner + outer[order[std::size_t(i - 2 * ahead)]]);
+    if (i >= ahead) {
+      const int u = order[std::size_t(i - ahead)];
+      for (int k = outer[u]; k < outer[u + 1]; ++k)
+        __builtin_prefetch(&colour[std::size_t(inner[k])]);
+    }
+    const int v = order[std::size_t(i)];
+    for (int k = outer[v]; k < outer[v + 1]; ++k) {
+      const int w = inner[k];
+      if (w != v && colour[std::size_t(w)] >= 0) used_by[std::size_t(colour[std::size_t(w)])] = v;
+    }
     int c = 0;
     while (used_by[std::size_t(c)] == v) ++c;
     colour[std::size_t(v)] = c;
@@ -279,9 +603,7 @@ SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triang
   SparseMatrix pattern = graph_pattern(levels.front());
   colours[0] = solver_colours(pattern);
   for (std::size_t k = 0; k < P.size(); ++k) {
-    SparseMatrix next = SparseMatrix(P[k].transpose()) * pattern * P[k];
-    next.makeCompressed();
-    pattern = std::move(next);
+    pattern = galerkin_pattern(P[k], pattern);
     colours[k + 1] = solver_colours(pattern);
   }
   SurfaceHierarchy h;

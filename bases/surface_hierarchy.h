@@ -28,7 +28,9 @@
 // kMaxSurfaceColours (the most the multigrid solver takes) gets no colouring and is relaxed
 // serially. The finest level needs about five colours, coarse Galerkin patterns 9 to 15.
 //
-// Everything is deterministic: serial loops in fixed orders, ties broken by index.
+// Everything is deterministic: serial loops in fixed orders, ties broken by index, and parallel
+// loops whose iterations write disjoint outputs, over fixed chunks where they gather (the same
+// hierarchy for any thread count).
 
 #include "core/sparse.h"
 #include "datasets/mesh.h"
@@ -63,6 +65,27 @@ struct SurfaceHierarchy {
 /// and are kept on every level with the identity prolongation).
 SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triangles& faces,
                                          const SurfaceHierarchyOptions& options = {});
+
+/// Graph Voronoi cells (header, step 2): for a graph in compressed rows (neighbours of v in
+/// neighbour[start[v] .. start[v+1]), symmetric, no self loops) with edge lengths |p_v - p_w|
+/// between its points, and sample[v] >= 0 the index of the sample at v (-1 elsewhere): per vertex,
+/// the index of the nearest sample by graph distance, ties to the smaller index
+/// (std::numeric_limits<int>::max() where no sample is reached). Exactly the labels of a
+/// multi-source Dijkstra that orders (distance, index) lexicographically, computed by parallel
+/// sweeps (deterministic) and checked to be those; where the check cannot tell (an edge too short
+/// to add to a distance, e.g. between coincident points) or the sweeps do not settle within 64
+/// (cells many edges wide), by that Dijkstra.
+std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
+                                     const std::vector<int>& neighbour, const Positions& points,
+                                     const std::vector<int>& sample);
+
+/// The pattern (ones, sorted row indices) of the Galerkin product P^T A P of a fine pattern A
+/// (square, symmetric — the result's rows are read off its columns —, compressed) and a
+/// prolongation P (fine x coarse, compressed): entry (I, J) wherever
+/// P(i, I) A(i, j) P(j, J) is stored for some i, j. The same pattern as Eigen's
+/// SparseMatrix(P^T) * A * P with positive values, in time linear in the triple products' terms,
+/// without values and in parallel over the coarse columns (deterministic).
+SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A);
 
 /// A smallest-last greedy colouring of a symmetric pattern (the pattern's diagonal is ignored):
 /// colours[i] differs from the colour of every j with A(i, j) stored, j != i. Returns the colours;

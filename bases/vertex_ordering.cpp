@@ -3,6 +3,7 @@
 #include "core/undirected_graph.h"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace mcf {
 namespace {
@@ -23,27 +24,45 @@ Graph vertex_graph(const Triangles& faces, int n) {
 }
 
 /// Breadth-first from `root` in Cuthill–McKee's neighbour order: appends the vertices reached (its
-/// component) to `out`; mark[v] == stamp means reached by this search.
+/// component) to `out`; mark[v] == stamp means reached by this search. The order (degree, index)
+/// is that of the keys degree * 2^32 + index; a vertex's few new neighbours are sorted by
+/// insertion. The queue visits the graph in no local order: the rows of the vertices a few places
+/// ahead in it are fetched early, and their neighbours' marks and degrees a few places after.
 void cuthill_mckee(const Graph& g, int root, std::vector<int>& mark, int stamp,
                    std::vector<int>& out) {
   const std::size_t first = out.size();
   out.push_back(root);
   mark[std::size_t(root)] = stamp;
-  std::vector<int> next;
+  std::vector<std::uint64_t> next;
+  constexpr std::size_t ahead = 8;
   for (std::size_t head = first; head < out.size(); ++head) {
+    if (head + 2 * ahead < out.size())
+      __builtin_prefetch(&g.start[std::size_t(out[head + 2 * ahead])]);
+    if (head + ahead < out.size()) {
+      const int u = out[head + ahead];
+      for (int k = g.start[std::size_t(u)]; k < g.start[std::size_t(u) + 1]; ++k) {
+        const int w = g.neighbour[std::size_t(k)];
+        __builtin_prefetch(&mark[std::size_t(w)]);
+        __builtin_prefetch(&g.start[std::size_t(w)]);
+      }
+    }
     const int v = out[head];
     next.clear();
     for (int k = g.start[std::size_t(v)]; k < g.start[std::size_t(v) + 1]; ++k) {
       const int w = g.neighbour[std::size_t(k)];
       if (mark[std::size_t(w)] != stamp) {
         mark[std::size_t(w)] = stamp;
-        next.push_back(w);
+        next.push_back(std::uint64_t(g.degree(w)) << 32 | std::uint32_t(w));
       }
     }
-    std::sort(next.begin(), next.end(), [&](int a, int b) {
-      return g.degree(a) != g.degree(b) ? g.degree(a) < g.degree(b) : a < b;
-    });
-    out.insert(out.end(), next.begin(), next.end());
+    if (next.size() > 16) {
+      std::sort(next.begin(), next.end());
+    } else {
+      for (std::size_t i = 1; i < next.size(); ++i)
+        for (std::size_t j = i; j > 0 && next[j] < next[j - 1]; --j)
+          std::swap(next[j], next[j - 1]);
+    }
+    for (const std::uint64_t key : next) out.push_back(int(std::uint32_t(key)));
   }
 }
 

@@ -15,6 +15,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <tuple>
 
 namespace mcf {
 namespace {
@@ -167,6 +171,135 @@ TEST(SurfaceHierarchy, ColouringsAreValidOnTheGalerkinPatterns) {
   EXPECT_GE(coloured, 1);
 }
 
+/// The vertex graph of a mesh in compressed rows (sorted, no self loops).
+void vertex_graph(const TriangleMesh& m, std::vector<int>& start, std::vector<int>& neighbour) {
+  const int n = int(m.vertices.rows());
+  std::vector<std::vector<int>> adj(static_cast<std::size_t>(n));
+  for (Eigen::Index f = 0; f < m.faces.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int a = m.faces(f, c), b = m.faces(f, (c + 1) % 3);
+      adj[std::size_t(a)].push_back(b);
+      adj[std::size_t(b)].push_back(a);
+    }
+  start.assign(1, 0);
+  neighbour.clear();
+  for (auto& a : adj) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+    neighbour.insert(neighbour.end(), a.begin(), a.end());
+    start.push_back(int(neighbour.size()));
+  }
+}
+
+/// The definition of the graph Voronoi cells: multi-source Dijkstra on (distance, sample index).
+std::vector<int> voronoi_by_dijkstra(const std::vector<int>& start,
+                                     const std::vector<int>& neighbour, const Positions& p,
+                                     const std::vector<int>& sample) {
+  const std::size_t n = std::size_t(p.rows());
+  std::vector<double> dist(n, std::numeric_limits<double>::infinity());
+  std::vector<int> label(n, std::numeric_limits<int>::max());
+  using Entry = std::tuple<double, int, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (std::size_t v = 0; v < n; ++v)
+    if (sample[v] >= 0) {
+      dist[v] = 0;
+      label[v] = sample[v];
+      queue.emplace(0.0, sample[v], int(v));
+    }
+  while (!queue.empty()) {
+    const auto [d, lab, v] = queue.top();
+    queue.pop();
+    if (d != dist[std::size_t(v)] || lab != label[std::size_t(v)]) continue;
+    for (int k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+      const int w = neighbour[std::size_t(k)];
+      const double nd = d + (p.row(v) - p.row(w)).norm();
+      if (std::tie(nd, lab) < std::tie(dist[std::size_t(w)], label[std::size_t(w)])) {
+        dist[std::size_t(w)] = nd;
+        label[std::size_t(w)] = lab;
+        queue.emplace(nd, lab, w);
+      }
+    }
+  }
+  return label;
+}
+
+/// Samples at every `stride`-th vertex from `offset` (indices in vertex order).
+std::vector<int> every(int n, int stride, int offset) {
+  std::vector<int> sample(static_cast<std::size_t>(n), -1);
+  int c = 0;
+  for (int v = offset; v < n; v += stride) sample[std::size_t(v)] = c++;
+  return sample;
+}
+
+// The parallel sweeps find Dijkstra's cells exactly: with ties (a grid's equal edges), with cells
+// many hops wide (few samples: the sweeps give up and Dijkstra decides), with coincident points
+// (zero-length edges), on one thread as on all.
+TEST(SurfaceHierarchy, GraphVoronoiCellsAreDijkstras) {
+  struct Case {
+    TriangleMesh mesh;
+    const char* name;
+  };
+  std::vector<Case> cases;
+  cases.push_back({flat_grid(40), "grid"});
+  cases.push_back({load_mesh_spec("cgal:armadillo").mesh, "armadillo"});
+  {
+    // The grid with its first vertex's point copied onto its neighbours in the first face.
+    TriangleMesh m = flat_grid(20);
+    m.vertices.row(m.faces(0, 1)) = m.vertices.row(m.faces(0, 0));
+    m.vertices.row(m.faces(0, 2)) = m.vertices.row(m.faces(0, 0));
+    cases.push_back({m, "coincident"});
+  }
+  for (const Case& c : cases) {
+    std::vector<int> start, neighbour;
+    vertex_graph(c.mesh, start, neighbour);
+    const int n = int(c.mesh.vertices.rows());
+    for (const auto& [stride, offset] : {std::pair{2, 0}, {5, 1}, {7, 3}, {n / 3, 0}, {n, 0}}) {
+      const std::vector<int> sample = every(n, stride, offset);
+      const std::vector<int> expected =
+          voronoi_by_dijkstra(start, neighbour, c.mesh.vertices, sample);
+      EXPECT_EQ(graph_voronoi_cells(start, neighbour, c.mesh.vertices, sample), expected)
+          << c.name << " stride " << stride;
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      EXPECT_EQ(graph_voronoi_cells(start, neighbour, c.mesh.vertices, sample), expected)
+          << c.name << " stride " << stride << ", one thread";
+    }
+  }
+}
+
+// The symbolic Galerkin product has the pattern of Eigen's numeric one, level by level, with
+// sorted row indices, on one thread as on all.
+TEST(SurfaceHierarchy, GalerkinPatternIsTheProductsPattern) {
+  const TriangleMesh m = load_mesh_spec("cgal:armadillo").mesh;
+  const SurfaceHierarchy h = build_surface_hierarchy(m.vertices, m.faces, {200, 16});
+  ASSERT_GE(h.levels(), 3);
+  SparseMatrix pattern = adjacency(m);
+  for (int l = h.levels() - 1; l > 0; --l) {
+    const SparseMatrix& P = h.prolongations[std::size_t(l - 1)];
+    SparseMatrix product = SparseMatrix(P.transpose()) * pattern * P;
+    product.makeCompressed();
+    const SparseMatrix symbolic = galerkin_pattern(P, pattern);
+    const SparseMatrix serial = [&] {
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      return galerkin_pattern(P, pattern);
+    }();
+    ASSERT_TRUE(symbolic.isCompressed());
+    ASSERT_EQ(symbolic.rows(), product.rows());
+    ASSERT_EQ(symbolic.cols(), product.cols());
+    ASSERT_EQ(symbolic.nonZeros(), product.nonZeros()) << "level " << l;
+    EXPECT_TRUE(std::equal(symbolic.outerIndexPtr(), symbolic.outerIndexPtr() + P.cols() + 1,
+                           product.outerIndexPtr()))
+        << "level " << l;
+    EXPECT_TRUE(std::equal(symbolic.innerIndexPtr(), symbolic.innerIndexPtr() + product.nonZeros(),
+                           product.innerIndexPtr()))
+        << "level " << l;
+    EXPECT_TRUE(std::equal(serial.innerIndexPtr(), serial.innerIndexPtr() + serial.nonZeros(),
+                           symbolic.innerIndexPtr()))
+        << "level " << l;
+    for (Eigen::Index k = 0; k < symbolic.nonZeros(); ++k) ASSERT_EQ(symbolic.valuePtr()[k], 1.0);
+    pattern = product;
+  }
+}
+
 // The same hierarchy twice, and on one thread as on all (the prolongation rows are found in
 // parallel).
 TEST(SurfaceHierarchy, TheBuildIsDeterministic) {
@@ -209,6 +342,54 @@ TEST(VertexOrdering, APermutationWithASmallBandwidth) {
     const int b = bandwidth(m.faces, rank);
     EXPECT_LT(b, 20.0 * std::sqrt(double(n))) << spec;
     EXPECT_LE(b, bandwidth(m.faces, identity)) << spec;
+  }
+}
+
+/// Cuthill–McKee as the header defines it, written plainly: per component, two breadth-first
+/// sweeps to a pseudo-peripheral root, each vertex's new neighbours sorted by (degree, index).
+std::vector<int> plain_cuthill_mckee(const TriangleMesh& m) {
+  std::vector<int> start, neighbour;
+  vertex_graph(m, start, neighbour);
+  const int n = int(m.vertices.rows());
+  auto degree = [&](int v) { return start[std::size_t(v) + 1] - start[std::size_t(v)]; };
+  auto sweep = [&](int root, std::vector<int>& out) {
+    std::vector<char> seen(static_cast<std::size_t>(n), 0);
+    out = {root};
+    seen[std::size_t(root)] = 1;
+    for (std::size_t h = 0; h < out.size(); ++h) {
+      std::vector<int> next;
+      for (int k = start[std::size_t(out[h])]; k < start[std::size_t(out[h]) + 1]; ++k)
+        if (!seen[std::size_t(neighbour[std::size_t(k)])]) {
+          seen[std::size_t(neighbour[std::size_t(k)])] = 1;
+          next.push_back(neighbour[std::size_t(k)]);
+        }
+      std::sort(next.begin(), next.end(), [&](int a, int b) {
+        return std::pair{degree(a), a} < std::pair{degree(b), b};
+      });
+      out.insert(out.end(), next.begin(), next.end());
+    }
+  };
+  std::vector<int> order, component;
+  std::vector<char> numbered(static_cast<std::size_t>(n), 0);
+  for (int seed = 0; seed < n; ++seed) {
+    if (numbered[std::size_t(seed)] || degree(seed) == 0) continue;
+    int root = seed;
+    for (int s = 0; s < 3; ++s) {
+      sweep(root, component);
+      root = component.back();
+    }
+    for (int v : component) numbered[std::size_t(v)] = 1;
+    order.insert(order.end(), component.begin(), component.end());
+  }
+  for (int v = 0; v < n; ++v)
+    if (degree(v) == 0) order.push_back(v);
+  return order;
+}
+
+TEST(VertexOrdering, IsCuthillMcKeeFromAPseudoPeripheralRoot) {
+  for (const char* spec : {"cgal:armadillo", "sphere:vertices=20000", "dumbbell"}) {
+    const TriangleMesh m = load_mesh_spec(spec).mesh;
+    EXPECT_EQ(bandwidth_ordering(m.faces, int(m.vertices.rows())), plain_cuthill_mckee(m)) << spec;
   }
 }
 
