@@ -99,9 +99,15 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
   // random reads within a ninth of the bytes (docs/benchmarks.md, "Floors").
   if (update_mass) face_area_.resize(std::size_t(m));
   if (update_stiffness) corner_weight_.resize(3 * std::size_t(m));
+  // The coefficients row-major first (a streaming pass): each face then reads its three corners
+  // as three 24-byte runs instead of nine scattered doubles of x's three columns.
+  points_.resize(std::size_t(x.rows()));
+  parallel_for_indices<Eigen::Index>(
+      x.rows(), 4096, [&](Eigen::Index i) { points_[std::size_t(i)] = x.row(i).transpose(); });
   parallel_for_indices<Eigen::Index>(m, 2048, [&](Eigen::Index f) {
-    const Eigen::Vector3d p[3] = {x.row(faces_(f, 0)).transpose(), x.row(faces_(f, 1)).transpose(),
-                                  x.row(faces_(f, 2)).transpose()};
+    const Eigen::Vector3d p[3] = {points_[std::size_t(faces_(f, 0))],
+                                  points_[std::size_t(faces_(f, 1))],
+                                  points_[std::size_t(faces_(f, 2))]};
     if (update_mass) face_area_[std::size_t(f)] = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
     if (update_stiffness) {
       // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite

@@ -53,6 +53,7 @@ class HatBasis final : public Basis {
   MassKind mass_kind_;
   FixedPattern pattern_;                  // 9 slots per face, gathered per nonzero
   std::vector<double> mass_, stiffness_;  // values on pattern_
+  std::vector<Eigen::Vector3d> points_;   // the coefficients row-major (update)
   std::vector<double> face_area_;         // per face, reused every step (update)
   std::vector<double> corner_weight_;     // per face and corner: half its cotangent (update)
   std::vector<int> boundary_;

@@ -20,6 +20,7 @@
 #include <tbb/info.h>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -184,8 +185,32 @@ nlohmann::json stats_json(const BasisStats& s) {
   return j;
 }
 
-bool all_finite(const Positions& V) {
-  return V.allFinite();
+// Row-chunked passes over a step's positions (n x 3, column-major: a chunk is three runs), in
+// parallel; the chunks depend on n alone, so the sum below is the same for any thread count.
+constexpr Eigen::Index kRowChunk = 16384;
+
+bool all_finite(const Eigen::MatrixX3d& V) {
+  const Eigen::Index chunks = (V.rows() + kRowChunk - 1) / kRowChunk;
+  std::vector<char> finite(std::size_t(chunks), 1);
+  parallel_for_chunks<Eigen::Index>(
+      V.rows(), kRowChunk, [&](Eigen::Index c, Eigen::Index r0, Eigen::Index r1) {
+        finite[std::size_t(c)] = V.middleRows(r0, r1 - r0).allFinite();
+      });
+  return std::all_of(finite.begin(), finite.end(), [](char f) { return f != 0; });
+}
+
+/// ||A - B|| (Frobenius), summed by fixed chunks.
+double difference_norm(const Eigen::MatrixX3d& A, const Eigen::MatrixX3d& B) {
+  const Eigen::Index chunks = (A.rows() + kRowChunk - 1) / kRowChunk;
+  std::vector<double> partial(std::size_t(chunks), 0.0);
+  parallel_for_chunks<Eigen::Index>(
+      A.rows(), kRowChunk, [&](Eigen::Index c, Eigen::Index r0, Eigen::Index r1) {
+        partial[std::size_t(c)] =
+            (A.middleRows(r0, r1 - r0) - B.middleRows(r0, r1 - r0)).squaredNorm();
+      });
+  double sum = 0.0;
+  for (const double p : partial) sum += p;
+  return std::sqrt(sum);
 }
 
 nlohmann::json mesh_json(const MeshSource& source) {
@@ -204,9 +229,13 @@ nlohmann::json mesh_json(const MeshSource& source) {
           {"degenerate_faces", rep.degenerate_faces}};
 }
 
-/// x -> (x - centroid) * scale, row by row.
+/// x -> (x - centroid) * scale, row by row (in parallel over row chunks).
 void apply(const Normalization& n, Coefficients& x) {
-  x = (x.rowwise() - n.centroid) * n.scale;
+  parallel_for_chunks<Eigen::Index>(x.rows(), kRowChunk,
+                                    [&](Eigen::Index, Eigen::Index r0, Eigen::Index r1) {
+                                      auto rows = x.middleRows(r0, r1 - r0);
+                                      rows = (rows.rowwise() - n.centroid) * n.scale;
+                                    });
 }
 
 /// One flow from its set-up to its last step: the basis, solver and integrator it sets up, the
@@ -368,7 +397,7 @@ nlohmann::json FlowRun::solver_record(int step, double t) const {
 std::optional<std::string> FlowRun::stop_rule(const Positions& V_new, const Coefficients& x_new,
                                               SurfaceMoments& moments,
                                               nlohmann::json& record) const {
-  if (!all_finite(V_new) || !x_new.allFinite()) return "non-finite vertex positions";
+  if (!all_finite(V_new) || !all_finite(x_new)) return "non-finite vertex positions";
   moments = surface_moments(V_new, mesh_.faces);
   const double area = moments.area;
   if (!(area > 1e-12 * area0_)) {
@@ -450,7 +479,7 @@ bool FlowRun::advance(int step) {
     apply(n, x_);  // becomes X_{n-1}: same frame as X_n for two-step schemes
     basis_->reframe(n.centroid, n.scale);  // with refine_input, the flowed midpoints follow
   }
-  const double step_difference = (V_new - V_).norm();
+  const double step_difference = difference_norm(V_new, V_);
   previous_area_ = config_.normalize_area ? 1.0 : area;
   const double evaluate_seconds = seconds_since(eval_start);
 
