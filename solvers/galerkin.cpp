@@ -72,9 +72,14 @@ GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMat
   const auto column = [&](int jj) {
     return column_order.empty() ? jj : column_order[std::size_t(jj)];
   };
+  // A dot product's terms are named by their place in P's column (8 bits) and counted per entry
+  // (8 bits): P's columns must be short.
+  for (int I = 0; I < q; ++I)
+    if (P.outer[I + 1] - P.outer[I] > 255) return {};
   GalerkinPlan plan;
   plan.scatter_start.assign(std::size_t(q) + 1, 0);
   plan.dot_start.assign(std::size_t(q) + 1, 0);
+  plan.entry_start.assign(std::size_t(q) + 1, 0);
   std::vector<int> support(std::size_t(q), 0);
   // Local numbering of column J's fine rows in pass `pass`: slot[i] for rows with
   // stamp[i] == 2 J + pass (a thread may meet a column in both passes; the second numbers anew).
@@ -84,9 +89,10 @@ GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMat
   tbb::enumerable_thread_specific<Marks> marks([m] {
     return Marks{std::vector<int>(std::size_t(m), -1), std::vector<int>(std::size_t(m))};
   });
-  // Walks column jj: numbers its support, then calls scatter(slot) and dot(slot) in the order
-  // galerkin_values visits the terms.
-  const auto walk = [&](int jj, int pass, Marks& mk, auto&& scatter, auto&& dot) {
+  // Walks column jj: numbers its support, then calls scatter(slot) for every scatter term,
+  // dot(place in P's column, slot) for every dot-product term whose row lies in the support, and
+  // entry(count) after each upper entry's terms, in the order galerkin_values visits them.
+  const auto walk = [&](int jj, int pass, Marks& mk, auto&& scatter, auto&& dot, auto&& entry) {
     const int J = column(jj);
     const int mark = 2 * J + pass;
     int ns = 0;
@@ -104,10 +110,14 @@ GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMat
     for (int e = Couter[J]; e < Couter[J + 1]; ++e) {
       const int I = Cinner[e];
       if (I > J) break;
+      int count = 0;
       for (int r = P.outer[I]; r < P.outer[I + 1]; ++r) {
         const std::size_t i = std::size_t(P.inner[r]);
-        dot(mk.stamp[i] == mark ? mk.slot[i] : -1);
+        if (mk.stamp[i] != mark) continue;  // v is zero there
+        dot(r - P.outer[I], mk.slot[i]);
+        ++count;
       }
+      entry(count);
     }
     return ns;
   };
@@ -115,36 +125,47 @@ GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMat
   tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
     Marks& mk = marks.local();
     for (int jj = r.begin(); jj < r.end(); ++jj) {
-      std::int64_t ns_scatter = 0, ns_dot = 0;
+      std::int64_t ns_scatter = 0, ns_dot = 0, ns_entry = 0;
       support[std::size_t(jj)] = walk(
-          jj, 0, mk, [&](int) { ++ns_scatter; }, [&](int) { ++ns_dot; });
+          jj, 0, mk, [&](int) { ++ns_scatter; }, [&](int, int) { ++ns_dot; },
+          [&](int) { ++ns_entry; });
       plan.scatter_start[std::size_t(jj) + 1] = ns_scatter;
       plan.dot_start[std::size_t(jj) + 1] = ns_dot;
+      plan.entry_start[std::size_t(jj) + 1] = ns_entry;
     }
   });
   const int largest = q ? *std::max_element(support.begin(), support.end()) : 0;
   for (std::size_t j = 0; j < std::size_t(q); ++j) {
     plan.scatter_start[j + 1] += plan.scatter_start[j];
     plan.dot_start[j + 1] += plan.dot_start[j];
+    plan.entry_start[j + 1] += plan.entry_start[j];
   }
-  const std::size_t terms = std::size_t(plan.scatter_start.back() + plan.dot_start.back());
+  const std::size_t bytes = 2 * std::size_t(plan.scatter_start.back()) +
+                            3 * std::size_t(plan.dot_start.back()) +
+                            std::size_t(plan.entry_start.back());
   const std::size_t a_bytes = std::size_t(A.outer[A.cols]) * (sizeof(int) + sizeof(double));
-  // The zero slot is numbered `support` and must fit 16 bits too.
-  if (largest >= 65535 || 2 * terms > a_bytes) return {};
+  if (largest > 65535 || bytes > a_bytes) return {};
   plan.max_support = largest;
   plan.support.assign(support.begin(), support.end());
   plan.scatter_slot.resize(std::size_t(plan.scatter_start.back()));
   plan.dot_slot.resize(std::size_t(plan.dot_start.back()));
+  plan.dot_place.resize(std::size_t(plan.dot_start.back()));
+  plan.dot_count.resize(std::size_t(plan.entry_start.back()));
   // Pass 2: the slots.
   tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
     Marks& mk = marks.local();
     for (int jj = r.begin(); jj < r.end(); ++jj) {
       std::uint16_t* sc = plan.scatter_slot.data() + plan.scatter_start[std::size_t(jj)];
-      std::uint16_t* dt = plan.dot_slot.data() + plan.dot_start[std::size_t(jj)];
-      const std::uint16_t zero = plan.support[std::size_t(jj)];
+      std::uint16_t* ds = plan.dot_slot.data() + plan.dot_start[std::size_t(jj)];
+      std::uint8_t* dp = plan.dot_place.data() + plan.dot_start[std::size_t(jj)];
+      std::uint8_t* dc = plan.dot_count.data() + plan.entry_start[std::size_t(jj)];
       walk(
           jj, 1, mk, [&](int s) { *sc++ = std::uint16_t(s); },
-          [&](int s) { *dt++ = s < 0 ? zero : std::uint16_t(s); });
+          [&](int place, int s) {
+            *dp++ = std::uint8_t(place);
+            *ds++ = std::uint16_t(s);
+          },
+          [&](int count) { *dc++ = std::uint8_t(count); });
     }
   });
   return plan;
@@ -166,7 +187,7 @@ void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& C
           double* b = v.data();
           for (int jj = r.begin(); jj < r.end(); ++jj) {
             const int J = column_order.empty() ? jj : column_order[std::size_t(jj)];
-            std::fill(b, b + plan->support[std::size_t(jj)] + 1, 0.0);  // the zero slot included
+            std::fill(b, b + plan->support[std::size_t(jj)], 0.0);
             const std::uint16_t* sc =
                 plan->scatter_slot.data() + plan->scatter_start[std::size_t(jj)];
             for (int p = P.outer[J]; p < P.outer[J + 1]; ++p) {
@@ -174,12 +195,16 @@ void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& C
               const double w = P.val[p];
               for (int a = A.outer[t]; a < A.outer[t + 1]; ++a) b[*sc++] += A.val[a] * w;
             }
-            const std::uint16_t* dt = plan->dot_slot.data() + plan->dot_start[std::size_t(jj)];
+            const std::uint16_t* ds = plan->dot_slot.data() + plan->dot_start[std::size_t(jj)];
+            const std::uint8_t* dp = plan->dot_place.data() + plan->dot_start[std::size_t(jj)];
+            const std::uint8_t* dc = plan->dot_count.data() + plan->entry_start[std::size_t(jj)];
             for (int e = Couter[J]; e < Couter[J + 1]; ++e) {
               const int I = Cinner[e];
               if (I > J) break;
+              // The terms whose v is zero are left out: each would add +-0 to the sum.
+              const double* pv = P.val + P.outer[I];
               double sum = 0.0;
-              for (int q = P.outer[I]; q < P.outer[I + 1]; ++q) sum += P.val[q] * b[*dt++];
+              for (int k = *dc++; k > 0; --k) sum += pv[*dp++] * b[*ds++];
               Cval[e] = sum;
               const int t = transpose_pos[std::size_t(e)];
               if (t >= 0) Cval[t] = sum;

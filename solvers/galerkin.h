@@ -34,22 +34,29 @@ using Spa = tbb::enumerable_thread_specific<std::vector<double>>;
 
 /// The visits of galerkin_values laid out once per pattern. Per coarse column J, in visit order
 /// (column_order): the distinct fine rows of A P e_J numbered locally in order of first touch,
-/// then the local slot of every scatter term A(i, t) P(t, J) and of every dot-product term
-/// P(q, I) v_q (I <= J; a row q outside A P e_J's support reads the zero slot, numbered
-/// `support`). With a plan, galerkin_values accumulates each column in a buffer of a few dozen
-/// entries (in L1) instead of a dense vector of the fine level's size, and walks no fine-sized
-/// state to clear it: the same terms in the same order, hence bitwise the same values.
-/// Empty (no plan) when a column's support does not fit 16-bit slots or the plan would take
-/// more bytes than A itself (then galerkin_values keeps its dense accumulator).
+/// the local slot of every scatter term A(i, t) P(t, J), and for every upper entry (I <= J) the
+/// dot-product terms P(q, I) v_q whose row q lies in that support (the others multiply a zero and
+/// are left out: on the surface hierarchy more than half of them), each as its place in P's
+/// column I and its slot. With a plan, galerkin_values accumulates each column in a buffer of a
+/// few dozen entries (in L1) instead of a dense vector of the fine level's size, and walks no
+/// fine-sized state to clear it: the same nonzero terms in the same order, hence the same values
+/// bit for bit (but for the sign of an entry that sums to zero).
+/// Empty (no plan) when a column's support does not fit 16-bit slots, a column of P has more than
+/// 255 entries, or the plan would take more bytes than A itself (then galerkin_values keeps its
+/// dense accumulator).
 struct GalerkinPlan {
-  std::vector<std::int64_t> scatter_start, dot_start;  // per visited column, offsets (+1 at end)
-  std::vector<std::uint16_t> scatter_slot, dot_slot;   // local slots, in visit order
-  std::vector<std::uint16_t> support;                  // per visited column: its fine rows
+  std::vector<std::int64_t> scatter_start, dot_start, entry_start;  // per visited column (+1)
+  std::vector<std::uint16_t> scatter_slot;  // per scatter term, in visit order
+  std::vector<std::uint16_t> dot_slot;      // per kept dot-product term: its slot
+  std::vector<std::uint8_t> dot_place;      // ... and its place in P's column I
+  std::vector<std::uint8_t> dot_count;      // per upper entry: its kept terms
+  std::vector<std::uint16_t> support;       // per visited column: its fine rows
   int max_support = 0;
   bool empty() const { return support.empty(); }
   std::size_t bytes() const {
-    return 8 * (scatter_start.size() + dot_start.size()) +
-           2 * (scatter_slot.size() + dot_slot.size() + support.size());
+    return 8 * (scatter_start.size() + dot_start.size() + entry_start.size()) +
+           2 * (scatter_slot.size() + dot_slot.size() + support.size()) + dot_place.size() +
+           dot_count.size();
   }
 };
 
@@ -70,7 +77,7 @@ GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMat
 /// A is a view (its values may be one term's, on the level's pattern); the values are written to
 /// `Cval`, on Cm's pattern (Cm's own values when Cval is Cm.valuePtr()).
 /// With a non-empty `plan` (galerkin_plan of the same patterns and column_order), the columns
-/// accumulate in the plan's local slots; the values are bitwise those without it.
+/// accumulate in the plan's local slots; the values are those without it, bit for bit.
 void galerkin_values(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm, double* Cval,
                      const std::vector<int>& transpose_pos, const std::vector<int>& column_order,
                      Spa& spa, const GalerkinPlan* plan = nullptr);
