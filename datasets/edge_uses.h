@@ -6,6 +6,8 @@
 
 #include "datasets/mesh.h"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -21,7 +23,8 @@ struct EdgeUse {
   bool operator<(const EdgeUse& o) const { return key < o.key || (key == o.key && face < o.face); }
 };
 
-/// Every corner's record, sorted by edge, then face.
+/// Every corner's record, sorted by edge, then face (a total order: the parallel sort's result
+/// does not depend on the threads).
 inline std::vector<EdgeUse> sorted_edge_uses(const Triangles& faces) {
   const Eigen::Index m = faces.rows();
   std::vector<EdgeUse> uses(static_cast<std::size_t>(3 * m));
@@ -33,7 +36,7 @@ inline std::vector<EdgeUse> sorted_edge_uses(const Triangles& faces) {
       if (!forward) std::swap(a, b);
       uses[static_cast<std::size_t>(3 * f + c)] = {(a << 32) | b, f, forward};
     }
-  std::sort(uses.begin(), uses.end());
+  tbb::parallel_sort(uses.begin(), uses.end());
   return uses;
 }
 
