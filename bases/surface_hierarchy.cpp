@@ -444,7 +444,7 @@ SparseMatrix graph_pattern(const LevelMesh& level) {
 std::vector<std::uint8_t> solver_colours(const SparseMatrix& pattern) {
   int count = 0;
   const std::vector<int> c = greedy_colouring(pattern, &count);
-  if (count > kMaxSurfaceColours) return {};
+  if (count > 8) return {};
   return std::vector<std::uint8_t>(c.begin(), c.end());
 }
 

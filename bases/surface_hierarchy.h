@@ -24,9 +24,8 @@
 //
 // Each level also gets a Gauss-Seidel colouring of the pattern its Galerkin matrix will have
 // (the finest: vertices sharing a triangle; coarser: P^T A P's), smallest-last greedy, so that
-// the multigrid can relax colour by colour in parallel; a level that needs more than
-// kMaxSurfaceColours (the most the multigrid solver takes) gets no colouring and is relaxed
-// serially. The finest level needs about five colours, coarse Galerkin patterns 9 to 15.
+// the multigrid can relax colour by colour in parallel; a level that needs more than the eight
+// colours the solver takes gets no colouring and is relaxed serially.
 //
 // Everything is deterministic: serial loops in fixed orders, ties broken by index, and parallel
 // loops whose iterations write disjoint outputs, over fixed chunks where they gather (the same
@@ -40,10 +39,6 @@
 
 namespace mcf {
 
-/// The most Gauss-Seidel colours a level may use: MultigridSolver::max_colours (the bases do not
-/// see the solvers; a test checks the two agree).
-constexpr int kMaxSurfaceColours = 32;
-
 struct SurfaceHierarchyOptions {
   int coarsest_size = 1000;  ///< stop once a level has at most this many vertices
   int max_levels = 16;       ///< levels in all, the finest included
@@ -53,8 +48,8 @@ struct SurfaceHierarchy {
   /// prolongations[l] maps level l to level l + 1 (coarsest first), rows x columns = the finer
   /// level's size x the coarser level's.
   std::vector<SparseMatrix> prolongations;
-  /// Per level, coarsest first, the finest last: colours in 0..kMaxSurfaceColours-1, or empty for
-  /// a level relaxed serially.
+  /// Per level, coarsest first, the finest last: colours in 0..7, or empty for a level relaxed
+  /// serially.
   std::vector<std::vector<std::uint8_t>> colours;
   /// Per level, coarsest first: its points (the samples' positions; the mesh's on the finest).
   std::vector<Positions> points;

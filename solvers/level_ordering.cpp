@@ -76,27 +76,24 @@ void number_by_colour(LevelNumbering& L, int n, const std::vector<std::uint8_t>*
   L.perm.clear();
   L.inv.clear();
   L.segment_start.clear();
-  L.colours = 0;
-  if (given == nullptr || int(given->size()) != n || n == 0) return;
+  if (given == nullptr || int(given->size()) != n) return;
   const auto& col = *given;
-  const int K = int(*std::max_element(col.begin(), col.end())) + 1;
-  if (K > kMaxColours) return;
-  const std::size_t Ks = std::size_t(K);
-  const int tiles = (n + kTile - 1) / kTile;
-  L.segment_start.assign(std::size_t(tiles) * Ks + 1, 0);
   for (int i = 0; i < n; ++i)
-    ++L.segment_start[std::size_t(i / kTile) * Ks + col[std::size_t(i)] + 1];
+    if (col[std::size_t(i)] > 7) return;
+  const int tiles = (n + kTile - 1) / kTile;
+  L.segment_start.assign(std::size_t(tiles) * 8 + 1, 0);
+  for (int i = 0; i < n; ++i)
+    ++L.segment_start[std::size_t(i / kTile) * 8 + col[std::size_t(i)] + 1];
   for (std::size_t q = 1; q < L.segment_start.size(); ++q)
     L.segment_start[q] += L.segment_start[q - 1];
   L.perm.resize(std::size_t(n));
   L.inv.resize(std::size_t(n));
   std::vector<int> fill(L.segment_start.begin(), L.segment_start.end() - 1);
   for (int i = 0; i < n; ++i) {
-    const int r = fill[std::size_t(i / kTile) * Ks + col[std::size_t(i)]]++;
+    const int r = fill[std::size_t(i / kTile) * 8 + col[std::size_t(i)]]++;
     L.perm[std::size_t(r)] = i;
     L.inv[std::size_t(i)] = r;
   }
-  L.colours = K;
 }
 
 void check_colouring(LevelNumbering& L, const SparseMatrix& Am,

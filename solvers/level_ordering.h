@@ -5,10 +5,10 @@
 // order in which a sweep visits the rows, and the permutation of matrices into and out of the
 // internal numbering.
 //
-// Inputs: a level's size, its given colours (one of 0..kMaxColours-1 per function, or none) and its
-// matrix pattern in the internal numbering. Outputs: LevelNumbering and permuted copies of
-// matrices. All of it is deterministic: the permutations depend on the colours alone, the checks
-// are logical reductions, and the parallel loops write disjoint entries.
+// Inputs: a level's size, its given colours (one of 0..7 per function, or none) and its matrix
+// pattern in the internal numbering. Outputs: LevelNumbering and permuted copies of matrices. All
+// of it is deterministic: the permutations depend on the colours alone, the checks are logical
+// reductions, and the parallel loops write disjoint entries.
 //
 // Internal to the multigrid solver (namespace multigrid_detail); not part of the solvers'
 // interface.
@@ -31,14 +31,12 @@ namespace mcf::multigrid_detail {
 // whole matrix (interleaved rows defeat the hardware prefetchers), and the rows a coarse
 // function's support touches stay within a few tiles, which keeps the Galerkin product's
 // accumulators in cache (a global colour-major order does not; docs/benchmarks.md, "Measurements
-// behind implementation choices"). The ordering within a colour and its iterates are unchanged.
-// A level takes as many colours as its given colouring uses (the octree's parity colouring eight,
-// a surface level's Galerkin pattern up to kMaxColours). `perm[r]` is the caller's index of
-// internal row r, `inv` its inverse; both are empty for the identity.
+// behind implementation choices"). The parity
+// 8-colour ordering and its iterates are unchanged. `perm[r]` is the caller's index of internal
+// row r, `inv` its inverse; both are empty for the identity.
 
 constexpr int kTile = MultigridSolver::tile_size;
 constexpr int kMinBlockTiles = 8;  // tiles per relaxation block, at least (find_blocks())
-constexpr int kMaxColours = MultigridSolver::max_colours;
 
 inline int old_index(const std::vector<int>& perm, int r) {
   return perm.empty() ? r : perm[std::size_t(r)];
@@ -64,17 +62,15 @@ bool same_permuted(const SparseMatrix& stored, const SparseRef& given,
 struct LevelNumbering {
   std::vector<int> perm, inv;  // internal row r <-> caller's index perm[r]; empty: identity
   bool coloured = false;
-  int colours = 0;  // colours in use: the largest given colour + 1
-  std::vector<int>
-      segment_start;    // rows of colour c in tile t: [s[K t+c], s[K t+c+1]), K = colours
-  int block_tiles = 1;  // tiles per relaxation block (find_blocks())
-  int tiles() const { return colours ? int((segment_start.size() - 1) / std::size_t(colours)) : 0; }
+  std::vector<int> segment_start;  // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
+  int block_tiles = 1;             // tiles per relaxation block (find_blocks())
+  int tiles() const { return int(segment_start.size() / 8); }
   int blocks() const { return (tiles() + block_tiles - 1) / block_tiles; }
 };
 
 /// The level's internal numbering from its given colours: blocks of kTile consecutive caller
 /// indices, colour-major inside each block (identity when no colours are given, their count is
-/// wrong or a colour is out of 0..kMaxColours-1). Segment (t, c) = rows of colour c in block t.
+/// wrong or a colour is out of 0..7). Segment (t, c) = rows of colour c in block t.
 void number_by_colour(LevelNumbering& L, int n, const std::vector<std::uint8_t>* given);
 
 /// A numbered level is coloured when no two functions of one colour couple (checked on the
@@ -86,7 +82,7 @@ void check_colouring(LevelNumbering& L, const SparseMatrix& A,
 /// Relaxation blocks of a coloured level (header, "Smoother ordering"): runs of `block_tiles`
 /// consecutive tiles, at least as many as the farthest coupling reaches (in tiles), so rows of
 /// block q couple only with blocks q-1, q, q+1 and blocks of one parity never couple.
-/// A block's rows and iterates stay in cache through its colours (on the armadillo at
+/// A block's rows and iterates stay in cache through its eight colours (on the armadillo at
 /// depth 9 the farthest coupling reaches 9 tiles). A floor of kMinBlockTiles (8) instead of 1
 /// costs nothing measurable there and keeps small levels from being cut into many tiny tasks.
 /// A is the level's matrix in the internal numbering.
@@ -102,12 +98,11 @@ inline int block_parity(int pi, bool reverse) {
 template <class F>
 void for_block_segments(const LevelNumbering& L, int q, bool reverse, F&& f) {
   const int t0 = q * L.block_tiles, t1 = std::min(L.tiles(), t0 + L.block_tiles);
-  const int K = L.colours;
-  for (int ci = 0; ci < K; ++ci) {
-    const std::size_t c = std::size_t(reverse ? K - 1 - ci : ci);
+  for (int ci = 0; ci < 8; ++ci) {
+    const std::size_t c = std::size_t(reverse ? 7 - ci : ci);
     for (int t = t0; t < t1; ++t) {
-      const std::size_t q = std::size_t(t) * std::size_t(K) + c;
-      f(L.segment_start[q], L.segment_start[q + 1]);
+      const std::size_t q8 = std::size_t(t) * 8 + c;
+      f(L.segment_start[q8], L.segment_start[q8 + 1]);
     }
   }
 }

@@ -57,10 +57,8 @@ struct SolveReport {
 
 /// Multigrid hierarchy as plain arrays (levels ordered coarsest first; the finest level is the
 /// system's own). prolongations[l] maps level l to level l+1, so there are levels-1 of them.
-/// colours[l][i] is the Gauss-Seidel colour of function i on level l: functions of the same colour
-/// never couple (the octree's parity colouring in 0..7, docs/octree-multigrid.md; a surface
-/// level's greedy colouring, bases/surface_hierarchy.h). A multigrid takes up to
-/// MultigridSolver::max_colours and relaxes a level with more serially.
+/// colours[l][i] in 0..7 is the Gauss-Seidel colour of function i on level l: functions of the
+/// same colour never couple (octree parity colouring, docs/octree-multigrid.md).
 ///
 /// pattern_key: 0, or a key from new_pattern_key() by which the caller vouches that A's sparsity
 /// pattern, the prolongations (pattern and values) and the colours are exactly those of the

@@ -10,13 +10,11 @@
 // Smoother ordering: a coloured level is cut into relaxation blocks of consecutive tiles (below),
 // each at least as wide as the level's farthest coupling, so only neighbouring blocks couple. A
 // forward sweep (pre-smoothing) relaxes the even blocks, in parallel, then the odd blocks; inside a
-// block colours 0..K-1 one after the other (K = the level's colours: eight for the octree's parity
-// colouring, up to max_colours for a surface level's Galerkin pattern; functions of one colour
-// never couple, so their order does not matter). A reverse sweep (post-smoothing) is the exact
-// reverse: odd blocks, then even blocks, colours K-1..0. Serial fallback (no valid colouring):
-// rows 0..n-1, reverse n-1..0. Every sweep is thus one fixed serial Gauss-Seidel ordering whatever
-// the thread count, and with pre_smooth == post_smooth the cycle, started from zero, is a
-// symmetric operator (precondition()).
+// block colours 0..7 one after the other (functions of one colour never couple, so their order
+// does not matter). A reverse sweep (post-smoothing) is the exact reverse: odd blocks, then even
+// blocks, colours 7..0. Serial fallback (no valid colouring): rows 0..n-1, reverse n-1..0. Every
+// sweep is thus one fixed serial Gauss-Seidel ordering whatever the thread count, and with
+// pre_smooth == post_smooth the cycle, started from zero, is a symmetric operator (precondition()).
 // Why blocks and not one pass per colour over the whole level: a colour pass reads the iterates of
 // all its rows' neighbours, i.e. nearly the whole iterate, eight times per sweep, and at depth 9
 // that is more than the last-level cache holds; a block's rows and iterates stay in cache through
@@ -131,9 +129,6 @@ class MultigridSolver : public LinearSolver {
  public:
   /// Consecutive function indices per tile of a coloured level's internal numbering.
   static constexpr int tile_size = 1024;
-  /// Gauss-Seidel colours a level may use (MultigridHierarchy::colours); a level given more is
-  /// relaxed serially.
-  static constexpr int max_colours = 32;
 
   explicit MultigridSolver(MultigridOptions options = {});
   ~MultigridSolver() override;

@@ -109,50 +109,6 @@ TEST(HatMultigrid, OneAndTwoThreadsGiveTheSameBits) {
   EXPECT_EQ((one - two).cwiseAbs().maxCoeff(), 0.0);
 }
 
-/// The coarse levels' Galerkin patterns need more than the octree's eight colours (the
-/// armadillo's: 9 to 15); every level is coloured, so relaxed in parallel, and its sweep is still
-/// the serial Gauss-Seidel sweep in the order relaxation_order() reports, on 2 threads.
-TEST(HatMultigrid, CoarseLevelsTakeTheirManyColoursAndSweepAsGaussSeidel) {
-  static_assert(kMaxSurfaceColours == MultigridSolver::max_colours);
-  const HatSystem s = hat_system("cgal:armadillo@faces=200000", 1e-3);
-  tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-  MultigridSolver mg;
-  ASSERT_TRUE(mg.set_matrix(s.A, view(*s.basis)).ok());
-  int most_colours = 0;
-  for (int l = 0; l < mg.levels(); ++l) {
-    const auto& colours = (*s.basis->colours())[std::size_t(l)];
-    ASSERT_FALSE(colours.empty()) << "level " << l;
-    most_colours = std::max(most_colours, *std::max_element(colours.begin(), colours.end()) + 1);
-    ASSERT_TRUE(mg.level_is_coloured(l)) << "level " << l;
-  }
-  EXPECT_GT(most_colours, 8);
-  // The busiest coarse level below the finest: several relaxation blocks, more than 8 colours.
-  const int l = mg.levels() - 2;
-  const SparseMatrix A = mg.level_matrix(l);
-  const std::vector<int> blocks = mg.relaxation_blocks(l);
-  EXPECT_GE(*std::max_element(blocks.begin(), blocks.end()), 3);
-  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(A.rows(), 3);
-  for (bool reverse : {false, true}) {
-    const std::vector<int> order = mg.relaxation_order(l, reverse);
-    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(A.rows(), 3), Xr = X;
-    mg.gauss_seidel(l, B, X, 1, reverse);
-    // Serial Gauss-Seidel in that order; coarse sweeps read single-precision off-diagonals.
-    for (int i : order) {
-      Eigen::RowVectorXd acc = B.row(i);
-      double d = 0;
-      for (SparseMatrix::InnerIterator it(A, i); it; ++it) {
-        if (it.row() == i)
-          d = it.value();
-        else
-          acc -= double(float(it.value())) * Xr.row(it.row());
-      }
-      Xr.row(i) = acc / d;
-    }
-    EXPECT_LE((X - Xr).cwiseAbs().maxCoeff(), 1e-12 * Xr.cwiseAbs().maxCoeff())
-        << "reverse " << reverse;
-  }
-}
-
 TEST(HatMultigrid, FlowsWithMultigridFollowCholmod) {
   for (const char* flow : {"cmcf", "heat"}) {
     const json base = {
