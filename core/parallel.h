@@ -2,8 +2,8 @@
 // The parallel loops every layer writes, on TBB. Each takes a body whose iterations write
 // disjoint outputs and read nothing another iteration of the same loop writes: then how the
 // range is split among threads cannot change the result, which stays bitwise the same for any
-// thread count. (Reductions, whose order of summation would depend on the split, are written out
-// where they are needed, over fixed chunks: parallel_for_chunks.)
+// thread count. (Reductions, whose order of summation would depend on the split, are taken over
+// fixed chunks: parallel_for_chunks, and sum_over_chunks for a plain sum of per-chunk values.)
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <vector>
 
 namespace mcf {
 
@@ -35,6 +36,19 @@ void parallel_for_chunks(Index n, Index size, Body&& body) {
                       for (Index c = r.begin(); c < r.end(); ++c)
                         body(c, c * size, std::min(n, (c + 1) * size));
                     });
+}
+
+/// Σ over the fixed chunks of [0, n) (parallel_for_chunks) of value(begin, end), the chunks' values
+/// added in chunk order: the same bits for any thread count. T is zero-initialised by T{} and
+/// added with +=.
+template <class T, class Index, class Value>
+T sum_over_chunks(Index n, Index size, Value&& value) {
+  std::vector<T> partial(std::size_t((n + size - 1) / size));
+  parallel_for_chunks(n, size,
+                      [&](Index c, Index b, Index e) { partial[std::size_t(c)] = value(b, e); });
+  T total{};
+  for (const T& p : partial) total += p;
+  return total;
 }
 
 /// The number of threads that work when `requested` are asked for (0 or less: all): TBB never

@@ -20,7 +20,6 @@
 #include <tbb/info.h>
 #include <Eigen/Geometry>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -190,27 +189,17 @@ nlohmann::json stats_json(const BasisStats& s) {
 constexpr Eigen::Index kRowChunk = 16384;
 
 bool all_finite(const Eigen::MatrixX3d& V) {
-  const Eigen::Index chunks = (V.rows() + kRowChunk - 1) / kRowChunk;
-  std::vector<char> finite(std::size_t(chunks), 1);
-  parallel_for_chunks<Eigen::Index>(
-      V.rows(), kRowChunk, [&](Eigen::Index c, Eigen::Index r0, Eigen::Index r1) {
-        finite[std::size_t(c)] = V.middleRows(r0, r1 - r0).allFinite();
-      });
-  return std::all_of(finite.begin(), finite.end(), [](char f) { return f != 0; });
+  return sum_over_chunks<Eigen::Index>(V.rows(), kRowChunk, [&](Eigen::Index r0, Eigen::Index r1) {
+           return Eigen::Index(!V.middleRows(r0, r1 - r0).allFinite());
+         }) == 0;
 }
 
 /// ||A - B|| (Frobenius), summed by fixed chunks.
 double difference_norm(const Eigen::MatrixX3d& A, const Eigen::MatrixX3d& B) {
-  const Eigen::Index chunks = (A.rows() + kRowChunk - 1) / kRowChunk;
-  std::vector<double> partial(std::size_t(chunks), 0.0);
-  parallel_for_chunks<Eigen::Index>(
-      A.rows(), kRowChunk, [&](Eigen::Index c, Eigen::Index r0, Eigen::Index r1) {
-        partial[std::size_t(c)] =
-            (A.middleRows(r0, r1 - r0) - B.middleRows(r0, r1 - r0)).squaredNorm();
-      });
-  double sum = 0.0;
-  for (const double p : partial) sum += p;
-  return std::sqrt(sum);
+  return std::sqrt(
+      sum_over_chunks<double>(A.rows(), kRowChunk, [&](Eigen::Index r0, Eigen::Index r1) {
+        return (A.middleRows(r0, r1 - r0) - B.middleRows(r0, r1 - r0)).squaredNorm();
+      }));
 }
 
 nlohmann::json mesh_json(const MeshSource& source) {
