@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 
@@ -60,17 +61,6 @@ FixedPattern::FixedPattern(Eigen::Index n, const std::vector<int>& rows,
 
   outer_ = std::move(outer);
   inner_ = std::move(inner);
-}
-
-void FixedPattern::gather(const std::vector<double>& local, std::vector<double>& values) const {
-  values.resize(inner_.size());
-  double* out = values.data();
-  parallel_for_indices<Eigen::Index>(non_zeros(), 4096, [&](Eigen::Index nz) {
-    double sum = 0.0;
-    for (int i = first_[std::size_t(nz)]; i < first_[std::size_t(nz) + 1]; ++i)
-      sum += local[std::size_t(slot_of_[std::size_t(i)])];
-    out[nz] = sum;
-  });
 }
 
 }  // namespace mcf

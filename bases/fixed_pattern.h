@@ -1,13 +1,13 @@
 #pragma once
-// A sparsity pattern built once from element-local (row, col) slots, then filled many times
-// from per-element local values without locks: each nonzero gathers the slots that land on it
-// in a fixed order, so assembly is parallel and bitwise deterministic for any thread count.
+// A sparsity pattern built once from element-local (row, col) slots: each nonzero knows the slots
+// that land on it, in ascending order, so a basis can fill its values many times by gathering per
+// nonzero from per-element values, without locks, in parallel and bitwise the same for any thread
+// count (HatBasis::update).
 
 #include "bases/basis.h"
 
 #include <Eigen/SparseCore>
 
-#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -22,26 +22,19 @@ class FixedPattern {
 
   Eigen::Index non_zeros() const { return Eigen::Index(inner_.size()); }
 
-  /// values[nz] = Σ local[slot] over the slots of nonzero nz (parallel over nonzeros); `values`
-  /// is resized to non_zeros().
-  void gather(const std::vector<double>& local, std::vector<double>& values) const;
-
   /// Values on this pattern (non_zeros() of them, in CSC order) seen as a matrix, so that several
   /// matrices on the pattern share its index arrays.
   SparseView view(const std::vector<double>& values) const {
     return view_of(outer_, inner_, values);
   }
 
-  std::size_t num_slots() const { return slot_of_.size(); }
-
-  /// The slots that land on nonzero nz, ascending: for element-aware gathers that read fewer
-  /// bytes than one local value per slot (HatBasis::update reads per-face values).
+  /// The slots that land on nonzero nz, ascending.
   std::span<const int> slots(Eigen::Index nz) const {
     return {slot_of_.data() + first_[std::size_t(nz)],
             std::size_t(first_[std::size_t(nz) + 1] - first_[std::size_t(nz)])};
   }
+  /// Column starts: the nonzeros of column j are [outer()[j], outer()[j + 1]).
   const std::vector<int>& outer() const { return outer_; }
-  const std::vector<int>& inner() const { return inner_; }
 
  private:
   std::vector<int> outer_, inner_;  // the pattern: column starts and row indices
