@@ -102,10 +102,11 @@ struct MultigridSolver::Impl {
     // in the finest numbering; coarse levels: their Galerkin products). Empty otherwise.
     std::vector<std::vector<double>> terms;
     // Transfer to the next finer level (absent on the finest level).
-    SparseMatrix P;     // n_{l+1} x n_l
-    SparseMatrix PT;    // n_l x n_{l+1}
-    Spa spa;            // accumulators of the Galerkin product
-    GalerkinPlan plan;  // its visits laid out once per pattern (may be empty: galerkin_plan)
+    SparseMatrix P;          // n_{l+1} x n_l
+    SparseMatrix PT;         // n_l x n_{l+1}
+    Spa spa;                 // accumulators of the Galerkin product
+    GalerkinPlan plan;       // its visits laid out once per pattern (may be empty: galerkin_plan)
+    int galerkin_calls = 0;  // products computed on this pattern (plan_for)
     // Work buffers (interleaved n x k, row stride padded to a multiple of 4).
     Buffer x, b, r;
     // Finest level, mixed precision: the iterate and right-hand side kept while a cycle runs on
@@ -187,7 +188,6 @@ struct MultigridSolver::Impl {
       C.A = symbolic_product(C.PT, symbolic_product(levels[l + 1].A, C.P));  // pattern of Pᵀ (A P)
       // Positions of transposed entries, to symmetrize the computed values exactly.
       C.transpose_pos = transpose_positions(C.A);
-      C.plan = galerkin_plan(Csc(levels[l + 1].A), C.P, C.A, C.inv);
     }
     for (std::size_t l = 0; l < nl; ++l) {
       Level& L = levels[l];
@@ -279,6 +279,15 @@ struct MultigridSolver::Impl {
     }
   }
 
+  /// The Galerkin plan of coarse level l (solvers/galerkin.h), built when the level's product is
+  /// computed a second time on its pattern: laying it out costs about two products, which a
+  /// pattern used once (the rebuilt octree's, new every step) would not earn back.
+  const GalerkinPlan* plan_for(std::size_t l) {
+    Level& C = levels[l];
+    if (++C.galerkin_calls == 2) C.plan = galerkin_plan(Csc(levels[l + 1].A), C.P, C.A, C.inv);
+    return &C.plan;
+  }
+
   /// Drops the kept terms (a call without a sum, or without the option).
   void drop_terms() {
     term_count = 0;
@@ -295,7 +304,7 @@ struct MultigridSolver::Impl {
       Csc A(F.A);
       A.val = F.terms[std::size_t(t)].data();
       galerkin_values(A, C.P, C.A, C.terms[std::size_t(t)].data(), C.transpose_pos, C.inv, C.spa,
-                      &C.plan);
+                      plan_for(l));
       ++term_products;
     }
     const double* mv = C.terms[0].data();
@@ -322,7 +331,7 @@ struct MultigridSolver::Impl {
         coarse_by_term(l, *by_term);
       else
         galerkin_values(Csc(levels[l + 1].A), C.P, C.A, C.A.valuePtr(), C.transpose_pos, C.inv,
-                        C.spa, &C.plan);
+                        C.spa, plan_for(l));
     }
     bool ok = true;
     for (std::size_t l = coarse ? 0 : levels.size() - 1; l < levels.size(); ++l) {

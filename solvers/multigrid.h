@@ -50,9 +50,10 @@
 // the columns of the stored Pᵀ). The Galerkin pattern of Pᵀ (A_{l+1} P) is built once
 // (symbolic_builds()); later set_matrix calls only recompute values: per coarse column J, v =
 // A_{l+1} P e_J, then the upper entries (I <= J) as dot products P e_I · v, mirrored, so A_l is
-// exactly symmetric and A P is never stored. v lives in a buffer of the column's few dozen fine
-// rows, numbered once with the pattern (solvers/galerkin.h, GalerkinPlan); where that plan would
-// outgrow A, in a thread-local dense accumulator of the fine level's size. Measured numbers:
+// exactly symmetric and A P is never stored. From the second product on a pattern, v lives in a
+// buffer of the column's few dozen fine rows, numbered once (solvers/galerkin.h, GalerkinPlan);
+// before it, or where that plan would outgrow A, in a thread-local dense accumulator of the fine
+// level's size. Measured numbers:
 // docs/benchmarks.md (the micro-benchmarks BM_Rebuilt_Cycle, BM_Rebuilt_Sweep, BM_Floor_*).
 
 #include "solvers/linear_solver.h"
