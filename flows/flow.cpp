@@ -52,6 +52,7 @@ struct StepTally {
   int solves = 0, iterations = 0;
   double contraction = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
   int fallbacks = 0, fallback_iterations = 0;  ///< solves whose stalled cycles CG took over
+  int direct_solves = 0;                       ///< of those, the ones a factorization finished
   SolveReport worst;
   // Every solve's residuals, in order (Taylor-2 and Neumann-2 solve twice a step).
   std::vector<std::vector<double>> residuals_per_solve;
@@ -122,9 +123,10 @@ class FlowStepContext final : public StepContext {
     t.iterations += r.iterations;
     t.residuals_per_solve.push_back(r.residuals);
     t.contraction = std::max(t.contraction, r.contraction);
-    if (r.fallback_iterations > 0) {
+    if (r.fallback_iterations > 0 || r.direct_fallback) {
       ++t.fallbacks;
       t.fallback_iterations += r.fallback_iterations;
+      if (r.direct_fallback) ++t.direct_solves;
     }
     if (!r.columns.empty()) {
       nlohmann::json columns = nlohmann::json::array();
@@ -366,7 +368,8 @@ nlohmann::json FlowRun::solver_record(int step, double t) const {
   if (tally.contraction >= 0) record["solver"]["contraction"] = tally.contraction;
   if (tally.fallbacks > 0)
     record["solver"]["fallback"] = {{"solves", tally.fallbacks},
-                                    {"iterations", tally.fallback_iterations}};
+                                    {"iterations", tally.fallback_iterations},
+                                    {"direct_solves", tally.direct_solves}};
   if (!tally.columns_per_solve.empty()) record["solver"]["rhs_per_solve"] = tally.columns_per_solve;
   if (!tally.preconditioner_setups.empty())
     record["solver"]["preconditioner_setup"] = tally.preconditioner_setups;

@@ -41,6 +41,9 @@ struct SolverConfig {
   /// (never below `fallback_tolerance`; solvers/multigrid_fallback.h). 0 = never.
   double stall_ratio = 0.2;
   double fallback_tolerance = 1e-10;
+  /// multigrid: the fallback CG's iterations after which (or on whose breakdown) CHOLMOD solves
+  /// the step, and every later stalled step at once (solvers/multigrid_fallback.h). 0 = never.
+  int direct_after = 10;
   /// multigrid (also as PCG's preconditioner): refresh the coarse operators term by term,
   /// recomputing only the terms whose values changed (MultigridOptions::galerkin_by_term).
   bool galerkin_by_term = false;

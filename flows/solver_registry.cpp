@@ -30,6 +30,8 @@ std::unique_ptr<LinearSolver> make_multigrid(const SolverConfig& c) {
   f.stall_ratio = c.stall_ratio;
   f.tolerance = c.fallback_tolerance;
   f.max_iterations = c.max_iterations;
+  f.direct_after = c.direct_after;
+  f.direct_blas_threads = c.blas_threads;
   return std::make_unique<FallbackMultigridSolver>(multigrid_options(c), f);
 }
 
@@ -86,7 +88,14 @@ NamedTable<SolverRow> built_in() {
                  option("fallback_tolerance", OptionType::number, 1e-10, "--fallback-tolerance",
                         "Multigrid: the fallback CG never stops below this relative residual"),
                  [](auto& c) -> auto& { return c.solver.fallback_tolerance; }),
-             1e-300, 1)};
+             1e-300, 1),
+      ranged(bind(
+                 option("direct_after", OptionType::integer, 10, "--direct-after",
+                        "Multigrid: when the fallback CG has not reached its target after this "
+                        "many iterations, or breaks down, a sparse Cholesky factorization solves "
+                        "the step, and later stalled steps at once; 0 = never"),
+                 [](auto& c) -> auto& { return c.solver.direct_after; }),
+             0, 1000000)};
   multigrid.iterative = multigrid.needs_hierarchy = true;
   multigrid.default_tolerance = 0;  // run `cycles` cycles
   SolverRow petsc{"petsc", "PETSc's KSP, default CG + GAMG (docs/petsc.md)", make_petsc,

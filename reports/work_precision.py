@@ -348,9 +348,11 @@ def make(results, out_dir, reference, written):
 
 
 def fallback_steps(result):
-    """(steps whose solves fell back to CG, CG iterations in all) of a result."""
+    """(steps whose solves fell back, CG iterations in all, steps a factorization finished) of a
+    result."""
     steps = [s for s in result.get("steps") or [] if common.get(s, "solver.fallback")]
-    return len(steps), sum(common.get(s, "solver.fallback.iterations", 0) or 0 for s in steps)
+    return (len(steps), sum(common.get(s, "solver.fallback.iterations", 0) or 0 for s in steps),
+            sum(1 for s in steps if (common.get(s, "solver.fallback.direct_solves", 0) or 0) > 0))
 
 
 def degenerating_sections(points):
@@ -369,12 +371,12 @@ def degenerating_sections(points):
             name = "distance to the reference flow"
             e, x = p["errors"].get("RMS distance to the reference flow"), (exact or {}).get("errors", {}).get(
                 "RMS distance to the reference flow")
-            n, its = fallback_steps(p["result"])
+            n, its, direct = fallback_steps(p["result"])
             rows.append([describe(p), common.fmt(e), exact["family"] if exact else "—", common.fmt(x),
                          common.fmt(e / x, "%.2f") if common.finite(e) and common.finite(x) else "—",
                          "%s / %s" % (common.get(p["result"], "stop.step", "?"),
                                       common.get(exact["result"], "stop.step", "?") if exact else "—"),
-                         "%d steps, %d CG iterations" % (n, its)])
+                         "%d steps, %d CG iterations, %d factorized" % (n, its, direct)])
         if rows:
             out.append("### Degenerating: %s, %s vertices — the fast settings with their fallback\n\n" % (
                 case[0][1], case[1]) + common.markdown_table(

@@ -44,6 +44,9 @@ struct SolveReport {
   double contraction = -1;
   /// Iterations of a fallback solver that took over after this one stalled (0: none ran).
   int fallback_iterations = 0;
+  /// A sparse factorization solved this system after the iterative solver and its fallback did
+  /// not (solvers/multigrid_fallback.h).
+  bool direct_fallback = false;
   std::string message;
   /// Per right-hand side, from a solver that reports them (PETSc); empty otherwise.
   std::vector<ColumnReport> columns;

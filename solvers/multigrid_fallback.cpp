@@ -16,13 +16,51 @@ FallbackMultigridSolver::FallbackMultigridSolver(MultigridOptions cycles,
       fallback_(fallback) {}
 
 SolveReport FallbackMultigridSolver::set_matrix(const SparseMatrix& A, HierarchyView hierarchy) {
-  pcg_current_ = false;
+  pcg_current_ = direct_current_ = false;
   return multigrid_.set_matrix(A, hierarchy);
 }
 
 SolveReport FallbackMultigridSolver::set_matrix_sum(const MatrixSum& sum, HierarchyView hierarchy) {
-  pcg_current_ = false;
+  pcg_current_ = direct_current_ = false;
   return multigrid_.set_matrix_sum(sum, hierarchy);
+}
+
+namespace {
+
+/// `first`'s message followed by `more`, "; "-separated.
+std::string joined(const std::string& first, const std::string& more) {
+  if (first.empty()) return more;
+  if (more.empty()) return first;
+  return first + "; " + more;
+}
+
+}  // namespace
+
+SolveReport FallbackMultigridSolver::solve_direct(const ConstMatrixRef& B, MatrixRef X,
+                                                  SolveReport before, const std::string& why) {
+  if (!direct_) direct_ = std::make_unique<CholmodSolver>(fallback_.direct_blas_threads);
+  if (!direct_current_) {
+    // The same pattern from step to step keeps the symbolic analysis (CholmodSolver compares).
+    const SolveReport f = direct_->set_matrix(multigrid_.level_matrix(multigrid_.levels() - 1));
+    if (!f.ok()) {
+      SolveReport out = before;
+      out.status = f.status;
+      out.message = joined(joined(before.message, why), "the factorization failed: " + f.message);
+      return out;
+    }
+    direct_current_ = true;
+  }
+  prefer_direct_ = true;
+  ++direct_solves_;
+  const SolveReport d = direct_->solve(B, X);
+  SolveReport out = before;
+  out.status = d.status;
+  out.relative_residual = d.relative_residual;
+  out.residuals.push_back(d.relative_residual);
+  out.direct_fallback = true;
+  out.message = joined(joined(before.message, why), "a sparse Cholesky factorization solved it");
+  if (!d.message.empty()) out.message = joined(out.message, d.message);
+  return out;
 }
 
 SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
@@ -30,6 +68,14 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   const bool stalled = cycles.ok() && cycles.contraction > fallback_.stall_ratio &&
                        cycles.relative_residual > fallback_.tolerance;
   if (!stalled) return cycles;
+  ++fallbacks_;
+  char note[192];
+  std::snprintf(note, sizeof note, "cycles stalled (contraction %.3g > %.3g)", cycles.contraction,
+                fallback_.stall_ratio);
+  cycles.message = joined(cycles.message, note);
+  const bool direct_allowed = fallback_.direct_after > 0;
+  if (direct_allowed && prefer_direct_)
+    return solve_direct(B, X, cycles, "an earlier stalled step needed the factorization");
   // r_k = r_0 · contraction^k, so healthy cycles would have reached r_k · (bound / contraction)^k.
   const double target =
       std::max(fallback_.tolerance,
@@ -37,7 +83,8 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
                    std::pow(fallback_.stall_ratio / cycles.contraction, cycles.iterations));
   PcgOptions o;
   o.relative_tolerance = target;
-  o.max_iterations = fallback_.max_iterations;
+  o.max_iterations = direct_allowed ? std::min(fallback_.max_iterations, fallback_.direct_after)
+                                    : fallback_.max_iterations;
   o.preconditioner = PcgPreconditioner::external;
   if (!pcg_) {
     pcg_ = std::make_unique<PcgSolver>(o);
@@ -52,7 +99,6 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
     if (!m.ok()) return m;
     pcg_current_ = true;
   }
-  ++fallbacks_;
   SolveReport cg = pcg_->solve(B, X);
   SolveReport out = cg;
   out.iterations = cycles.iterations + cg.iterations;
@@ -60,14 +106,13 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   out.contraction = cycles.contraction;
   out.residuals = cycles.residuals;
   out.residuals.insert(out.residuals.end(), cg.residuals.begin(), cg.residuals.end());
-  char note[192];
-  std::snprintf(
-      note, sizeof note,
-      "cycles stalled (contraction %.3g > %.3g): CG preconditioned by the cycle took over to %.3g",
-      cycles.contraction, fallback_.stall_ratio, target);
-  out.message = cycles.message.empty() ? note : cycles.message + "; " + note;
-  if (!cg.message.empty()) out.message += "; " + cg.message;
-  return out;
+  char took[128];
+  std::snprintf(took, sizeof took, "CG preconditioned by the cycle took over to %.3g", target);
+  out.message = joined(joined(cycles.message, took), cg.message);
+  if (!direct_allowed || cg.status == SolveStatus::converged) return out;
+  // CG broke down or ran out of its iterations: the factorization solves the step (it
+  // overwrites X, whatever CG left there).
+  return solve_direct(B, X, out, "CG did not reach it");
 }
 
 }  // namespace mcf

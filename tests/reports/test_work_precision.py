@@ -99,7 +99,7 @@ def degenerate(index, solver, distance):
 dino = [degenerate(20, {"name": "cholmod"}, 2e-4),
         degenerate(21, dict(mg(2), stall_ratio=0.5), 2.5e-4)]
 section = "\n".join(wp.degenerating_sections(wp.points_of(dino)))
-check("| hat MG V(2,2) + fallback x2 | 0.00025 | hat + CHOLMOD | 0.0002 | 1.25 | 3 / 3 | 1 steps, 7 CG iterations |"
+check("| hat MG V(2,2) + fallback x2 | 0.00025 | hat + CHOLMOD | 0.0002 | 1.25 | 3 / 3 | 1 steps, 7 CG iterations, 0 factorized |"
       in section, "degenerating table:\n" + section)
 results += dino
 

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
@@ -1271,6 +1272,7 @@ TEST(MultigridFallback, StalledCyclesHandOverToCgThatReachesTheTolerance) {
   mcf::StallFallbackOptions f;
   f.stall_ratio = 1e-12;
   f.tolerance = 1e-11;
+  f.direct_after = 0;  // CG alone here; the factorization after it is tested below
   mcf::FallbackMultigridSolver guarded(o, f);
   for (int round = 0; round < 2; ++round) {  // the second solve reuses CG's matrix
     ASSERT_TRUE(guarded.set_matrix(pr.A, pr.view()).ok());
@@ -1313,6 +1315,80 @@ TEST(MultigridFallback, StalledCyclesHandOverToCgThatReachesTheTolerance) {
   ASSERT_TRUE(capped.set_matrix(pr.A, pr.view()).ok());
   Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
   EXPECT_EQ(capped.solve(B, X).status, SolveStatus::max_iterations);
+}
+
+TEST(MultigridFallback, CgThatRunsOutHandsTheStepToTheFactorizationAndLaterStallsGoThereAtOnce) {
+  Problem pr = make_problem(4, 1, 0.05);
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 11);
+  MultigridOptions o;
+  mcf::StallFallbackOptions f;
+  f.stall_ratio = 1e-12;  // every solve stalls
+  f.tolerance = 1e-15;    // out of CG's reach in 2 iterations
+  f.direct_after = 2;
+  mcf::FallbackMultigridSolver guarded(o, f);
+  // Two matrices on one pattern: the factor must follow set_matrix.
+  const SparseMatrix A2 = make_problem(4, 1, 0.3).A;
+  ASSERT_EQ(A2.nonZeros(), pr.A.nonZeros());
+  for (int round = 0; round < 3; ++round) {
+    const SparseMatrix& A = round == 1 ? A2 : pr.A;
+    ASSERT_TRUE(guarded.set_matrix(A, pr.view()).ok());
+    const Eigen::MatrixXd exact = Eigen::SimplicialLDLT<SparseMatrix>(A).solve(B);
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(A.rows(), 3);
+    const auto rep = guarded.solve(B, X);
+    EXPECT_EQ(rep.status, SolveStatus::converged);
+    EXPECT_TRUE(rep.direct_fallback);
+    EXPECT_LT(rel_diff(X, exact), 1e-10);
+    EXPECT_LT(rep.relative_residual, 1e-12);
+    EXPECT_EQ(rep.residuals.back(), rep.relative_residual);
+    // The first stalled solve tries CG for its 2 iterations; later ones go to the factor at once.
+    EXPECT_EQ(rep.fallback_iterations, round == 0 ? 2 : 0);
+    EXPECT_EQ(rep.iterations, 1 + rep.fallback_iterations);
+    EXPECT_NE(rep.message.find("factorization solved it"), std::string::npos) << rep.message;
+    EXPECT_EQ(guarded.direct_solves(), round + 1);
+    EXPECT_EQ(guarded.fallbacks(), round + 1);
+  }
+  // Contracting cycles never touch the factorization, however it was used before.
+  mcf::StallFallbackOptions healthy = f;
+  healthy.stall_ratio = 0.9;
+  mcf::FallbackMultigridSolver fine(o, healthy);
+  ASSERT_TRUE(fine.set_matrix(pr.A, pr.view()).ok());
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  EXPECT_FALSE(fine.solve(B, X).direct_fallback);
+  EXPECT_EQ(fine.direct_solves(), 0);
+}
+
+TEST(MultigridFallback, AMatrixThatIsNotDefiniteFailsTheStepAsAFactorizationWould) {
+  // A - c v v^T for the checkerboard v on the interior functions: v^T A v < 0, so A is not
+  // definite, but the trilinear restriction nearly annihilates v (exactly, away from the
+  // boundary), so the coarse levels stay definite and the multigrid accepts the matrix. The
+  // cycles do not contract, CG breaks down or runs out, and the factorization meets a non-positive
+  // pivot: the step fails and says why, with or without the factorization.
+  Problem pr = make_problem(3, 1, 0.05);
+  const int N = 8;
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(pr.A.rows());
+  for (int k = 1; k < N; ++k)
+    for (int j = 1; j < N; ++j)
+      for (int i = 1; i < N; ++i) v[vid(N, i, j, k)] = ((i + j + k) & 1) ? -1.0 : 1.0;
+  const double c = 2 * v.dot(pr.A * v) / (v.squaredNorm() * v.squaredNorm());
+  const SparseMatrix A = (Eigen::MatrixXd(pr.A) - c * v * v.transpose()).sparseView();
+  ASSERT_LT(v.dot(A * v), 0);
+  const Eigen::MatrixXd B = random_matrix(A.rows(), 2, 12);
+  for (const int direct_after : {0, 10}) {
+    mcf::StallFallbackOptions f;
+    f.direct_after = direct_after;
+    mcf::FallbackMultigridSolver guarded(MultigridOptions{}, f);
+    const auto set = guarded.set_matrix(A, pr.view());
+    ASSERT_TRUE(set.ok()) << set.message;
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(A.rows(), 2);
+    const auto rep = guarded.solve(B, X);
+    EXPECT_FALSE(rep.ok()) << mcf::to_string(rep.status) << ": " << rep.message;
+    EXPECT_FALSE(rep.direct_fallback);
+    EXPECT_EQ(guarded.direct_solves(), 0);
+    if (direct_after > 0) {
+      EXPECT_EQ(rep.status, SolveStatus::not_positive_definite);
+      EXPECT_NE(rep.message.find("factorization failed"), std::string::npos) << rep.message;
+    }
+  }
 }
 
 }  // namespace
