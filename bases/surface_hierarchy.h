@@ -25,7 +25,8 @@
 // Each level also gets a Gauss-Seidel colouring of the pattern its Galerkin matrix will have
 // (the finest: vertices sharing a triangle; coarser: P^T A P's), smallest-last greedy, so that
 // the multigrid can relax colour by colour in parallel; a level that needs more than the eight
-// colours the solver takes gets no colouring and is relaxed serially.
+// colours the solver takes gets no colouring and is relaxed in blocks of consecutive rows
+// (solvers/multigrid.h, "Smoother ordering").
 //
 // Everything is deterministic: serial loops in fixed orders, ties broken by index, and parallel
 // loops whose iterations write disjoint outputs, over fixed chunks where they gather (the same

@@ -121,18 +121,24 @@ void check_colouring(LevelNumbering& L, const SparseMatrix& Am,
 
 void find_blocks(LevelNumbering& L, const SparseMatrix& Am) {
   L.block_tiles = 1;
-  if (!L.coloured) return;
   const Csc A(Am);
+  L.rows = A.rows;
+  L.block_rows = std::max(A.rows, 1);
+  // The farthest coupling, in tiles (coloured) or in rows (not).
+  const int unit = L.coloured ? kTile : 1;
   const int reach = tbb::parallel_reduce(
       tbb::blocked_range<int>(0, A.rows, 4096), 0,
       [&](const tbb::blocked_range<int>& rows, int far) {
         for (int r = rows.begin(); r < rows.end(); ++r)
           for (int p = A.outer[r]; p < A.outer[r + 1]; ++p)
-            far = std::max(far, std::abs(A.inner[p] / kTile - r / kTile));
+            far = std::max(far, std::abs(A.inner[p] / unit - r / unit));
         return far;
       },
       [](int a, int b) { return std::max(a, b); });
-  L.block_tiles = std::max(reach, kMinBlockTiles);
+  if (L.coloured)
+    L.block_tiles = std::max(reach, kMinBlockTiles);
+  else
+    L.block_rows = std::max({reach, kMinBlockTiles * kTile, 1});
 }
 
 std::vector<int> relaxation_order(const LevelNumbering& L, int n, bool reverse) {
@@ -145,7 +151,11 @@ std::vector<int> relaxation_order(const LevelNumbering& L, int n, bool reverse) 
           for (int r = r0; r < r1; ++r) order.push_back(old_index(L.perm, r));
         });
   } else {
-    for (int i = 0; i < n; ++i) order.push_back(old_index(L.perm, reverse ? n - 1 - i : i));
+    for (int pi = 0; pi < 2; ++pi)
+      for (int q = block_parity(pi, reverse); q < L.blocks(); q += 2)
+        for (int i = 0; i < L.block_last(q) - L.block_first(q); ++i)
+          order.push_back(
+              old_index(L.perm, reverse ? L.block_last(q) - 1 - i : L.block_first(q) + i));
   }
   return order;
 }

@@ -64,8 +64,16 @@ struct LevelNumbering {
   bool coloured = false;
   std::vector<int> segment_start;  // rows of colour c in tile t: [s[8t+c], s[8t+c+1])
   int block_tiles = 1;             // tiles per relaxation block (find_blocks())
+  /// A level without a valid colouring: rows per relaxation block (find_blocks()), of n rows.
+  int block_rows = 1, rows = 0;
   int tiles() const { return int(segment_start.size() / 8); }
-  int blocks() const { return (tiles() + block_tiles - 1) / block_tiles; }
+  int blocks() const {
+    return coloured ? (tiles() + block_tiles - 1) / block_tiles
+                    : (rows + block_rows - 1) / block_rows;
+  }
+  /// The internal rows [first, last) of relaxation block q of a level without colours.
+  int block_first(int q) const { return q * block_rows; }
+  int block_last(int q) const { return std::min(rows, (q + 1) * block_rows); }
 };
 
 /// The level's internal numbering from its given colours: blocks of kTile consecutive caller
@@ -75,16 +83,19 @@ void number_by_colour(LevelNumbering& L, int n, const std::vector<std::uint8_t>*
 
 /// A numbered level is coloured when no two functions of one colour couple (checked on the
 /// level's matrix pattern A, in the internal numbering, with its given colours); otherwise it is
-/// relaxed serially in its internal order.
+/// relaxed in blocks of rows of its internal order (find_blocks()).
 void check_colouring(LevelNumbering& L, const SparseMatrix& A,
                      const std::vector<std::uint8_t>* given);
 
-/// Relaxation blocks of a coloured level (header, "Smoother ordering"): runs of `block_tiles`
+/// Relaxation blocks (header, "Smoother ordering"). A coloured level: runs of `block_tiles`
 /// consecutive tiles, at least as many as the farthest coupling reaches (in tiles), so rows of
 /// block q couple only with blocks q-1, q, q+1 and blocks of one parity never couple.
 /// A block's rows and iterates stay in cache through its eight colours (on the armadillo at
 /// depth 9 the farthest coupling reaches 9 tiles). A floor of kMinBlockTiles (8) instead of 1
 /// costs nothing measurable there and keeps small levels from being cut into many tiny tasks.
+/// A level without colours: runs of `block_rows` consecutive rows, at least the farthest coupling
+/// (in rows) and at least kMinBlockTiles tiles' worth, for the same reason; a level whose
+/// couplings reach across half of it has at most two blocks, whose order is plain 0..n-1.
 /// A is the level's matrix in the internal numbering.
 void find_blocks(LevelNumbering& L, const SparseMatrix& A);
 

@@ -196,8 +196,12 @@ struct MultigridSolver::Impl {
       find_blocks(L, L.A);
       // The serial fallback reads the double-precision matrix; the finest level's compact rows
       // are the matrix's own (aligned) unless its sweeps read single precision.
-      L.smoother = L.coloured ? smoother_pattern(L.A, L.diag_pos, l + 1 == nl && !fine_single)
-                              : SmootherRows{};
+      if (L.coloured)
+        L.smoother = smoother_pattern(L.A, L.diag_pos, l + 1 == nl && !fine_single);
+      else if (l + 1 < nl)
+        L.smoother = smoother_pattern(L.A, L.diag_pos, false);
+      else
+        L.smoother = SmootherRows{};
     }
     k = 0;
     work.assign(nl, MultigridLevelWork{});
@@ -387,10 +391,38 @@ struct MultigridSolver::Impl {
                               for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
                             });
         }
-      } else if (!reverse) {
-        for (int i = 0; i < A.cols; ++i) gs_row(A, dp, id, b, x, s, o, i);
       } else {
-        for (int i = A.cols - 1; i >= 0; --i) gs_row(A, dp, id, b, x, s, o, i);
+        // Without colours: blocks of consecutive rows, each relaxed in row order (reverse: the
+        // exact reverse), even blocks in parallel, then odd ones (header, "Smoother ordering").
+        const SmootherRows& S = L.smoother;
+        const auto relax_block = [&](int q) {
+          const int first = L.block_first(q), last = L.block_last(q);
+          if (!S.empty()) {
+            if (!reverse)
+              for (int i = first; i < last; ++i)
+                gs_row_compact(S, S.single.data(), id, b, x, s, o, i);
+            else
+              for (int i = last - 1; i >= first; --i)
+                gs_row_compact(S, S.single.data(), id, b, x, s, o, i);
+          } else if (!reverse) {
+            for (int i = first; i < last; ++i) gs_row(A, dp, id, b, x, s, o, i);
+          } else {
+            for (int i = last - 1; i >= first; --i) gs_row(A, dp, id, b, x, s, o, i);
+          }
+        };
+        const int blocks = L.blocks();
+        for (int pi = 0; pi < 2; ++pi) {
+          const int parity = block_parity(pi, reverse);
+          const int count = (blocks - parity + 1) / 2;
+          if (count <= 1) {
+            for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
+            continue;
+          }
+          tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
+                            [&](const tbb::blocked_range<int>& r) {
+                              for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
+                            });
+        }
       }
     }
   }
@@ -630,12 +662,17 @@ bool MultigridSolver::level_is_coloured(int l) const {
 }
 bool MultigridSolver::level_has_compact_smoother(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
-  return L.coloured && !L.smoother.empty();
+  return !L.smoother.empty();
 }
 std::vector<int> MultigridSolver::relaxation_blocks(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
   std::vector<int> block(std::size_t(L.n()), 0);
-  if (!L.coloured) return block;
+  if (!L.coloured) {
+    for (int q = 0; q < L.blocks(); ++q)
+      for (int r = L.block_first(q); r < L.block_last(q); ++r)
+        block[std::size_t(old_index(L.perm, r))] = q;
+    return block;
+  }
   // Block membership as the sweep itself walks it (for_block_segments), not re-derived here.
   for (int q = 0; q < L.blocks(); ++q)
     for_block_segments(L, q, false, [&](int r0, int r1) {
@@ -777,7 +814,7 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
     for (std::size_t l = 1; l < m.levels.size(); ++l)
       if (!m.levels[l].coloured)
         m.coarse_note += (m.coarse_note.empty() ? "" : "; ") + std::string("level ") +
-                         std::to_string(l) + " uses serial Gauss-Seidel (no valid colouring)";
+                         std::to_string(l) + " has no valid colouring: relaxed in blocks of rows";
   }
   rep.message = m.coarse_note;
   m.ready = true;
@@ -879,7 +916,7 @@ std::int64_t MultigridSolver::level_sweep_entries(int l) const {
 }
 int MultigridSolver::level_sweep_entry_bytes(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
-  if (!L.coloured || L.smoother.empty()) return int(sizeof(int) + sizeof(double));
+  if (L.smoother.empty()) return int(sizeof(int) + sizeof(double));
   return int(sizeof(std::int16_t) + (L.smoother.aligned ? sizeof(double) : sizeof(float)));
 }
 std::int64_t MultigridSolver::coarsest_factor_nonzeros() const {

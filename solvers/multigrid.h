@@ -12,7 +12,14 @@
 // forward sweep (pre-smoothing) relaxes the even blocks, in parallel, then the odd blocks; inside a
 // block colours 0..7 one after the other (functions of one colour never couple, so their order
 // does not matter). A reverse sweep (post-smoothing) is the exact reverse: odd blocks, then even
-// blocks, colours 7..0. Serial fallback (no valid colouring): rows 0..n-1, reverse n-1..0. Every
+// blocks, colours 7..0. A level without a valid colouring (the surface hierarchy's coarse levels,
+// whose Galerkin patterns need more than eight colours) is cut into blocks of consecutive rows
+// instead, each at least as long as the level's farthest coupling in rows, and relaxed the same
+// way, each block in row order (reverse: rows descending, odd blocks first). On a level numbered
+// with a small bandwidth (the hat basis's Cuthill–McKee order, which the coarse levels inherit)
+// that is nearly the lexicographic ordering, so it smooths as well as a serial sweep (the same
+// contraction to three digits on the armadillo), and it runs in parallel; a level whose couplings
+// reach across half of it has at most two blocks and is plain 0..n-1, reverse n-1..0. Every
 // sweep is thus one fixed serial Gauss-Seidel ordering whatever the thread count, and with
 // pre_smooth == post_smooth the cycle, started from zero, is a symmetric operator (precondition()).
 // Why blocks and not one pass per colour over the whole level: a colour pass reads the iterates of
@@ -21,9 +28,10 @@
 // its eight colours.
 //
 // Smoother matrix: the sweeps read each level's off-diagonal entries with 16-bit column offsets,
-// in single precision on coarse levels (6 bytes an entry instead of 12) and in double precision on
-// the finest (10 bytes; the values are the finest matrix's own, so the largest matrix is stored
-// once): the sweeps stream the matrix ten times per level visit and are bound by its bytes.
+// in single precision on coarse levels, coloured or not (6 bytes an entry instead of 12), and in
+// double precision on a coloured finest level (10 bytes; the values are the finest matrix's own,
+// so the largest matrix is stored once): the sweeps stream the matrix ten times per level visit
+// and are bound by its bytes.
 // Coarse-level sweeps only shape a correction of the finest level's residual, which the
 // residual, the transfers and the coarse operators keep exact, so the cycle converges to the
 // solution of A x = b; a rounded finest-level matrix would not (solvers/smoother.h, SmootherRows).
@@ -41,7 +49,7 @@
 // order in which a row's terms are added differs from the caller's numbering (the finest level's
 // sweeps add them in the caller's order, its residual too but for the diagonal's term, which it
 // adds last; coarse levels add in internal order); level_matrix() converts back. A level whose
-// given colouring is invalid keeps the internal order and is relaxed serially in it.
+// given colouring is invalid keeps the internal order and is relaxed in blocks of rows of it.
 //
 // Layout and cost: right-hand sides are interleaved (row-major n x k, the row padded to a multiple
 // of 4 columns) in preallocated per-level buffers; every kernel relaxes four columns of a row as
