@@ -25,6 +25,18 @@ Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3
   return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
 }
 
+/// F's rows in the order of their smallest vertex (a stable counting sort: faces with the same
+/// smallest vertex keep their order).
+Triangles faces_by_first_function(const Triangles& F, int vertices) {
+  std::vector<int> start(std::size_t(vertices) + 1, 0);
+  const auto first = [&](Eigen::Index f) { return F.row(f).minCoeff(); };
+  for (Eigen::Index f = 0; f < F.rows(); ++f) ++start[std::size_t(first(f)) + 1];
+  for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+  Triangles out(F.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) out.row(start[std::size_t(first(f))]++) = F.row(f);
+  return out;
+}
+
 }  // namespace
 
 HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
@@ -35,6 +47,7 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
                                            : std::min(output_vertices, mesh.num_vertices())),
       mass_kind_(mass_kind) {
   const auto t0 = std::chrono::steady_clock::now();
+  Triangles hierarchy_faces;
   if (hierarchy) {
     // Functions numbered so that neighbours are close (bases/vertex_ordering.h), which the
     // multigrid's parallel relaxation needs; the mesh's own order is restored on evaluation.
@@ -45,6 +58,11 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
       vertices0_.row(Eigen::Index(k)) = mesh.vertices.row(order_[k]);
     for (Eigen::Index f = 0; f < faces_.rows(); ++f)
       for (int c = 0; c < 3; ++c) faces_(f, c) = rank[std::size_t(faces_(f, c))];
+    // The hierarchy is built on the faces in the mesh's order (below); the assembly reads them
+    // sorted by their first function, so that the update's per-face pass reads neighbouring
+    // corners and its gathers, per nonzero of a column, faces stored close together.
+    hierarchy_faces = faces_;
+    faces_ = faces_by_first_function(faces_, int(vertices0_.rows()));
   }
   const auto t0b = std::chrono::steady_clock::now();
   const Eigen::Index m = faces_.rows();
@@ -69,7 +87,7 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
   stats_.setup_seconds["integrate"] = std::chrono::duration<double>(t2 - t1).count();
   if (hierarchy) {
     const auto t3 = std::chrono::steady_clock::now();
-    hierarchy_ = build_surface_hierarchy(vertices0_, faces_, *hierarchy);
+    hierarchy_ = build_surface_hierarchy(vertices0_, hierarchy_faces, *hierarchy);
     hierarchy_.points.clear();  // only the prolongations and colours are used by the solver
     hierarchy_.points.shrink_to_fit();
     stats_.levels = int(hierarchy_.colours.size());

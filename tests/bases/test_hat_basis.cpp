@@ -4,6 +4,7 @@
 
 #include "bases/hat_basis.h"
 #include "datasets/generators.h"
+#include "datasets/subdivide.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
@@ -164,6 +165,56 @@ TEST(HatBasis, MassAndStiffnessShareOnePattern) {
   basis.update(2.0 * mesh.vertices, true, true);
   EXPECT_EQ(basis.mass().valuePtr(), M.valuePtr());
   EXPECT_LT((SparseMatrix(basis.mass()) - 4.0 * M0).norm(), 1e-12 * M0.norm());  // areas scale by 4
+}
+
+TEST(HatBasis, RenumberedForAHierarchyItAssemblesTheSameMatrices) {
+  // With a hierarchy the functions are numbered in Cuthill-McKee order and the assembly reads the
+  // faces sorted by their first function; the matrices are the mesh-order basis's, renumbered,
+  // up to the order in which a nonzero's faces are added. An ellipsoid split once: its midpoints
+  // are numbered after the corners, so both orders differ from the mesh's.
+  TriangleMesh m = subdivide_midpoint(make_icosphere(4));
+  m.vertices.col(0) *= 1.5;
+  HatBasis plain(m);
+  HatBasis ordered(m, MassKind::consistent, SurfaceHierarchyOptions{});
+  const Eigen::Index n = m.num_vertices();
+  Coefficients index = Coefficients::Zero(n, 3);
+  for (Eigen::Index k = 0; k < n; ++k) index(k, 0) = double(k);
+  const Positions function_of = ordered.evaluate_vertices(index);  // vertex v is function (v, 0)
+  std::vector<int> k_of(static_cast<std::size_t>(n));
+  bool renumbered = false;
+  for (Eigen::Index v = 0; v < n; ++v) {
+    k_of[std::size_t(v)] = int(function_of(v, 0));
+    renumbered = renumbered || k_of[std::size_t(v)] != int(v);
+  }
+  ASSERT_TRUE(renumbered);
+  const auto compare = [&](const char* when) {
+    for (const bool stiffness : {false, true}) {
+      const SparseMatrix A =
+          stiffness ? SparseMatrix(plain.stiffness()) : SparseMatrix(plain.mass());
+      const SparseMatrix B =
+          stiffness ? SparseMatrix(ordered.stiffness()) : SparseMatrix(ordered.mass());
+      ASSERT_EQ(A.nonZeros(), B.nonZeros());
+      const double scale = A.coeffs().cwiseAbs().maxCoeff();
+      double worst = 0;
+      for (int j = 0; j < A.outerSize(); ++j)
+        for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+          worst = std::max(worst, std::abs(it.value() - B.coeff(k_of[std::size_t(it.row())],
+                                                                k_of[std::size_t(j)])));
+      EXPECT_LE(worst, 1e-13 * scale) << when << (stiffness ? " stiffness" : " mass");
+    }
+  };
+  compare("initial");
+  // A random move, updated in both numberings.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.02, 0.02);
+  Positions X = m.vertices;
+  for (Eigen::Index v = 0; v < n; ++v)
+    for (int c = 0; c < 3; ++c) X(v, c) += u(rng);
+  Coefficients Y(n, 3);
+  for (Eigen::Index v = 0; v < n; ++v) Y.row(k_of[std::size_t(v)]) = X.row(v);
+  plain.update(X, true, true);
+  ordered.update(Y, true, true);
+  compare("moved");
 }
 
 }  // namespace
