@@ -356,6 +356,24 @@ struct MultigridSolver::Impl {
 
   // ---- cycle ----
 
+  /// A sweep's two passes over relaxation blocks (header, "Smoother ordering"): the blocks of one
+  /// parity (parity, parity + 2, ...) never couple, so each pass relaxes them in parallel.
+  template <class Relax>
+  static void relax_by_parity(int blocks, bool reverse, const Relax& relax_block) {
+    for (int pi = 0; pi < 2; ++pi) {
+      const int parity = block_parity(pi, reverse);
+      const int count = (blocks - parity + 1) / 2;
+      if (count <= 1) {
+        for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
+        continue;
+      }
+      tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
+                        [&](const tbb::blocked_range<int>& r) {
+                          for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
+                        });
+    }
+  }
+
   void sweep(int l, bool reverse) {
     Level& L = levels[std::size_t(l)];
     const Csc A(L.A);
@@ -378,19 +396,7 @@ struct MultigridSolver::Impl {
             }
           });
         };
-        const int blocks = L.blocks();
-        for (int pi = 0; pi < 2; ++pi) {
-          const int parity = block_parity(pi, reverse);
-          const int count = (blocks - parity + 1) / 2;  // blocks parity, parity + 2, ...
-          if (count <= 1) {
-            for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
-            continue;
-          }
-          tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
-                            [&](const tbb::blocked_range<int>& r) {
-                              for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
-                            });
-        }
+        relax_by_parity(L.blocks(), reverse, relax_block);
       } else {
         // Without colours: blocks of consecutive rows, each relaxed in row order (reverse: the
         // exact reverse), even blocks in parallel, then odd ones (header, "Smoother ordering").
@@ -410,19 +416,7 @@ struct MultigridSolver::Impl {
             for (int i = last - 1; i >= first; --i) gs_row(A, dp, id, b, x, s, o, i);
           }
         };
-        const int blocks = L.blocks();
-        for (int pi = 0; pi < 2; ++pi) {
-          const int parity = block_parity(pi, reverse);
-          const int count = (blocks - parity + 1) / 2;
-          if (count <= 1) {
-            for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
-            continue;
-          }
-          tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
-                            [&](const tbb::blocked_range<int>& r) {
-                              for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
-                            });
-        }
+        relax_by_parity(L.blocks(), reverse, relax_block);
       }
     }
   }
