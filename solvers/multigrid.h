@@ -174,7 +174,7 @@ class MultigridSolver : public LinearSolver {
   int levels() const;  ///< 0 before set_matrix
   /// Level l's operator (l = 0 coarsest, levels()-1 finest) in the caller's numbering (a copy).
   SparseMatrix level_matrix(int l) const;
-  bool level_is_coloured(int l) const;  ///< false: serial Gauss-Seidel fallback
+  bool level_is_coloured(int l) const;  ///< false: relaxed in blocks of rows, no colours
   /// Whether level l's sweeps read the compact rows: 16-bit offsets, single-precision values on
   /// coarse levels, double on the finest (header, "Smoother matrix").
   bool level_has_compact_smoother(int l) const;
