@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <span>
+#include <utility>
 
 namespace mcf {
 
@@ -61,8 +62,8 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
     // The hierarchy is built on the faces in the mesh's order (below); the assembly reads them
     // sorted by their first function, so that the update's per-face pass reads neighbouring
     // corners and its gathers, per nonzero of a column, faces stored close together.
-    hierarchy_faces = faces_;
-    faces_ = faces_by_first_function(faces_, int(vertices0_.rows()));
+    hierarchy_faces = std::move(faces_);
+    faces_ = faces_by_first_function(hierarchy_faces, int(vertices0_.rows()));
   }
   const auto t0b = std::chrono::steady_clock::now();
   const Eigen::Index m = faces_.rows();

@@ -123,7 +123,6 @@ void find_blocks(LevelNumbering& L, const SparseMatrix& Am) {
   L.block_tiles = 1;
   const Csc A(Am);
   L.rows = A.rows;
-  L.block_rows = std::max(A.rows, 1);
   // The farthest coupling, in tiles (coloured) or in rows (not).
   const int unit = L.coloured ? kTile : 1;
   const int reach = tbb::parallel_reduce(
@@ -138,7 +137,7 @@ void find_blocks(LevelNumbering& L, const SparseMatrix& Am) {
   if (L.coloured)
     L.block_tiles = std::max(reach, kMinBlockTiles);
   else
-    L.block_rows = std::max({reach, kMinBlockTiles * kTile, 1});
+    L.block_rows = std::max(reach, kMinBlockTiles * kTile);
 }
 
 std::vector<int> relaxation_order(const LevelNumbering& L, int n, bool reverse) {
@@ -153,9 +152,9 @@ std::vector<int> relaxation_order(const LevelNumbering& L, int n, bool reverse) 
   } else {
     for (int pi = 0; pi < 2; ++pi)
       for (int q = block_parity(pi, reverse); q < L.blocks(); q += 2)
-        for (int i = 0; i < L.block_last(q) - L.block_first(q); ++i)
+        for (int r = L.block_first(q); r < L.block_last(q); ++r)
           order.push_back(
-              old_index(L.perm, reverse ? L.block_last(q) - 1 - i : L.block_first(q) + i));
+              old_index(L.perm, reverse ? L.block_first(q) + L.block_last(q) - 1 - r : r));
   }
   return order;
 }
