@@ -2,6 +2,7 @@
 
 #include "bases/vertex_ordering.h"
 #include "core/parallel.h"
+#include "datasets/face_order.h"
 #include "datasets/validate.h"
 
 #include <Eigen/Geometry>
@@ -14,28 +15,22 @@ namespace mcf {
 
 namespace {
 
-/// Cotangent weights of one triangle: cot of the angle at each corner (0 for a degenerate one).
-Eigen::Vector3d corner_cotangents(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                  const Eigen::Vector3d& c) {
-  // cot of the angle at p between edges to q and r = (e1·e2) / |e1×e2|. A collapsed triangle
-  // (pinching) contributes nothing rather than inf, so the flow can report the singularity.
-  auto cot = [](const Eigen::Vector3d& e1, const Eigen::Vector3d& e2) {
-    const double cross = e1.cross(e2).norm();
-    return cross > 0.0 ? e1.dot(e2) / cross : 0.0;
-  };
-  return {cot(b - a, c - a), cot(c - b, a - b), cot(a - c, b - c)};
-}
+/// What one triangle contributes: its area and half the cotangent of the angle at each corner
+/// (the weight of the edge opposite it in K).
+struct FaceTerms {
+  double area;
+  double half_cot[3];
+};
 
-/// F's rows in the order of their smallest vertex (a stable counting sort: faces with the same
-/// smallest vertex keep their order).
-Triangles faces_by_first_function(const Triangles& F, int vertices) {
-  std::vector<int> start(std::size_t(vertices) + 1, 0);
-  const auto first = [&](Eigen::Index f) { return F.row(f).minCoeff(); };
-  for (Eigen::Index f = 0; f < F.rows(); ++f) ++start[std::size_t(first(f)) + 1];
-  for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
-  Triangles out(F.rows(), 3);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) out.row(start[std::size_t(first(f))]++) = F.row(f);
-  return out;
+/// A triangle's FaceTerms. cot at p between edges to q and r = (e1·e2) / |e1×e2|, and |e1×e2| is
+/// twice the area at every corner, so one cross product serves all three. A collapsed triangle
+/// (pinching) contributes no weights rather than inf, so the flow can report the singularity.
+inline FaceTerms face_terms(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                            const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, bc = c - b, ca = a - c;
+  const double twice_area = ab.cross(-ca).norm();
+  const double h = twice_area > 0.0 ? 0.5 / twice_area : 0.0;
+  return {0.5 * twice_area, {-h * ab.dot(ca), -h * bc.dot(ab), -h * ca.dot(bc)}};
 }
 
 }  // namespace
@@ -63,7 +58,7 @@ HatBasis::HatBasis(const TriangleMesh& mesh, MassKind mass_kind,
     // sorted by their first function, so that the update's per-face pass reads neighbouring
     // corners and its gathers, per nonzero of a column, faces stored close together.
     hierarchy_faces = std::move(faces_);
-    faces_ = faces_by_first_function(hierarchy_faces, int(vertices0_.rows()));
+    faces_ = faces_by_smallest_vertex(hierarchy_faces, vertices0_.rows());
   }
   const auto t0b = std::chrono::steady_clock::now();
   const Eigen::Index m = faces_.rows();
@@ -123,57 +118,66 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
   points_.resize(std::size_t(x.rows()));
   parallel_for_indices<Eigen::Index>(
       x.rows(), 4096, [&](Eigen::Index i) { points_[std::size_t(i)] = x.row(i).transpose(); });
-  parallel_for_indices<Eigen::Index>(m, 2048, [&](Eigen::Index f) {
-    const Eigen::Vector3d p[3] = {points_[std::size_t(faces_(f, 0))],
-                                  points_[std::size_t(faces_(f, 1))],
-                                  points_[std::size_t(faces_(f, 2))]};
-    if (update_mass) face_area_[std::size_t(f)] = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-    if (update_stiffness) {
-      // K_ij = -(cot α_ij + cot β_ij)/2 for an edge; corner c's cotangent weighs the opposite
-      // edge.
-      const Eigen::Vector3d cot = corner_cotangents(p[0], p[1], p[2]);
+  const auto corner = [&](Eigen::Index f, int c) -> const Eigen::Vector3d& {
+    return points_[std::size_t(faces_(f, c))];
+  };
+  if (update_stiffness) {
+    parallel_for_indices<Eigen::Index>(m, 2048, [&](Eigen::Index f) {
+      const FaceTerms t = face_terms(corner(f, 0), corner(f, 1), corner(f, 2));
+      if (update_mass) face_area_[std::size_t(f)] = t.area;
       for (int c = 0; c < 3; ++c)
-        corner_weight_[3 * std::size_t(f) + std::size_t(c)] = 0.5 * cot[c];
-    }
-  });
+        corner_weight_[3 * std::size_t(f) + std::size_t(c)] = t.half_cot[c];
+    });
+  } else {
+    parallel_for_indices<Eigen::Index>(m, 2048, [&](Eigen::Index f) {
+      face_area_[std::size_t(f)] =
+          0.5 * (corner(f, 1) - corner(f, 0)).cross(corner(f, 2) - corner(f, 0)).norm();
+    });
+  }
+  // Consistent P1 mass: A/6 on the diagonal, A/12 off it; lumped: A/3 on the diagonal, 0 off it.
+  // Stiffness off the diagonal: -Σ w over the faces sharing the edge (w of the corner opposite
+  // it, the third corner 3 - a - b); on it, minus the column's off-diagonal sum (rows sum to
+  // zero). Both are gathered in one pass over a column's slots when both change.
+  const bool lumped = mass_kind_ == MassKind::lumped;
+  const double diagonal_share = lumped ? 1.0 / 3.0 : 1.0 / 6.0;
+  const double off_share = lumped ? 0.0 : 1.0 / 12.0;
   const auto is_diagonal_slot = [](int slot) { return (slot % 9) % 4 == 0; };  // 3a + a
-  if (update_mass) {
-    // Consistent P1 mass: A/6 on the diagonal, A/12 off it; lumped: A/3 on the diagonal, 0 off it.
-    const bool lumped = mass_kind_ == MassKind::lumped;
-    mass_.resize(std::size_t(pattern_.non_zeros()));
+  const auto area_sum = [&](std::span<const int> slots) {
+    double area = 0.0;
+    for (const int slot : slots) area += face_area_[std::size_t(slot / 9)];
+    return area;
+  };
+  if (update_mass) mass_.resize(std::size_t(pattern_.non_zeros()));
+  if (update_stiffness) stiffness_.resize(std::size_t(pattern_.non_zeros()));
+  if (update_mass && !update_stiffness) {
     parallel_for_indices<Eigen::Index>(pattern_.non_zeros(), 4096, [&](Eigen::Index nz) {
       const std::span<const int> slots = pattern_.slots(nz);
-      const bool diagonal = is_diagonal_slot(slots.front());
-      double area = 0.0;
-      for (const int slot : slots) area += face_area_[std::size_t(slot / 9)];
-      mass_[std::size_t(nz)] = diagonal ? area / (lumped ? 3.0 : 6.0) : lumped ? 0.0 : area / 12.0;
+      mass_[std::size_t(nz)] =
+          area_sum(slots) * (is_diagonal_slot(slots.front()) ? diagonal_share : off_share);
     });
+    return;
   }
-  if (update_stiffness) {
-    // Off the diagonal, -Σ w over the faces sharing the edge (w of the corner opposite it, the
-    // third corner 3 - a - b); on it, minus the column's off-diagonal sum (rows sum to zero).
-    stiffness_.resize(std::size_t(pattern_.non_zeros()));
-    const std::vector<int>& outer = pattern_.outer();
-    parallel_for_indices<Eigen::Index>(Eigen::Index(outer.size()) - 1, 1024, [&](Eigen::Index j) {
-      double off_sum = 0.0;
-      int diagonal = -1;
-      for (int nz = outer[std::size_t(j)]; nz < outer[std::size_t(j) + 1]; ++nz) {
-        const std::span<const int> slots = pattern_.slots(nz);
-        if (is_diagonal_slot(slots.front())) {
-          diagonal = nz;
-          continue;
-        }
-        double w = 0.0;
-        for (const int slot : slots) {
-          const int a = (slot % 9) / 3, b = slot % 3;
-          w += corner_weight_[3 * std::size_t(slot / 9) + std::size_t(3 - a - b)];
-        }
-        stiffness_[std::size_t(nz)] = -w;
-        off_sum -= w;
+  const std::vector<int>& outer = pattern_.outer();
+  parallel_for_indices<Eigen::Index>(Eigen::Index(outer.size()) - 1, 1024, [&](Eigen::Index j) {
+    double off_sum = 0.0;
+    int diagonal = -1;
+    for (int nz = outer[std::size_t(j)]; nz < outer[std::size_t(j) + 1]; ++nz) {
+      const std::span<const int> slots = pattern_.slots(nz);
+      const bool on_diagonal = is_diagonal_slot(slots.front());
+      if (update_mass)
+        mass_[std::size_t(nz)] = area_sum(slots) * (on_diagonal ? diagonal_share : off_share);
+      if (on_diagonal) {
+        diagonal = nz;
+        continue;
       }
-      if (diagonal >= 0) stiffness_[std::size_t(diagonal)] = -off_sum;
-    });
-  }
+      double w = 0.0;  // the corner opposite the edge of slot 3a + b: 3 - a - b
+      for (const int slot : slots)
+        w += corner_weight_[3 * std::size_t(slot / 9) + std::size_t(3 - (slot % 9) / 3 - slot % 3)];
+      stiffness_[std::size_t(nz)] = -w;
+      off_sum -= w;
+    }
+    if (diagonal >= 0) stiffness_[std::size_t(diagonal)] = -off_sum;
+  });
 }
 
 }  // namespace mcf
