@@ -67,9 +67,11 @@ SparseMatrix adjacency(const TriangleMesh& m) {
 void expect_valid_colouring(const SparseMatrix& pattern, const std::vector<std::uint8_t>& c) {
   ASSERT_EQ(Eigen::Index(c.size()), pattern.rows());
   for (int j = 0; j < pattern.outerSize(); ++j)
-    for (SparseMatrix::InnerIterator it(pattern, j); it; ++it)
-      if (it.row() != j)
+    for (SparseMatrix::InnerIterator it(pattern, j); it; ++it) {
+      if (it.row() != j) {
         ASSERT_NE(c[std::size_t(it.row())], c[std::size_t(j)]) << it.row() << " " << j;
+      }
+    }
 }
 
 TEST(SurfaceHierarchy, ProlongationRowsSumToOneAndLevelsShrink) {
