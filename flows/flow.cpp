@@ -1,6 +1,7 @@
 #include "flows/flow.h"
 
 #include "core/parallel.h"
+#include "datasets/face_order.h"
 #include "datasets/validate.h"
 #include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
@@ -111,8 +112,9 @@ class FlowStepContext final : public StepContext {
     } else if (iterative_ && warm != fixed) {
       // The integrator's prediction, taken as far as it fits (flows/predicted_start.h).
       const SparseView M = basis_.mass(), K = basis_.stiffness();
-      const PredictedStart start = predicted_start(MatrixSum(a, M, b, K), R, fixed, warm);
-      Y = system_->solve(a, b, R, fixed, Coefficients(fixed + start.increment));
+      predicted_start(MatrixSum(a, M, b, K), R, fixed, warm, start_);
+      start_.increment += fixed;  // the start itself
+      Y = system_->solve(a, b, R, fixed, start_.increment);
     } else {
       Y = system_->solve(a, b, R, fixed, warm);
     }
@@ -169,6 +171,7 @@ class FlowStepContext final : public StepContext {
   StepTally tally_;
   bool iterative_ = false;  ///< the solver starts from the warm start (multigrid, PCG)
   std::optional<StabilizedSolve> stabilized_;
+  PredictedStart start_;  ///< the predicted start's buffers, reused from step to step
   // The caller's iterates, which outlive the step: read in place, not copied.
   const Coefficients* x_ = nullptr;
   const Coefficients* x_prev_ = nullptr;
@@ -256,6 +259,9 @@ class FlowRun {
   const MeshSource& source_;
   nlohmann::json& result_;
   TriangleMesh mesh_;
+  // mesh_'s faces by smallest vertex (datasets/face_order.h): the stop rule's pass over the
+  // surface after every step reads its vertices nearly in order.
+  Triangles moment_faces_;
   std::unique_ptr<Basis> basis_;
   std::unique_ptr<LinearSolver> solver_;
   std::unique_ptr<Integrator> integrator_;
@@ -276,6 +282,7 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
     : config_(config), source_(source), result_(result), mesh_(source.mesh) {
   const Triangles& F = mesh_.faces;
   if (config.normalize_area) apply(unit_area_normalization(mesh_.vertices, F), mesh_.vertices);
+  moment_faces_ = faces_by_smallest_vertex(F, mesh_.num_vertices());
 
   // The solver first: it may refuse its configuration (PETSc's options) before the basis is
   // built.
@@ -390,7 +397,7 @@ std::optional<std::string> FlowRun::stop_rule(const Positions& V_new, const Coef
                                               SurfaceMoments& moments,
                                               nlohmann::json& record) const {
   if (!all_finite(V_new) || !all_finite(x_new)) return "non-finite vertex positions";
-  moments = surface_moments(V_new, mesh_.faces);
+  moments = surface_moments(V_new, moment_faces_);
   const double area = moments.area;
   if (!(area > 1e-12 * area0_)) {
     record["area"] = area;

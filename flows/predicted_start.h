@@ -17,9 +17,17 @@ struct PredictedStart {
   double theta = 0.0;
   Coefficients increment;  ///< θ (P - F)
   Coefficients residual;   ///< R - A F
+  /// The fused product's columns [F, P - F] and their images (n x 6 each), kept with the result
+  /// so that a caller which keeps one PredictedStart from step to step reuses their memory: fresh
+  /// pages cost more than the product's arithmetic on a large mesh.
+  Eigen::MatrixXd columns, images;
 };
 
-/// One fused pass over A's terms for A F and A (P - F) (six columns).
+/// One fused pass over A's terms for A F and A (P - F) (six columns), into `s`.
+void predicted_start(const MatrixSum& A, const Coefficients& R, const Coefficients& F,
+                     const Coefficients& P, PredictedStart& s);
+
+/// The same into a new PredictedStart.
 PredictedStart predicted_start(const MatrixSum& A, const Coefficients& R, const Coefficients& F,
                                const Coefficients& P);
 

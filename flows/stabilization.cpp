@@ -22,7 +22,8 @@ Coefficients StabilizedSolve::solve(ReducedSystem& system, const Basis& basis, d
     throw std::logic_error("stabilized solve: the basis has no normal-gradient matrix");
   const SparseView M = basis.mass(), K = basis.stiffness();
   rho_ = stabilization_rho(weight_, a, b, M, K, S);
-  PredictedStart start = predicted_start(MatrixSum(a, M, b, K), R, F, warm);
+  PredictedStart& start = start_;
+  predicted_start(MatrixSum(a, M, b, K), R, F, warm, start);
   // R - (a M + b K) F + ρ S Δ̂, and Δ̂ is also where the solver starts.
   Coefficients& rhs = start.residual;
   if (start.theta > 0.0) rhs.noalias() += rho_ * symmetric_multiply(S, start.increment);

@@ -10,6 +10,7 @@
 // surface every step.
 
 #include "bases/basis.h"
+#include "flows/predicted_start.h"
 #include "flows/reduced_system.h"
 
 namespace mcf {
@@ -38,6 +39,7 @@ class StabilizedSolve {
   double weight_;
   double rho_ = 0.0;
   bool started_ = false;  ///< a solve ran (the start-up is the first one's)
+  PredictedStart start_;  ///< the prediction's buffers, reused from solve to solve
   /// The first solve's passes: the flow's first step has no previous increment to predict from,
   /// so its solve starts from zero and an iterative solver runs until the residual is down to
   /// kStartUpTolerance (what it leaves of that increment would stay in the surface; later steps

@@ -137,7 +137,13 @@ struct MultigridSolver::Impl {
   // them changed in this call.
   int term_count = 0;
   std::vector<char> term_changed;
-  std::uint64_t pattern_key = 0;         // the key the current pattern was set with (0: none)
+  std::uint64_t pattern_key = 0;  // the key the current pattern was set with (0: none)
+  // finest_matrix(): the finest matrix in the caller's numbering, and for each of its entries the
+  // position of its value in the finest level's A (empty: not laid out for this pattern); the
+  // values are those of set_matrix call `finest_call` (calls counts the calls).
+  SparseMatrix finest;
+  std::vector<int> finest_from;
+  std::int64_t calls = 0, finest_call = -1;
   std::vector<MultigridLevelWork> work;  // per level, coarsest first (level_work())
 
   void ensure_buffers(int cols) {
@@ -157,6 +163,7 @@ struct MultigridSolver::Impl {
   void symbolic(const SparseRef& A, const std::vector<SparseMatrix>& P,
                 const std::vector<std::vector<std::uint8_t>>* given_colours, bool single) {
     fine_single = single;
+    finest_from.clear();
     const std::size_t nl = P.size() + 1;
     levels.clear();
     levels.resize(nl);
@@ -282,12 +289,15 @@ struct MultigridSolver::Impl {
     }
   }
 
-  /// The Galerkin plan of coarse level l (solvers/galerkin.h), built when the level's product is
-  /// computed a second time on its pattern: laying it out costs about two products, which a
-  /// pattern used once (the rebuilt octree's, new every step) would not earn back.
+  /// The Galerkin plan of coarse level l (solvers/galerkin.h). Laying it out costs about two
+  /// products, which a pattern used once (the rebuilt octree's, new every step) would not earn
+  /// back: it is built when the level's product is computed a second time on its pattern, or at
+  /// once when the caller vouches for its pattern with a key (it owns a fixed pattern and will
+  /// set it again), so that the flow's second step is a steady one.
   const GalerkinPlan* plan_for(std::size_t l) {
     Level& C = levels[l];
-    if (++C.galerkin_calls == 2) C.plan = galerkin_plan(Csc(levels[l + 1].A), C.P, C.A, C.inv);
+    if (++C.galerkin_calls == (pattern_key != 0 ? 1 : 2))
+      C.plan = galerkin_plan(Csc(levels[l + 1].A), C.P, C.A, C.inv);
     return &C.plan;
   }
 
@@ -652,6 +662,32 @@ SparseMatrix MultigridSolver::level_matrix(int l) const {
   const auto& L = impl_->levels.at(std::size_t(l));
   return permuted(L.A, L.perm, L.inv, true);  // back to the caller's numbering
 }
+const SparseMatrix& MultigridSolver::finest_matrix() const {
+  Impl& m = *impl_;
+  if (m.levels.empty()) throw std::logic_error("MultigridSolver::finest_matrix before set_matrix");
+  const auto& L = m.levels.back();
+  if (m.finest_from.empty()) {
+    // Each entry's position as its value, moved as level_matrix moves the values: exact in a
+    // double up to 2^53 entries.
+    SparseMatrix positions = L.A;
+    for (Eigen::Index p = 0; p < positions.nonZeros(); ++p) positions.valuePtr()[p] = double(p);
+    m.finest = permuted(positions, L.perm, L.inv, true);
+    m.finest_from.resize(std::size_t(m.finest.nonZeros()));
+    for (Eigen::Index p = 0; p < m.finest.nonZeros(); ++p)
+      m.finest_from[std::size_t(p)] = int(m.finest.valuePtr()[p]);
+    m.finest_call = -1;
+  }
+  if (m.finest_call != m.calls) {
+    const double* from = L.A.valuePtr();
+    double* to = m.finest.valuePtr();
+    const int* where = m.finest_from.data();
+    for_rows(int(m.finest.nonZeros()), [&](int b, int e) {
+      for (int p = b; p < e; ++p) to[p] = from[where[p]];
+    });
+    m.finest_call = m.calls;
+  }
+  return m.finest;
+}
 bool MultigridSolver::level_is_coloured(int l) const {
   return impl_->levels.at(std::size_t(l)).coloured;
 }
@@ -768,6 +804,7 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
   if (!need_symbolic && m.fine_single != options_.mixed_precision) need_symbolic = true;
   if (need_symbolic) m.symbolic(A, P, colours, options_.mixed_precision);
   if (!need_symbolic || sum) m.set_fine_values(A, sum);
+  ++m.calls;
   const bool by_term = options_.galerkin_by_term && sum != nullptr && m.levels.size() > 1;
   if (by_term)
     m.set_fine_terms(*sum, need_symbolic);

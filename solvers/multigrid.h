@@ -174,6 +174,11 @@ class MultigridSolver : public LinearSolver {
   int levels() const;  ///< 0 before set_matrix
   /// Level l's operator (l = 0 coarsest, levels()-1 finest) in the caller's numbering (a copy).
   SparseMatrix level_matrix(int l) const;
+  /// The finest level's operator in the caller's numbering, as level_matrix(levels() - 1) gives
+  /// it, kept by the solver: laid out once per pattern, its values refreshed after set_matrix
+  /// (what the stall fallback hands to CG and the factorization, step after step, without
+  /// allocating). Valid until the next set_matrix.
+  const SparseMatrix& finest_matrix() const;
   bool level_is_coloured(int l) const;  ///< false: relaxed in blocks of rows, no colours
   /// Whether level l's sweeps read the compact rows: 16-bit offsets, single-precision values on
   /// coarse levels, double on the finest (header, "Smoother matrix").

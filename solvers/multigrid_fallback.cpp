@@ -41,7 +41,7 @@ SolveReport FallbackMultigridSolver::solve_direct(const ConstMatrixRef& B, Matri
   if (!direct_) direct_ = std::make_unique<CholmodSolver>(fallback_.direct_blas_threads);
   if (!direct_current_) {
     // The same pattern from step to step keeps the symbolic analysis (CholmodSolver compares).
-    const SolveReport f = direct_->set_matrix(multigrid_.level_matrix(multigrid_.levels() - 1));
+    const SolveReport f = direct_->set_matrix(multigrid_.finest_matrix());
     if (!f.ok()) {
       SolveReport out = before;
       out.status = f.status;
@@ -95,7 +95,7 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   }
   pcg_->set_options(o);
   if (!pcg_current_) {
-    const SolveReport m = pcg_->set_matrix(multigrid_.level_matrix(multigrid_.levels() - 1));
+    const SolveReport m = pcg_->set_matrix(multigrid_.finest_matrix());
     if (!m.ok()) return m;
     pcg_current_ = true;
   }

@@ -252,17 +252,17 @@ struct PcgSolver::Recurrence {
   /// What an iteration leaves to the loop: go on, stop with the report, or stop at the cap.
   enum class Next { go_on, done, cap };
 
-  Recurrence(const PcgSolver& solver, const ConstMatrixRef& B, MatrixRef& X)
+  Recurrence(const PcgSolver& solver, Blocks& blocks, const ConstMatrixRef& B, MatrixRef& X)
       : solver(solver),
         B(B),
         X(X),
         n(solver.A_.rows()),
         k(B.cols()),
         tol(solver.options_.relative_tolerance),
-        R(n, k),
-        Z(n, k),
-        P(n, k),
-        Q(n, k),
+        R(blocks.R),
+        Z(blocks.Z),
+        P(blocks.P),
+        Q(blocks.Q),
         res(k),
         rz(k),
         pq(k),
@@ -271,6 +271,7 @@ struct PcgSolver::Recurrence {
         beta(k),
         active(static_cast<std::size_t>(k), 0),
         start(static_cast<std::size_t>(k), 0) {
+    for (MatrixXd* block : {&R, &Z, &P, &Q}) block->resize(n, k);
     column_dots(B, B, bnorm);
     bnorm = bnorm.cwiseSqrt();
   }
@@ -473,7 +474,7 @@ struct PcgSolver::Recurrence {
   const Index n, k;
   const double tol;
   VectorXd bnorm;
-  MatrixXd R, Z, P, Q;
+  MatrixXd &R, &Z, &P, &Q;  // the solver's blocks_
   VectorXd res, rz, pq, rr, alpha, beta;
   std::vector<char> active, start;
 };
@@ -493,7 +494,7 @@ SolveReport PcgSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X) {
     Recurrence::fail(rep, SolveStatus::failed, "external preconditioner selected but none set");
     return rep;
   }
-  Recurrence cg(*this, B, X);
+  Recurrence cg(*this, blocks_, B, X);
   if (!cg.begin(rep)) return rep;
   for (int it = 0; it < options_.max_iterations; ++it) {
     const Recurrence::Next next = cg.iterate(it, rep);

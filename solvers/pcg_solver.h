@@ -88,6 +88,12 @@ class PcgSolver final : public LinearSolver {
   SolveStatus matrix_status_ = SolveStatus::failed;
   std::string matrix_message_ = "set_matrix not called";
   Eigen::VectorXd inv_diag_;
+  // A solve's residual, preconditioned residual, direction and A times the direction (n x k),
+  // kept from solve to solve: on a large mesh, fresh pages cost more than an iteration.
+  struct Blocks {
+    Eigen::MatrixXd R, Z, P, Q;
+  };
+  Blocks blocks_;
   std::unique_ptr<Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>>> ic_;
 };
 

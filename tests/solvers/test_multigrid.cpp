@@ -608,6 +608,32 @@ TEST(Multigrid, FinestDiagonalStoredLastWhereverTheCallerHasIt) {
   EXPECT_TRUE(same_values(rotated.level_matrix(rotated.levels() - 1), pm.A));
 }
 
+// The kept finest matrix follows every set_matrix: the values of the same pattern, a sum, and a
+// new pattern (the caller's diagonal first in its columns, the solver's last: a real permutation).
+TEST(Multigrid, FinestMatrixIsTheFinestLevelAfterEverySetMatrix) {
+  const Problem pm = make_problem(5, 2, 0.0, Drop::shell);
+  const Problem pk = make_problem(5, 2, 1.0, Drop::shell);
+  const SparseMatrix M = rotate_columns(pm.A), K = rotate_columns(pk.A);
+  MultigridSolver mg;
+  const auto expect_finest = [&](const SparseMatrix& A) {
+    const SparseMatrix& kept = mg.finest_matrix();
+    EXPECT_TRUE(same_values(kept, mg.level_matrix(mg.levels() - 1)));
+    EXPECT_LE(SparseMatrix(kept - A).norm(), 1e-15 * A.norm());
+  };
+  // (Compared with the sorted matrices: Eigen's arithmetic needs sorted columns.)
+  ASSERT_TRUE(mg.set_matrix(M, pm.view()).ok());
+  expect_finest(pm.A);
+  const double* storage = mg.finest_matrix().valuePtr();
+  ASSERT_TRUE(mg.set_matrix(SparseMatrix(M * 3.0), pm.view()).ok());
+  expect_finest(SparseMatrix(pm.A * 3.0));
+  EXPECT_EQ(mg.finest_matrix().valuePtr(), storage);  // same pattern: refreshed in place
+  ASSERT_TRUE(mg.set_matrix_sum(1.0, M, 0.05, K, pm.view()).ok());
+  expect_finest(SparseMatrix(pm.A + 0.05 * pk.A));
+  ASSERT_TRUE(mg.set_matrix(pk.A, pk.view()).ok());  // another stored pattern
+  EXPECT_EQ(mg.symbolic_builds(), 2);
+  expect_finest(pk.A);
+}
+
 // PCG preconditioned by the cycle hands M and K to both halves: bitwise as set_matrix on the sum.
 TEST(Multigrid, PcgSetMatrixSumEqualsSetMatrixOfTheSum) {
   const Problem pm = make_problem(4, 1, 0.0, Drop::shell),
