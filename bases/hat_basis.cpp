@@ -141,10 +141,13 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
   const bool lumped = mass_kind_ == MassKind::lumped;
   const double diagonal_share = lumped ? 1.0 / 3.0 : 1.0 / 6.0;
   const double off_share = lumped ? 0.0 : 1.0 / 12.0;
-  const auto is_diagonal_slot = [](int slot) { return (slot % 9) % 4 == 0; };  // 3a + a
+  // Slots are non-negative: unsigned division by 9 is a multiply and a shift.
+  const auto is_diagonal_slot = [](int slot) { return (unsigned(slot) % 9u) % 4u == 0; };  // 3a + a
+  // The corner opposite the edge of slot 3a + b (a != b): 3 - a - b.
+  static constexpr unsigned kOpposite[9] = {0, 2, 1, 2, 0, 0, 1, 0, 0};
   const auto area_sum = [&](std::span<const int> slots) {
     double area = 0.0;
-    for (const int slot : slots) area += face_area_[std::size_t(slot / 9)];
+    for (const int slot : slots) area += face_area_[unsigned(slot) / 9u];
     return area;
   };
   if (update_mass) mass_.resize(std::size_t(pattern_.non_zeros()));
@@ -163,16 +166,18 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
     int diagonal = -1;
     for (int nz = outer[std::size_t(j)]; nz < outer[std::size_t(j) + 1]; ++nz) {
       const std::span<const int> slots = pattern_.slots(nz);
-      const bool on_diagonal = is_diagonal_slot(slots.front());
-      if (update_mass)
-        mass_[std::size_t(nz)] = area_sum(slots) * (on_diagonal ? diagonal_share : off_share);
-      if (on_diagonal) {
+      if (is_diagonal_slot(slots.front())) {
+        if (update_mass) mass_[std::size_t(nz)] = area_sum(slots) * diagonal_share;
         diagonal = nz;
         continue;
       }
-      double w = 0.0;  // the corner opposite the edge of slot 3a + b: 3 - a - b
-      for (const int slot : slots)
-        w += corner_weight_[3 * std::size_t(slot / 9) + std::size_t(3 - (slot % 9) / 3 - slot % 3)];
+      double area = 0.0, w = 0.0;
+      for (const int slot : slots) {
+        const unsigned f = unsigned(slot) / 9u, ab = unsigned(slot) - 9u * f;
+        area += face_area_[f];
+        w += corner_weight_[3u * f + kOpposite[ab]];
+      }
+      if (update_mass) mass_[std::size_t(nz)] = area * off_share;
       stiffness_[std::size_t(nz)] = -w;
       off_sum -= w;
     }
