@@ -10,8 +10,9 @@ With BM_Floor_* benchmarks in the file (benchmarks/micro_floor.cpp), also the Fl
 docs/benchmarks.md: per phase its time, the bytes and flops of its floor (solvers/phase_floor.h),
 the bandwidth achieved as a fraction of BM_StreamTriad at the same thread count (from the same
 file), its floor max(bytes / triad, flops / peak) and its time as a multiple of that floor. The
-peak is --peak-gflops (per thread count: the machine's figure times the threads); without it the
-floor is the bytes' alone.
+peak is BM_PeakFlops at the same thread count (from the same file: fused multiply-adds in
+registers), or --peak-gflops when given (per thread: the machine's figure times the threads);
+without either the floor is the bytes' alone.
 
 Usage: reports/summarize_micro.py [--peak-gflops G] micro.json [> table.md]
 """
@@ -80,6 +81,10 @@ def floor_table(b, peak_gflops=None):
     for name, x in sorted(b.items(), key=lambda kv: not kv[0].startswith("BM_StreamTriad/0")):
         if name.startswith("BM_StreamTriad/") and "bandwidth_GBps" in x:
             triad[int(x.get("threads", 0))] = x["bandwidth_GBps"] * 1e9
+    probe_peak = {}
+    for name, x in sorted(b.items(), key=lambda kv: not kv[0].startswith("BM_PeakFlops/0")):
+        if name.startswith("BM_PeakFlops/") and "flops_per_second" in x:
+            probe_peak[int(x.get("threads", 0))] = x["flops_per_second"]
     rows = []
     for name, x in b.items():
         if not name.startswith("BM_Floor_") or x.get("error_occurred") or "bytes" not in x:
@@ -88,7 +93,7 @@ def floor_table(b, peak_gflops=None):
         threads = int(x.get("threads", 0))
         probe = triad.get(threads)
         nbytes, flops = float(x["bytes"]), float(x["flops"])
-        peak = peak_gflops * 1e9 * threads if peak_gflops else None
+        peak = peak_gflops * 1e9 * threads if peak_gflops else probe_peak.get(threads)
         floor = max(nbytes / probe if probe else 0.0, flops / peak if peak else 0.0)
         achieved = nbytes / seconds if seconds > 0 else None
         label = name[len("BM_Floor_"):] + (f" ({x['label']})" if x.get("label") else "")
@@ -101,7 +106,14 @@ def floor_table(b, peak_gflops=None):
         return []
     probes = ", ".join(f"{t} thread{'s' if t != 1 else ''} {fmt(v / 1e9)} GB/s"
                        for t, v in sorted(triad.items())) or "none in this file"
-    peak = f"{peak_gflops} GFLOP/s per thread" if peak_gflops else "not given (bytes alone)"
+    if peak_gflops:
+        peak = f"{peak_gflops} GFLOP/s per thread"
+    elif probe_peak:
+        peak = "BM_PeakFlops " + ", ".join(
+            f"{t} thread{'s' if t != 1 else ''} {fmt(v / 1e9)} GFLOP/s"
+            for t, v in sorted(probe_peak.items()))
+    else:
+        peak = "not given (bytes alone)"
     return [f"Floors: STREAM triad {probes}; compute peak {peak}.\n",
             "| phase | ms | floor MB | floor Mflop | GB/s | of triad | floor ms | x floor |",
             "|---|---:|---:|---:|---:|---:|---:|---:|"] + rows + [""]

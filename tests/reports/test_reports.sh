@@ -60,6 +60,14 @@ grep -qF '| HatKernel/threads:2/kernel:0/below:0 (sweep) | 10 | 100 | 1 | 10 | 0
   grep -qF '| HatKernel/threads:2/kernel:0/below:0 (sweep) | 10 | 100 | 1 | 10 | 0.5 | 50 | 0.2 |' "$sw/peak.md" &&
   ! grep -q 'HatGalerkin' "$sw/floor.md" && ! grep -q 'per step' "$sw/floor.md" ||
   { cat "$sw/floor.md" "$sw/peak.md"; echo "FAIL: summarize_micro.py's floors table"; exit 1; }
+# The peak from BM_PeakFlops in the same file (2e7 flop/s on two threads: the same 50 ms floor),
+# not from a probe at another thread count.
+sed 's|"benchmarks": \[|"benchmarks": [\n  {"name": "BM_PeakFlops/2/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 1, "threads": 2, "flops_per_second": 2e7},\n  {"name": "BM_PeakFlops/1/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 1, "threads": 1, "flops_per_second": 1e12},|' \
+  "$sw/floor.json" >"$sw/probe.json"
+"$py" "$root/reports/summarize_micro.py" "$sw/probe.json" >"$sw/probe.md" 2>&1 || { cat "$sw/probe.md"; echo "FAIL: summarize_micro.py with BM_PeakFlops"; exit 1; }
+grep -qF '| HatKernel/threads:2/kernel:0/below:0 (sweep) | 10 | 100 | 1 | 10 | 0.5 | 50 | 0.2 |' "$sw/probe.md" &&
+  grep -qF 'BM_PeakFlops 1 thread 1000 GFLOP/s, 2 threads 0.02 GFLOP/s' "$sw/probe.md" ||
+  { cat "$sw/probe.md"; echo "FAIL: summarize_micro.py's floors from BM_PeakFlops"; exit 1; }
 rm -rf "$sw"
 if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
   echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 77
