@@ -194,7 +194,10 @@ struct HatFloor {
     }();
     return f;
   }
-  HierarchyView view() const { return {basis->prolongations(), basis->colours()}; }
+  // With a pattern key, as a flow's ReducedSystem hands the basis's fixed pattern to the solver
+  // (no comparison of the pattern per call).
+  const std::uint64_t key = new_pattern_key();
+  HierarchyView view() const { return {basis->prolongations(), basis->colours(), key}; }
   const std::vector<SparseMatrix>& P() const { return *basis->prolongations(); }
   /// A permuted copy of the coefficients.
   PhaseCost evaluate_floor() const { return copy_cost(x.rows(), 3); }
@@ -371,7 +374,10 @@ struct TrackedFloor {
     }();
     return f;
   }
-  HierarchyView view() const { return {basis->prolongations(), basis->colours()}; }
+  // With a pattern key, as a flow's ReducedSystem hands the basis's fixed pattern to the solver
+  // (no comparison of the pattern per call).
+  const std::uint64_t key = new_pattern_key();
+  HierarchyView view() const { return {basis->prolongations(), basis->colours(), key}; }
   const std::vector<SparseMatrix>& P() const { return *basis->prolongations(); }
   /// Each original vertex: the 8 trilinear weights of its cell's corners (VertexStencils).
   PhaseCost evaluate_floor() const {
