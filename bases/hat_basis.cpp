@@ -174,7 +174,7 @@ void HatBasis::update(const Coefficients& x, bool update_mass, bool update_stiff
       double area = 0.0, w = 0.0;
       for (const int slot : slots) {
         const unsigned f = unsigned(slot) / 9u, ab = unsigned(slot) - 9u * f;
-        area += face_area_[f];
+        if (update_mass) area += face_area_[f];
         w += corner_weight_[3u * f + kOpposite[ab]];
       }
       if (update_mass) mass_[std::size_t(nz)] = area * off_share;
