@@ -277,8 +277,7 @@ void ReducedSystem::solve_after_set(const ConstMatrixRef& R, MatrixRef X) {
                           report_.residuals.end());
     report_ = std::move(more);
   }
-  if (!note.empty())
-    report_.message = report_.message.empty() ? std::move(note) : note + "; " + report_.message;
+  report_.message = joined_messages(note, report_.message);
 }
 
 }  // namespace mcf

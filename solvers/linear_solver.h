@@ -103,6 +103,13 @@ class KeptPattern {
   int comparisons_ = 0;
 };
 
+/// Two report messages as one, "; "-separated (either may be empty).
+inline std::string joined_messages(const std::string& first, const std::string& more) {
+  if (first.empty()) return more;
+  if (more.empty()) return first;
+  return first + "; " + more;
+}
+
 /// Whether two compressed matrices have the same sparsity pattern (size, column starts and row
 /// indices compared exactly; values ignored). False when either is not compressed.
 bool same_pattern(const SparseRef& A, const SparseRef& B);

@@ -25,17 +25,6 @@ SolveReport FallbackMultigridSolver::set_matrix_sum(const MatrixSum& sum, Hierar
   return multigrid_.set_matrix_sum(sum, hierarchy);
 }
 
-namespace {
-
-/// `first`'s message followed by `more`, "; "-separated.
-std::string joined(const std::string& first, const std::string& more) {
-  if (first.empty()) return more;
-  if (more.empty()) return first;
-  return first + "; " + more;
-}
-
-}  // namespace
-
 SolveReport FallbackMultigridSolver::solve_direct(const ConstMatrixRef& B, MatrixRef X,
                                                   SolveReport before, const std::string& why) {
   if (!direct_) direct_ = std::make_unique<CholmodSolver>(fallback_.direct_blas_threads);
@@ -45,7 +34,8 @@ SolveReport FallbackMultigridSolver::solve_direct(const ConstMatrixRef& B, Matri
     if (!f.ok()) {
       SolveReport out = before;
       out.status = f.status;
-      out.message = joined(joined(before.message, why), "the factorization failed: " + f.message);
+      out.message = joined_messages(joined_messages(before.message, why),
+                                    "the factorization failed: " + f.message);
       return out;
     }
     direct_current_ = true;
@@ -58,8 +48,9 @@ SolveReport FallbackMultigridSolver::solve_direct(const ConstMatrixRef& B, Matri
   out.relative_residual = d.relative_residual;
   out.residuals.push_back(d.relative_residual);
   out.direct_fallback = true;
-  out.message = joined(joined(before.message, why), "a sparse Cholesky factorization solved it");
-  if (!d.message.empty()) out.message = joined(out.message, d.message);
+  out.message = joined_messages(joined_messages(before.message, why),
+                                "a sparse Cholesky factorization solved it");
+  out.message = joined_messages(out.message, d.message);
   return out;
 }
 
@@ -72,7 +63,7 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   char note[192];
   std::snprintf(note, sizeof note, "cycles stalled (contraction %.3g > %.3g)", cycles.contraction,
                 fallback_.stall_ratio);
-  cycles.message = joined(cycles.message, note);
+  cycles.message = joined_messages(cycles.message, note);
   const bool direct_allowed = fallback_.direct_after > 0;
   if (direct_allowed && prefer_direct_)
     return solve_direct(B, X, cycles, "an earlier stalled step needed the factorization");
@@ -108,7 +99,7 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
   out.residuals.insert(out.residuals.end(), cg.residuals.begin(), cg.residuals.end());
   char took[128];
   std::snprintf(took, sizeof took, "CG preconditioned by the cycle took over to %.3g", target);
-  out.message = joined(joined(cycles.message, took), cg.message);
+  out.message = joined_messages(joined_messages(cycles.message, took), cg.message);
   if (!direct_allowed || cg.status == SolveStatus::converged) return out;
   // CG broke down or ran out of its iterations: the factorization solves the step (it
   // overwrites X, whatever CG left there).

@@ -22,7 +22,8 @@
 // the step fails as a CHOLMOD flow's would.
 //
 // The fallback costs nothing on a step whose cycles contract but one residual pass (to know the
-// contraction); its CG takes a copy of the finest matrix from the multigrid only when it runs.
+// contraction); CG and the factorization read the finest matrix in the caller's numbering, which
+// the multigrid lays out at the first stall and refreshes in place after (finest_matrix()).
 
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"

@@ -21,9 +21,7 @@ namespace {
 // PCG's report with the preconditioner's note on the matrix (a semi-definite coarsest level,
 // a level without colouring) in front of PCG's own: PCG's report alone dropped it.
 SolveReport with_note(SolveReport preconditioner, SolveReport pcg) {
-  if (!preconditioner.message.empty())
-    pcg.message =
-        pcg.message.empty() ? preconditioner.message : preconditioner.message + "; " + pcg.message;
+  pcg.message = joined_messages(preconditioner.message, pcg.message);
   return pcg;
 }
 }  // namespace
