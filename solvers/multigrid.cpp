@@ -350,13 +350,21 @@ struct MultigridSolver::Impl {
     for (std::size_t l = coarse ? 0 : levels.size() - 1; l < levels.size(); ++l) {
       Level& L = levels[l];
       const Csc A(L.A);
-      L.inv_diag.assign(std::size_t(L.n()), 0.0);
-      for (int i = 0; i < L.n(); ++i) {
-        const int p = L.diag_pos[std::size_t(i)];
-        const double d = p >= 0 ? A.val[p] : 0.0;
-        if (!(d >= 0.0) || !std::isfinite(d)) ok = false;
-        L.inv_diag[std::size_t(i)] = d > 0.0 ? 1.0 / d : 0.0;
-      }
+      L.inv_diag.resize(std::size_t(L.n()));  // every entry written below
+      double* inv = L.inv_diag.data();
+      const int* diag_pos = L.diag_pos.data();
+      std::atomic<bool> bad{false};
+      for_rows(L.n(), [&](int b, int e) {
+        bool unsound = false;
+        for (int i = b; i < e; ++i) {
+          const int p = diag_pos[i];
+          const double d = p >= 0 ? A.val[p] : 0.0;
+          unsound |= !(d >= 0.0) || !std::isfinite(d);
+          inv[i] = d > 0.0 ? 1.0 / d : 0.0;
+        }
+        if (unsound) bad.store(true, std::memory_order_relaxed);
+      });
+      if (bad.load()) ok = false;
       smoother_values(L.smoother, L.A, L.diag_pos);
     }
     if (coarse) ++numeric_builds;

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
@@ -780,6 +781,27 @@ TEST(Multigrid, SemiDefiniteCoarsestLevelIsSolvedByItsPseudoInverse) {
   const mcf::SolveReport refused = mg.set_matrix(indefinite, HierarchyView{&none, nullptr});
   EXPECT_EQ(refused.status, SolveStatus::not_positive_definite);
   EXPECT_NE(refused.message.find("eigenvalue"), std::string::npos) << refused.message;
+}
+
+TEST(Multigrid, RefusesANegativeOrNonFiniteDiagonalInAnyRow) {
+  // 16^3 rows: the diagonal's check runs in parallel chunks; a bad entry in any chunk refuses.
+  const int N = 15;
+  const SparseMatrix A = grid_matrix(N, 1e-3);
+  ASSERT_GE(A.rows(), 4096);
+  const std::vector<SparseMatrix> none;
+  for (const int row : {0, int(A.rows()) / 2 + 7, int(A.rows()) - 1}) {
+    for (const double bad : {-1.0, std::numeric_limits<double>::quiet_NaN(),
+                             std::numeric_limits<double>::infinity()}) {
+      SparseMatrix B = A;
+      B.coeffRef(row, row) = bad;
+      MultigridSolver mg;
+      const mcf::SolveReport rep = mg.set_matrix(B, HierarchyView{&none, nullptr});
+      EXPECT_EQ(rep.status, SolveStatus::not_positive_definite) << "row " << row << ", " << bad;
+      EXPECT_NE(rep.message.find("diagonal"), std::string::npos) << rep.message;
+      // The same solver accepts the sound matrix afterwards.
+      EXPECT_TRUE(mg.set_matrix(A, HierarchyView{&none, nullptr}).ok());
+    }
+  }
 }
 
 TEST(Multigrid, OneWCycleReducesResidualTenfold) {
