@@ -3,6 +3,7 @@
 #include "core/vec4.h"
 #include "solvers/csc_view.h"
 #include "solvers/galerkin.h"
+#include "solvers/interleaved_ldlt.h"
 #include "solvers/level_ordering.h"
 #include "solvers/smoother.h"
 
@@ -118,6 +119,9 @@ struct MultigridSolver::Impl {
   std::vector<Level> levels;                       // coarsest first
   std::vector<std::vector<std::uint8_t>> colours;  // as given (to detect changes)
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+  // Its factor as the coarsest solve reads it (one pass over L for four columns), and its work.
+  InterleavedLdlt coarse_factor;
+  std::vector<double> coarse_work;
   // The coarsest solve when its matrix is only semi-definite (set_matrix: coarsest_pseudo_inverse):
   // a dense generalized inverse, empty while the LDLᵀ factor serves.
   Eigen::MatrixXd coarse_pinv;
@@ -511,12 +515,14 @@ struct MultigridSolver::Impl {
   void coarse_solve() {
     Level& L = levels.front();
     const int n = L.n();
+    if (coarse_pinv.size() == 0) {
+      // The padding columns of b are zero, so those of x come out zero, as everywhere else.
+      solve_interleaved(coarse_factor, L.b.data(), L.x.data(), s, coarse_work);
+      return;
+    }
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < k; ++c) coarse_rhs(i, c) = L.b[std::size_t(i) * s + std::size_t(c)];
-    if (coarse_pinv.size() > 0)
-      coarse_sol.noalias() = coarse_pinv * coarse_rhs;
-    else
-      coarse_sol = ldlt.solve(coarse_rhs);
+    coarse_sol.noalias() = coarse_pinv * coarse_rhs;
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < k; ++c) L.x[std::size_t(i) * s + std::size_t(c)] = coarse_sol(i, c);
   }
@@ -839,7 +845,9 @@ SolveReport MultigridSolver::set_levels(const SparseRef& A_in, const MatrixSum* 
     // The coarse levels' notes, which a lagged call repeats with their operators.
     m.coarse_note.clear();
     m.coarse_pinv.resize(0, 0);
-    if (!m.coarsest_factor_is_sound()) {
+    if (m.coarsest_factor_is_sound())
+      copy_factor(m.ldlt, m.coarse_factor);
+    else {
       // The octree's functions on a flat face parallel to a grid plane (the cubical spiral, a
       // box) are linearly dependent on the surface: A is then only semi-definite, on every
       // level. Gauss–Seidel relaxes such a consistent system as it does a definite one (the
