@@ -533,14 +533,25 @@ struct MultigridSolver::Impl {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   }
 
-  /// Restriction b_C = Pᵀ r_F from level l to l - 1 (gather over the columns of P).
+  /// Restriction b_C = Pᵀ r_F from level l to l - 1 (gather over the columns of P), and the
+  /// coarse level's start x_C = 0, in the same pass over its rows (in parallel, instead of a
+  /// serial fill of its own).
   void restrict_residual(int l) {
     const Level& F = levels[std::size_t(l)];
     Level& C = levels[std::size_t(l) - 1];
     const Csc P(C.P);
     for (int o = 0; o < int(s); o += 4)
-      for_rows(P.cols,
-               [&](int b, int e) { transpose_rows<false>(P, F.r.data(), C.b.data(), s, o, b, e); });
+      for_rows(P.cols, [&](int b, int e) {
+        transpose_rows<false>(P, F.r.data(), C.b.data(), s, o, b, e);
+        for (int J = b; J < e; ++J) store4(C.x.data() + std::size_t(J) * s + o, splat(0.0));
+      });
+  }
+
+  /// x = 0 on level L, in parallel over its rows.
+  void zero_iterate(Level& L) {
+    double* x = L.x.data();
+    for_rows(L.n(),
+             [&](int b, int e) { std::fill(x + std::size_t(b) * s, x + std::size_t(e) * s, 0.0); });
   }
 
   /// Prolongation x_F += P x_C from level l - 1 to l (gather over the columns of Pᵀ = rows of P).
@@ -562,11 +573,9 @@ struct MultigridSolver::Impl {
       w.seconds += since(t0);
       return;
     }
-    Level& C = levels[std::size_t(l) - 1];
     for (int i = 0; i < opt.pre_smooth; ++i) sweep(l, false);
     residual(l);
-    restrict_residual(l);
-    std::fill(C.x.begin(), C.x.end(), 0.0);
+    restrict_residual(l);  // and C.x = 0
     // γ = 2 for W; an exact coarsest solve is never repeated (it would change nothing).
     const int gamma = (opt.cycle == MultigridCycle::W && l - 1 > 0) ? 2 : 1;
     const auto tc = Clock::now();
@@ -589,7 +598,7 @@ struct MultigridSolver::Impl {
     std::swap(F.b, F.saved_b);  // b kept
     std::swap(F.b, F.r);        // the cycle's right-hand side: the residual
     std::swap(F.x, F.saved_x);  // x kept
-    std::fill(F.x.begin(), F.x.end(), 0.0);
+    zero_iterate(F);
     cycle(top, opt);
     double* x = F.x.data();
     const double* x0 = F.saved_x.data();
@@ -951,7 +960,7 @@ void MultigridSolver::precondition(const Eigen::MatrixXd& r, Eigen::MatrixXd& z)
   m.ensure_buffers(k);
   auto& fine = m.levels.back();
   m.load(fine, fine.b, r);
-  std::fill(fine.x.begin(), fine.x.end(), 0.0);
+  m.zero_iterate(fine);
   m.cycle(int(m.levels.size()) - 1, options_);
   m.store(fine, fine.x, z);
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Geometric multigrid on a given hierarchy (docs/octree-multigrid.md; Chuang & Kazhdan 2011,
 // Section 5): Galerkin coarse operators A_l = P_lᵀ A_{l+1} P_l, V- or W-cycles, colour-parallel
-// Gauss-Seidel smoothing, a direct (SimplicialLDLT) solve on the coarsest level.
+// Gauss-Seidel smoothing, a direct solve on the coarsest level (SimplicialLDLT's factor, whose
+// substitutions solvers/interleaved_ldlt.h runs for four columns at once).
 //
 // Determinism: every parallel kernel is a gather (each output entry is computed by exactly one
 // task, in a fixed order), and norms use a deterministic reduction, so results are bitwise

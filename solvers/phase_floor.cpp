@@ -39,7 +39,7 @@ PhaseCost sweep_cost(const SparseSize& A, std::int64_t off_diagonal, int columns
 
 PhaseCost restriction_cost(const SparseSize& P, int columns) {
   const double c = columns;
-  return {matrix_bytes(P, P.nnz, P.cols) + double(P.rows + P.cols) * c * kDouble,
+  return {matrix_bytes(P, P.nnz, P.cols) + double(P.rows + 2 * P.cols) * c * kDouble,
           2 * double(P.nnz) * c};
 }
 

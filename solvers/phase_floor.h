@@ -15,7 +15,8 @@
 //   residual r = b - A x       bytes (nnz (ib + vb) + 4 (n + 1)) + 3 n c 8       flops 2 nnz c
 //   Gauss-Seidel sweep         bytes (nnz_off (ib + vb) + 4 (n + 1)) + n 8       flops 2 nnz_off c
 //                                    (inverse diagonal) + 3 n c 8 (b; x read, x written)  + n c
-//   restriction b_c = Pᵀ r     bytes nnz_P (4 + 8) + 4 (n_c + 1) + (n_f + n_c) c 8  flops 2 nnz_P c
+//   restriction b_c = Pᵀ r     bytes nnz_P (4 + 8) + 4 (n_c + 1) + (n_f + 2 n_c) c 8
+//     (and the coarse start x_c = 0 written in the same pass)            flops 2 nnz_P c
 //   prolongation x += P x_c    bytes nnz_P (4 + 8) + 4 (n_f + 1) + (n_c + 2 n_f) c 8
 //                                                                          flops (2 nnz_P + n_f) c
 //   Galerkin A_c = Pᵀ A P      bytes nnz_A (4 + 8) + 4 (n_f + 1) + nnz_P (4 + 8) + 4 (n_c + 1)

@@ -56,10 +56,10 @@ TEST(PhaseFloor, LevelKernelsMatchHandCounts) {
   compact.index_bytes = 2;
   compact.value_bytes = 4;
   EXPECT_EQ(mcf::sweep_cost(compact, 4, 4).bytes, 24 + 16 + 24 + 288);
-  // Restriction: P (4 x 12 bytes, 3 column pointers), the fine residual read (3 rows) and the
-  // coarse right-hand side written (2 rows).
+  // Restriction: P (4 x 12 bytes, 3 column pointers), the fine residual read (3 rows), the
+  // coarse right-hand side and the coarse start (zero) written (2 rows each).
   const mcf::PhaseCost rs = mcf::restriction_cost(P, 4);
-  EXPECT_EQ(rs.bytes, 48 + 12 + 5 * 32);
+  EXPECT_EQ(rs.bytes, 48 + 12 + 7 * 32);
   EXPECT_EQ(rs.flops, 32);
   // Prolongation: Pᵀ (4 pointers over the fine rows), x_c read, x read and written.
   const mcf::PhaseCost pr = mcf::prolongation_cost(P, 4);
