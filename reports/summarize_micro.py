@@ -55,6 +55,10 @@ def load(path):
                         all(isinstance(r.get(k), (int, float)) for r in rs):
                     b[k] = median([r[k] for r in rs])
         b["repetitions"] = len(rs)
+        # Each counter's smallest and largest repetition (the bandwidth probe's spread).
+        b["spread"] = {k: (min(r[k] for r in rs), max(r[k] for r in rs)) for k in rs[0]
+                       if isinstance(rs[0][k], (int, float)) and not isinstance(rs[0][k], bool)
+                       and all(isinstance(r.get(k), (int, float)) for r in rs)}
         out[name] = b
     return data.get("context", {}), out
 
@@ -76,11 +80,13 @@ def fmt(x, digits=3):
 def floor_table(b, peak_gflops=None):
     """Markdown lines of the Floors table, [] without BM_Floor_* benchmarks. A benchmark skipped
     for a level the mesh lacks (error_occurred) is left out."""
-    triad = {}
+    triad, triad_spread = {}, {}
     # "BM_StreamTriad/0" (all cores) first, so that an explicit thread count of the same value wins.
     for name, x in sorted(b.items(), key=lambda kv: not kv[0].startswith("BM_StreamTriad/0")):
         if name.startswith("BM_StreamTriad/") and "bandwidth_GBps" in x:
-            triad[int(x.get("threads", 0))] = x["bandwidth_GBps"] * 1e9
+            threads = int(x.get("threads", 0))
+            triad[threads] = x["bandwidth_GBps"] * 1e9
+            triad_spread[threads] = x.get("spread", {}).get("bandwidth_GBps")
     probe_peak = {}
     for name, x in sorted(b.items(), key=lambda kv: not kv[0].startswith("BM_PeakFlops/0")):
         if name.startswith("BM_PeakFlops/") and "flops_per_second" in x:
@@ -104,8 +110,20 @@ def floor_table(b, peak_gflops=None):
                     f"{fmt(seconds / floor if floor > 0 else None)} |")
     if not rows:
         return []
-    probes = ", ".join(f"{t} thread{'s' if t != 1 else ''} {fmt(v / 1e9)} GB/s"
+    def spread(t):
+        lo, hi = triad_spread.get(t) or (None, None)
+        return f" ({fmt(lo)}–{fmt(hi)} over its repetitions)" if lo is not None and hi > lo else ""
+
+    probes = ", ".join(f"{t} thread{'s' if t != 1 else ''} {fmt(v / 1e9)} GB/s{spread(t)}"
                        for t, v in sorted(triad.items())) or "none in this file"
+    # A probe whose repetitions differ by more than a fifth: the machine's bandwidth moved during
+    # the run (on a shared host it does), and a ratio to the floor moves with it.
+    unsteady = [t for t, lo_hi in triad_spread.items() if lo_hi and lo_hi[0] > 0
+                and lo_hi[1] > 1.2 * lo_hi[0]]
+    warning = ([f"The triad's repetitions differ by more than 20% ({', '.join(str(t) for t in sorted(unsteady))}"
+                f" thread{'s' if unsteady != [1] else ''}): the bandwidth moved during the run, and"
+                " a phase's `x floor` moves with it; a ratio within that of a bound is on neither"
+                " side of it.\n"] if unsteady else [])
     if peak_gflops:
         peak = f"{peak_gflops} GFLOP/s per thread"
     elif probe_peak:
@@ -114,7 +132,7 @@ def floor_table(b, peak_gflops=None):
             for t, v in sorted(probe_peak.items()))
     else:
         peak = "not given (bytes alone)"
-    return [f"Floors: STREAM triad {probes}; compute peak {peak}.\n",
+    return [f"Floors: STREAM triad {probes}; compute peak {peak}.\n"] + warning + [
             "| phase | ms | floor MB | floor Mflop | GB/s | of triad | floor ms | x floor |",
             "|---|---:|---:|---:|---:|---:|---:|---:|"] + rows + [""]
 

@@ -68,6 +68,15 @@ sed 's|"benchmarks": \[|"benchmarks": [\n  {"name": "BM_PeakFlops/2/real_time", 
 grep -qF '| HatKernel/threads:2/kernel:0/below:0 (sweep) | 10 | 100 | 1 | 10 | 0.5 | 50 | 0.2 |' "$sw/probe.md" &&
   grep -qF 'BM_PeakFlops 1 thread 1000 GFLOP/s, 2 threads 0.02 GFLOP/s' "$sw/probe.md" ||
   { cat "$sw/probe.md"; echo "FAIL: summarize_micro.py's floors from BM_PeakFlops"; exit 1; }
+# The triad's spread over its repetitions (20 and 30 GB/s: median 25) is printed, and a spread
+# over 20% is called out; the single-repetition file above has neither.
+sed 's|"bandwidth_GBps": 20},|"bandwidth_GBps": 20},\n  {"name": "BM_StreamTriad/2/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 1, "threads": 2, "bandwidth_GBps": 30},|' \
+  "$sw/floor.json" >"$sw/spread.json"
+"$py" "$root/reports/summarize_micro.py" "$sw/spread.json" >"$sw/spread.md" 2>&1 || { cat "$sw/spread.md"; echo "FAIL: summarize_micro.py with repetitions"; exit 1; }
+grep -qF '2 threads 25 GB/s (20–30 over its repetitions)' "$sw/spread.md" &&
+  grep -qF "The triad's repetitions differ by more than 20% (2 threads)" "$sw/spread.md" &&
+  ! grep -q "over its repetitions\|differ by more" "$sw/floor.md" ||
+  { cat "$sw/spread.md"; echo "FAIL: summarize_micro.py's triad spread"; exit 1; }
 rm -rf "$sw"
 if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
   echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 77
