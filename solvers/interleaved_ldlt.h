@@ -31,8 +31,9 @@ struct InterleavedLdlt {
   std::vector<int> outer, inner, perm;
   std::vector<double> val, inverse_diagonal;  // L's entries; 1 / D
   // Lᵀ in compressed columns (the rows of L), which the forward substitution reads.
-  std::vector<int> upper_outer, upper_inner, next;
+  std::vector<int> upper_outer, upper_inner;
   std::vector<double> upper_val;
+  std::vector<int> next;  // copy_factor's scratch (the transpose's insertion points), kept
   int n() const { return int(perm.size()); }
 };
 
