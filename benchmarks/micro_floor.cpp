@@ -21,10 +21,12 @@
 //
 // Mesh: $MCFBENCH_FLOOR_MESH (default sphere:vertices=40000, a run of about a minute; the issue's
 // size: cgal:armadillo@faces=832000), octree depth $MCFBENCH_FLOOR_DEPTH (default 7; 9 for the
-// armadillo). Levels a mesh lacks are reported as skipped (error "no such level").
+// armadillo). Levels a mesh lacks are reported as skipped (error "no such level"). T is 1 and 2,
+// or every count of $MCFBENCH_THREADS (benchmarks/thread_counts.h; benchmarks/many_core.sh).
 
 #include "bases/hat_basis.h"
 #include "bases/tracked_octree_basis.h"
+#include "benchmarks/thread_counts.h"
 #include "datasets/mesh_spec.h"
 #include "solvers/csc_view.h"
 #include "solvers/galerkin.h"
@@ -75,8 +77,10 @@ void report(benchmark::State& state, const PhaseCost& c, int threads) {
 }
 
 /// A benchmark of one argument, the thread count: 1 and 2.
+/// 1 and 2 threads, or $MCFBENCH_THREADS (benchmarks/thread_counts.h).
 void per_thread_count(benchmark::internal::Benchmark* b) {
-  b->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+  b->ArgName("threads")->Unit(benchmark::kMillisecond)->UseRealTime();
+  for (const std::int64_t t : bench_thread_counts({1, 2})) b->Arg(t);
 }
 
 /// The thread count of range(0), held by `limit` for the benchmark's lifetime.
@@ -221,7 +225,7 @@ void BM_Floor_HatUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_Floor_HatUpdate)
     ->ArgNames({"threads", "matrices"})
-    ->ArgsProduct({{1, 2}, {1, 2}})
+    ->ArgsProduct({bench_thread_counts({1, 2}), {1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -244,7 +248,7 @@ void BM_Floor_HatSetMatrix(benchmark::State& state) {
 }
 BENCHMARK(BM_Floor_HatSetMatrix)
     ->ArgNames({"threads", "by_term"})
-    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgsProduct({bench_thread_counts({1, 2}), {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -279,7 +283,7 @@ void BM_Floor_HatGalerkin(benchmark::State& state) {
 }
 BENCHMARK(BM_Floor_HatGalerkin)
     ->ArgNames({"threads", "below", "dense"})
-    ->ArgsProduct({{1, 2}, {0, 1, 2, 3}, {0, 1}})
+    ->ArgsProduct({bench_thread_counts({1, 2}), {0, 1, 2, 3}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -322,7 +326,7 @@ void BM_Floor_HatKernel(benchmark::State& state) {
 }
 BENCHMARK(BM_Floor_HatKernel)
     ->ArgNames({"threads", "kernel", "below"})
-    ->ArgsProduct({{1, 2}, {0, 1, 2, 3}, {0, 1, 2}})
+    ->ArgsProduct({bench_thread_counts({1, 2}), {0, 1, 2, 3}, {0, 1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -31,6 +31,7 @@
 #include "bases/octree_system.h"
 #include "bases/tracked_octree_basis.h"
 #include "bench/environment.h"
+#include "benchmarks/thread_counts.h"
 #include "datasets/mesh_spec.h"
 #include "flows/predicted_start.h"
 #include "flows/stabilization.h"
@@ -453,8 +454,9 @@ void BM_Step_Tracked(benchmark::State& state) {
 }
 BENCHMARK(BM_Step_Tracked)
     ->ArgName("threads")
-    ->Arg(2)
-    ->Arg(1)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+      for (const std::int64_t t : bench_thread_counts({2, 1})) b->Arg(t);
+    })
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(5);
@@ -694,7 +696,9 @@ void BM_Step_HatCholmod(benchmark::State& state) {
 }
 BENCHMARK(BM_Step_HatCholmod)
     ->ArgName("threads")
-    ->Arg(2)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+      for (const std::int64_t t : bench_thread_counts({2})) b->Arg(t);
+    })
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);
@@ -756,8 +760,7 @@ void BM_Step_HatMultigrid(benchmark::State& state) {
 }
 BENCHMARK(BM_Step_HatMultigrid)
     ->ArgNames({"threads", "cycle"})
-    ->Args({2, 0})
-    ->Args({2, 1})
+    ->ArgsProduct({bench_thread_counts({2}), {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);

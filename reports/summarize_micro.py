@@ -14,9 +14,14 @@ peak is BM_PeakFlops at the same thread count (from the same file: fused multipl
 registers), or --peak-gflops when given (per thread: the machine's figure times the threads);
 without either the floor is the bytes' alone.
 
+With BM_Floor_* or BM_Step_* benchmarks at more than two thread counts ($MCFBENCH_THREADS,
+benchmarks/many_core.sh), also a scaling table: each benchmark's time on one thread and its
+speed-up at every other count, and the hat multigrid step against CHOLMOD's at its best count.
+
 Usage: reports/summarize_micro.py [--peak-gflops G] micro.json [> table.md]
 """
 import json
+import re
 import sys
 
 
@@ -137,6 +142,46 @@ def floor_table(b, peak_gflops=None):
             "|---|---:|---:|---:|---:|---:|---:|---:|"] + rows + [""]
 
 
+def scaling_table(b):
+    """Markdown lines of the many-core scaling table, [] unless some BM_Floor_* or BM_Step_*
+    benchmark ran at more than two thread counts, one of them 1 ($MCFBENCH_THREADS,
+    benchmarks/many_core.sh): per benchmark its time on one thread and its speed-up over that at
+    every other count; then the hat multigrid step's (two V-cycles) against one thread and against
+    CHOLMOD's step at CHOLMOD's best thread count."""
+    families = {}
+    for name, x in b.items():
+        if not name.startswith(("BM_Floor_", "BM_Step_")) or x.get("error_occurred"):
+            continue
+        m = re.search(r"/threads:(\d+)", name)
+        if m:
+            family = name[:m.start()] + name[m.end():]
+            families.setdefault(family, {})[int(m.group(1))] = ms(x)
+    if not any(len(ts) > 2 and 1 in ts for ts in families.values()):
+        return []
+    counts = sorted({t for ts in families.values() for t in ts if t != 1})
+    lines = ["Scaling: time on one thread, and the speed-up over it at each thread count.\n",
+             "| benchmark | 1 thread (ms) | " + " | ".join(f"{t} threads" for t in counts) + " |",
+             "|---|---:|" + "---:|" * len(counts)]
+    for family, ts in sorted(families.items()):
+        if 1 not in ts or len(ts) < 2:
+            continue
+        cells = [f"{fmt(ts[1] / ts[t])}x" if t in ts and ts[t] > 0 else "—" for t in counts]
+        lines.append(f"| {family[len('BM_'):]} | {fmt(ts[1])} | " + " | ".join(cells) + " |")
+    mg = families.get("BM_Step_HatMultigrid/cycle:1", {})
+    chol = families.get("BM_Step_HatCholmod", {})
+    if mg and 1 in mg:
+        top = max(mg)
+        line = (f"\nThe hat multigrid step (two V(2,2)-cycles) at {top} threads: {fmt(mg[top])} ms, "
+                f"{fmt(mg[1] / mg[top])}x its time on one thread (target ≥ 8x at 16 threads)")
+        if chol:
+            best = min(chol, key=chol.get)
+            line += (f"; CHOLMOD's step at its best count ({best} thread{'s' if best != 1 else ''})"
+                     f" {fmt(chol[best])} ms, so the multigrid step is {fmt(mg[top] / chol[best])}x"
+                     " CHOLMOD's best")
+        lines.append(line + ".")
+    return lines + [""]
+
+
 def main():
     args = sys.argv[1:]
     peak_gflops = None
@@ -147,9 +192,10 @@ def main():
         print(__doc__, file=sys.stderr)
         sys.exit(2)
     ctx, b = load(args[0])
-    floors = floor_table(b, peak_gflops)
-    if floors and all(n.startswith(("BM_Floor_", "BM_Stream")) for n in b):
-        print("\n".join(floors))  # a floors run alone: no step tables to fill
+    floors = floor_table(b, peak_gflops) + scaling_table(b)
+    if floors and all(n.startswith(("BM_Floor_", "BM_Stream", "BM_PeakFlops", "BM_Step_Hat"))
+                      for n in b):
+        print("\n".join(floors))  # floors (and hat steps) alone: no octree step tables to fill
         return
     get = b.get
     lines = []

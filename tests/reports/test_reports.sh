@@ -77,6 +77,26 @@ grep -qF '2 threads 25 GB/s (20–30 over its repetitions)' "$sw/spread.md" &&
   grep -qF "The triad's repetitions differ by more than 20% (2 threads)" "$sw/spread.md" &&
   ! grep -q "over its repetitions\|differ by more" "$sw/floor.md" ||
   { cat "$sw/spread.md"; echo "FAIL: summarize_micro.py's triad spread"; exit 1; }
+# The scaling table of a many-core run (benchmarks/many_core.sh): a benchmark at 1, 2 and 4
+# threads, its speed-ups over one thread, and the hat step against CHOLMOD's best thread count
+# (2 threads: 400 ms); a file at one or two thread counts has none (above).
+cat >"$sw/scaling.json" <<'JSON'
+{"context": {"host_name": "h", "num_cpus": 4},
+ "benchmarks": [
+  {"name": "BM_Step_HatMultigrid/threads:1/cycle:1/iterations:3/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 800},
+  {"name": "BM_Step_HatMultigrid/threads:2/cycle:1/iterations:3/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 400},
+  {"name": "BM_Step_HatMultigrid/threads:4/cycle:1/iterations:3/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 100},
+  {"name": "BM_Step_HatCholmod/threads:1/iterations:3/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 1000},
+  {"name": "BM_Step_HatCholmod/threads:2/iterations:3/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 400},
+  {"name": "BM_Step_HatCholmod/threads:4/iterations:3/real_time", "run_type": "iteration", "time_unit": "ms", "real_time": 500}]}
+JSON
+"$py" "$root/reports/summarize_micro.py" "$sw/scaling.json" >"$sw/scaling.md" 2>&1 || { cat "$sw/scaling.md"; echo "FAIL: summarize_micro.py scaling"; exit 1; }
+grep -qF '| Step_HatMultigrid/cycle:1 | 800 | 2x | 8x |' "$sw/scaling.md" &&
+  grep -qF '| Step_HatCholmod | 1000 | 2.5x | 2x |' "$sw/scaling.md" &&
+  grep -qF "at 4 threads: 100 ms, 8x its time on one thread" "$sw/scaling.md" &&
+  grep -qF "CHOLMOD's step at its best count (2 threads) 400 ms, so the multigrid step is 0.25x" "$sw/scaling.md" &&
+  ! grep -q '^Scaling' "$sw/floor.md" ||
+  { cat "$sw/scaling.md"; echo "FAIL: summarize_micro.py's scaling table"; exit 1; }
 rm -rf "$sw"
 if ! [ -x "$py" ] || ! "$py" -c "import matplotlib, numpy" 2>/dev/null; then
   echo "SKIP: /usr/bin/python3 has no matplotlib/numpy (apt-get install python3-matplotlib)"; exit 77

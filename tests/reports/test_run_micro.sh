@@ -4,6 +4,7 @@
 # with one sample per repetition; a binary built from uncommitted code keeps its file and is
 # not stored (a history holds commits). The filter of benchmarks/configs/micro_quick.json (the
 # history's quick micro-benchmarks) names exactly the seven benchmarks it describes.
+# $MCFBENCH_THREADS sets the benchmarks' thread counts (benchmarks/many_core.sh).
 # usage: test_run_micro.sh MCFBENCH_MICRO
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -14,6 +15,19 @@ filter=$(/usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1]
   "$root/benchmarks/configs/micro_quick.json")
 n=$("$bin" --benchmark_list_tests --benchmark_filter="$filter" | wc -l)
 [ "$n" = 7 ] || { "$bin" --benchmark_list_tests --benchmark_filter="$filter"; echo "FAIL: micro_quick.json's filter names $n benchmarks, not 7"; exit 1; }
+# $MCFBENCH_THREADS (benchmarks/thread_counts.h) sets the thread counts of the floors and steps;
+# unset, the floors run at 1 and 2; a malformed list stops before any benchmark, naming it.
+list=$(MCFBENCH_THREADS=1,3 "$bin" --benchmark_list_tests --benchmark_filter='BM_Floor_HatCycle|BM_Step_HatCholmod')
+[ "$list" = "$(printf '%s\n' BM_Step_HatCholmod/threads:1/iterations:3/real_time \
+  BM_Step_HatCholmod/threads:3/iterations:3/real_time BM_Floor_HatCycle/threads:1/real_time \
+  BM_Floor_HatCycle/threads:3/real_time)" ] || { echo "$list"; echo "FAIL: MCFBENCH_THREADS=1,3"; exit 1; }
+list=$(env -u MCFBENCH_THREADS "$bin" --benchmark_list_tests --benchmark_filter='BM_Floor_HatCycle')
+[ "$list" = "$(printf '%s\n' BM_Floor_HatCycle/threads:1/real_time BM_Floor_HatCycle/threads:2/real_time)" ] ||
+  { echo "$list"; echo "FAIL: the floors' default thread counts"; exit 1; }
+rc=0
+MCFBENCH_THREADS=2,x "$bin" --benchmark_list_tests >"$work/bad" 2>&1 || rc=$?
+[ "$rc" = 2 ] && grep -q 'MCFBENCH_THREADS="2,x": "x" is not a thread count' "$work/bad" ||
+  { cat "$work/bad"; echo "FAIL: a malformed MCFBENCH_THREADS (exit $rc)"; exit 1; }
 MCFBENCH_BUILD=$(dirname "$bin") MCFBENCH_MICRO_OUT=$work/micro MCFBENCH_HISTORY_STORE=$work/store \
   MCFBENCH_STREAM_MB=1 bash "$root/benchmarks/run_micro.sh" --benchmark_filter='BM_StreamCopy/1/' \
   --benchmark_repetitions=3 --benchmark_min_time=0.01 >"$work/log" 2>&1 \
