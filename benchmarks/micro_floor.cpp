@@ -76,8 +76,8 @@ void report(benchmark::State& state, const PhaseCost& c, int threads) {
   state.counters["threads"] = threads;
 }
 
-/// A benchmark of one argument, the thread count: 1 and 2.
-/// 1 and 2 threads, or $MCFBENCH_THREADS (benchmarks/thread_counts.h).
+/// A benchmark of one argument, the thread count: 1 and 2, or every count of $MCFBENCH_THREADS
+/// (benchmarks/thread_counts.h).
 void per_thread_count(benchmark::internal::Benchmark* b) {
   b->ArgName("threads")->Unit(benchmark::kMillisecond)->UseRealTime();
   for (const std::int64_t t : bench_thread_counts({1, 2})) b->Arg(t);
