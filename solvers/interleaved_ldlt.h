@@ -24,20 +24,17 @@
 
 namespace mcf::multigrid_detail {
 
-/// The factor's arrays in the form the solve reads them: L strictly lower (its unit diagonal
-/// implicit) in compressed columns, D's reciprocals, and the permutation P (row i of A is row
-/// perm[i] of P A).
+/// The factor in the form the solve reads it: L strictly lower (its unit diagonal implicit) and
+/// its transpose, both in compressed columns, D's reciprocals, and the permutation P (row i of A
+/// is row perm[i] of P A).
 struct InterleavedLdlt {
-  std::vector<int> outer, inner, perm;
-  std::vector<double> val, inverse_diagonal;  // L's entries; 1 / D
-  // Lᵀ in compressed columns (the rows of L), which the forward substitution reads.
-  std::vector<int> upper_outer, upper_inner;
-  std::vector<double> upper_val;
-  std::vector<int> next;  // copy_factor's scratch (the transpose's insertion points), kept
+  SparseMatrix lower, upper;  // L, and Lᵀ (L's rows), which the forward substitution reads
+  std::vector<double> inverse_diagonal;
+  std::vector<int> perm;
   int n() const { return int(perm.size()); }
 };
 
-/// Copies the factor of a successful SimplicialLDLT::factorize into f (reusing its memory).
+/// Copies the factor of a successful SimplicialLDLT::factorize into f.
 void copy_factor(const Eigen::SimplicialLDLT<SparseMatrix>& ldlt, InterleavedLdlt& f);
 
 /// x = A⁻¹ b for the n x s interleaved blocks b and x (all s columns; the padding columns, zero

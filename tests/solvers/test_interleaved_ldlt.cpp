@@ -2,9 +2,11 @@
 // factor, one column at a time) and against the matrix itself (the residual of what it returns).
 #include "solvers/interleaved_ldlt.h"
 
+#include "test_matrices.h"
+
 #include <gtest/gtest.h>
 
-#include <random>
+#include <cmath>
 #include <vector>
 
 namespace mcf {
@@ -14,34 +16,9 @@ using multigrid_detail::copy_factor;
 using multigrid_detail::InterleavedLdlt;
 using multigrid_detail::solve_interleaved;
 
-/// A graph Laplacian of a random sparse graph plus a positive diagonal: symmetric positive
-/// definite, with fill-in in its factor.
-SparseMatrix random_spd(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> col(0, n - 1), len(1, 5);
-  std::uniform_real_distribution<double> w(0.1, 1.0);
-  std::vector<Eigen::Triplet<double>> t;
-  for (int i = 0; i < n; ++i) {
-    t.emplace_back(i, i, 0.05 + w(rng));
-    for (int e = len(rng); e > 0; --e) {
-      const int j = col(rng);
-      if (j == i) continue;
-      const double v = w(rng);
-      t.emplace_back(i, j, -v);
-      t.emplace_back(j, i, -v);
-      t.emplace_back(i, i, v);
-      t.emplace_back(j, j, v);
-    }
-  }
-  SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  A.makeCompressed();
-  return A;
-}
-
 TEST(InterleavedLdlt, MatchesEigenSolveOnEveryColumnAndLeavesPaddingZero) {
   const int n = 700;
-  const SparseMatrix A = random_spd(n, 11);
+  const SparseMatrix A = test::graph_laplacian(n, 3, 0.05, 11);  // fill-in in its factor
   Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
   ASSERT_EQ(ldlt.info(), Eigen::Success);
   ASSERT_GT(ldlt.matrixL().nestedExpression().nonZeros(), A.nonZeros() / 2);  // real fill-in
@@ -51,11 +28,7 @@ TEST(InterleavedLdlt, MatchesEigenSolveOnEveryColumnAndLeavesPaddingZero) {
   // Seven columns in a stride of 8: two groups of four, the last column padding.
   const int k = 7;
   const std::size_t s = 8;
-  std::mt19937 rng(5);
-  std::normal_distribution<double> g;
-  Eigen::MatrixXd B(n, k);
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < k; ++c) B(i, c) = g(rng);
+  const Eigen::MatrixXd B = test::random_rhs(n, k, 5);
   std::vector<double> b(std::size_t(n) * s, 0.0), x(std::size_t(n) * s, -1.0), work;
   for (int i = 0; i < n; ++i)
     for (int c = 0; c < k; ++c) b[std::size_t(i) * s + std::size_t(c)] = B(i, c);
@@ -78,7 +51,7 @@ TEST(InterleavedLdlt, FollowsTheFactorOfEachNewMatrix) {
   InterleavedLdlt f;
   std::vector<double> work;
   for (const int n : {300, 120}) {
-    const SparseMatrix A = random_spd(n, unsigned(n));
+    const SparseMatrix A = test::graph_laplacian(n, 3, 0.05, unsigned(n));
     Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
     copy_factor(ldlt, f);
     std::vector<double> b(std::size_t(n) * 4, 0.0), x(std::size_t(n) * 4);
