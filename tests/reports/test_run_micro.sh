@@ -28,6 +28,11 @@ rc=0
 MCFBENCH_THREADS=2,x "$bin" --benchmark_list_tests >"$work/bad" 2>&1 || rc=$?
 [ "$rc" = 2 ] && grep -q 'MCFBENCH_THREADS="2,x": "x" is not a thread count' "$work/bad" ||
   { cat "$work/bad"; echo "FAIL: a malformed MCFBENCH_THREADS (exit $rc)"; exit 1; }
+# benchmarks/many_core.sh with such a list stops with that message and leaves no result behind.
+rc=0
+MCFBENCH_BUILD=$(dirname "$bin") bash "$root/benchmarks/many_core.sh" "$work/many" 1,x >"$work/many.log" 2>&1 || rc=$?
+[ "$rc" = 2 ] && grep -q 'MCFBENCH_THREADS="1,x"' "$work/many.log" && [ -z "$(ls -A "$work/many")" ] ||
+  { cat "$work/many.log"; ls -A "$work/many"; echo "FAIL: many_core.sh with a malformed list (exit $rc)"; exit 1; }
 MCFBENCH_BUILD=$(dirname "$bin") MCFBENCH_MICRO_OUT=$work/micro MCFBENCH_HISTORY_STORE=$work/store \
   MCFBENCH_STREAM_MB=1 bash "$root/benchmarks/run_micro.sh" --benchmark_filter='BM_StreamCopy/1/' \
   --benchmark_repetitions=3 --benchmark_min_time=0.01 >"$work/log" 2>&1 \
