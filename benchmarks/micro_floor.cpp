@@ -10,6 +10,11 @@
 //                                               Galerkin by the sum (0) or by term (1)
 //   BM_Floor_HatGalerkin/threads:T/below:d     the Galerkin product onto the level d + 1 below
 //                                               the finest, alone
+//   BM_Floor_HatGalerkinPetsc/below:d/algorithm:a  the same product by PETSc (values only, on
+//                                               its pattern; one process, one thread), where the
+//                                               build has PETSc, by its algorithm a: 0 "default"
+//                                               (scalable), 1 "rap", 2 "hypre" (the label says):
+//                                               a yardstick written by others
 //   BM_Floor_HatKernel/threads:T/kernel:k/below:d  one kernel on the level d below the finest:
 //                                               0 sweep, 1 residual, 2 restriction, 3 prolongation
 //   BM_Floor_HatCoarsestSolve/threads:T        the direct solve on the coarsest level
@@ -31,6 +36,8 @@
 #include "solvers/csc_view.h"
 #include "solvers/galerkin.h"
 #include "solvers/multigrid.h"
+#include "solvers/petsc_galerkin.h"
+#include "solvers/petsc_runtime.h"
 #include "solvers/phase_floor.h"
 #include "solvers/symmetric_multiply.h"
 
@@ -284,6 +291,32 @@ void BM_Floor_HatGalerkin(benchmark::State& state) {
 BENCHMARK(BM_Floor_HatGalerkin)
     ->ArgNames({"threads", "below", "dense"})
     ->ArgsProduct({bench_thread_counts({1, 2}), {0, 1, 2, 3}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_Floor_HatGalerkinPetsc(benchmark::State& state) {
+  if (!petsc_available()) {
+    state.SkipWithError("built without PETSc");
+    return;
+  }
+  HatFloor& f = HatFloor::get();
+  const int l = f.mg->levels() - 2 - int(state.range(0));
+  if (l < 0) {
+    state.SkipWithError("no such level");
+    return;
+  }
+  static const char* const algorithms[] = {"default", "rap", "hypre"};
+  const char* algorithm = algorithms[state.range(1)];
+  const SparseMatrix A = f.mg->level_matrix(l + 1);
+  const SparseMatrix& P = f.P()[std::size_t(l)];
+  PetscGalerkin product(A, P, algorithm);
+  for (auto _ : state) product.multiply();
+  report(state, galerkin_floor(A, P, f.mg->level_matrix(l)), 1);
+  state.SetLabel(algorithm);
+}
+BENCHMARK(BM_Floor_HatGalerkinPetsc)
+    ->ArgNames({"below", "algorithm"})
+    ->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -1,8 +1,11 @@
 // The Galerkin product's plan (solvers/galerkin.h): values through the plan's local slots are
 // bitwise those of the dense accumulator, both equal Pᵀ A P formed by Eigen, and a plan that would
-// outgrow A is not made.
+// outgrow A is not made. PETSc's product (solvers/petsc_galerkin.h) gives the same values, also
+// after a refresh of A's values.
 
 #include "solvers/galerkin.h"
+#include "solvers/petsc_galerkin.h"
+#include "solvers/petsc_runtime.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -114,6 +117,39 @@ TEST(Galerkin, NoPlanWhereItWouldOutgrowTheMatrix) {
   std::copy(values.begin(), values.end(), C.valuePtr());
   const Eigen::MatrixXd ref = Eigen::MatrixXd(SparseMatrix(g.PT * g.A * g.P));
   EXPECT_LE((Eigen::MatrixXd(C) - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff());
+}
+
+/// max |X - Y| over max |Y|, entry by entry (patterns may differ by explicit zeros).
+double relative_max_difference(const SparseMatrix& X, const SparseMatrix& Y) {
+  return (Eigen::MatrixXd(X) - Eigen::MatrixXd(Y)).cwiseAbs().maxCoeff() /
+         Eigen::MatrixXd(Y).cwiseAbs().maxCoeff();
+}
+
+TEST(PetscGalerkin, MatPtAPGivesTheMultigridsValuesAlsoAfterARefresh) {
+  if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
+  Product g = make_product(40, 5);
+  const GalerkinPlan plan = galerkin_plan(Csc(g.A), g.P, g.C, g.order);
+  Spa spa;
+  const auto ours = [&] {
+    SparseMatrix C = g.C;
+    galerkin_values(Csc(g.A), g.P, g.C, C.valuePtr(), g.transpose_pos, g.order, spa, &plan);
+    return C;
+  };
+  const SparseMatrix A0 = g.A;
+  for (const char* algorithm : {"default", "rap", "hypre"}) {
+    g.A = A0;
+    PetscGalerkin petsc(g.A, g.P, algorithm);
+    EXPECT_LE(relative_max_difference(petsc.product(), ours()), 1e-13) << algorithm;
+    // New values on A's pattern (still symmetric): the product follows them.
+    for (int j = 0; j < g.A.outerSize(); ++j)
+      for (SparseMatrix::InnerIterator it(g.A, j); it; ++it)
+        it.valueRef() *= 1.0 + 0.1 * double((it.row() + it.col()) % 5);
+    const SparseMatrix before = petsc.product();
+    petsc.refresh(g.A.valuePtr());
+    EXPECT_GT(relative_max_difference(before, ours()), 1e-3) << algorithm;
+    EXPECT_LE(relative_max_difference(petsc.product(), ours()), 1e-13) << algorithm;
+  }
+  EXPECT_THROW(PetscGalerkin(A0, g.P, "no-such-algorithm"), PetscFailure);
 }
 
 }  // namespace
