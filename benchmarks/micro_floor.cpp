@@ -22,7 +22,8 @@
 //   BM_Floor_HatEvaluate/threads:T             evaluate_vertices (a permuted copy)
 // Tracked octree basis, one W(5,5)-cycle a step:
 //   BM_Floor_TrackedUpdate, BM_Floor_TrackedSetMatrix, BM_Floor_TrackedCycle,
-//   BM_Floor_TrackedEvaluate (threads:T)
+//   BM_Floor_TrackedEvaluate (threads:T); BM_Floor_TrackedGalerkin and
+//   BM_Floor_TrackedGalerkinPetsc as the hat basis's, on the octree's levels
 //
 // Mesh: $MCFBENCH_FLOOR_MESH (default sphere:vertices=40000, a run of about a minute; the issue's
 // size: cgal:armadillo@faces=832000), octree depth $MCFBENCH_FLOOR_DEPTH (default 7; 9 for the
@@ -259,10 +260,14 @@ BENCHMARK(BM_Floor_HatSetMatrix)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-void BM_Floor_HatGalerkin(benchmark::State& state) {
+/// The Galerkin product onto the level range(1) + 1 below the finest of Fixture's hierarchy, at
+/// range(0) threads, as the solver computes it: through the product's plan unless range(2)
+/// (`dense`; galerkin.h).
+template <class Fixture>
+void time_galerkin(benchmark::State& state) {
   std::unique_ptr<tbb::global_control> limit;
   const int threads = set_threads(state, limit);
-  HatFloor& f = HatFloor::get();
+  Fixture& f = Fixture::get();
   const int l = f.mg->levels() - 2 - int(state.range(1));  // the coarse level computed
   if (l < 0) {
     state.SkipWithError("no such level");
@@ -274,7 +279,6 @@ void BM_Floor_HatGalerkin(benchmark::State& state) {
   SparseMatrix C = SparseMatrix(SparseMatrix(f.mg->level_matrix(l).transpose()).transpose());
   const std::vector<int> transpose_pos = multigrid_detail::transpose_positions(C);
   multigrid_detail::Spa spa;
-  // As the solver computes it: through the product's plan unless `dense` (galerkin.h).
   const bool dense = state.range(2) != 0;
   const multigrid_detail::GalerkinPlan plan =
       dense ? multigrid_detail::GalerkinPlan{}
@@ -288,18 +292,16 @@ void BM_Floor_HatGalerkin(benchmark::State& state) {
   state.counters["coarse_rows"] = double(C.rows());
   state.counters["plan_bytes"] = double(plan.bytes());
 }
-BENCHMARK(BM_Floor_HatGalerkin)
-    ->ArgNames({"threads", "below", "dense"})
-    ->ArgsProduct({bench_thread_counts({1, 2}), {0, 1, 2, 3}, {0, 1}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
 
-void BM_Floor_HatGalerkinPetsc(benchmark::State& state) {
+/// The same product by PETSc (PetscGalerkin), onto the level range(0) + 1 below the finest, by
+/// the algorithm range(1): 0 "default", 1 "rap", 2 "hypre".
+template <class Fixture>
+void time_galerkin_petsc(benchmark::State& state) {
   if (!petsc_available()) {
     state.SkipWithError("built without PETSc");
     return;
   }
-  HatFloor& f = HatFloor::get();
+  Fixture& f = Fixture::get();
   const int l = f.mg->levels() - 2 - int(state.range(0));
   if (l < 0) {
     state.SkipWithError("no such level");
@@ -313,6 +315,19 @@ void BM_Floor_HatGalerkinPetsc(benchmark::State& state) {
   for (auto _ : state) product.multiply();
   report(state, galerkin_floor(A, P, f.mg->level_matrix(l)), 1);
   state.SetLabel(algorithm);
+}
+
+void BM_Floor_HatGalerkin(benchmark::State& state) {
+  time_galerkin<HatFloor>(state);
+}
+BENCHMARK(BM_Floor_HatGalerkin)
+    ->ArgNames({"threads", "below", "dense"})
+    ->ArgsProduct({bench_thread_counts({1, 2}), {0, 1, 2, 3}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_Floor_HatGalerkinPetsc(benchmark::State& state) {
+  time_galerkin_petsc<HatFloor>(state);
 }
 BENCHMARK(BM_Floor_HatGalerkinPetsc)
     ->ArgNames({"below", "algorithm"})
@@ -447,6 +462,13 @@ void BM_Floor_TrackedSetMatrix(benchmark::State& state) {
   report(state, set_matrix_floor(*f.mg, f.P(), false), threads);
 }
 
+void BM_Floor_TrackedGalerkin(benchmark::State& state) {
+  time_galerkin<TrackedFloor>(state);
+}
+void BM_Floor_TrackedGalerkinPetsc(benchmark::State& state) {
+  time_galerkin_petsc<TrackedFloor>(state);
+}
+
 void BM_Floor_TrackedCycle(benchmark::State& state) {
   time_cycle<TrackedFloor>(state);
 }
@@ -456,6 +478,16 @@ void BM_Floor_TrackedEvaluate(benchmark::State& state) {
 
 BENCHMARK(BM_Floor_TrackedUpdate)->Apply(per_thread_count);
 BENCHMARK(BM_Floor_TrackedSetMatrix)->Apply(per_thread_count);
+BENCHMARK(BM_Floor_TrackedGalerkin)
+    ->ArgNames({"threads", "below", "dense"})
+    ->ArgsProduct({bench_thread_counts({1, 2}), {0, 1, 2}, {0}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Floor_TrackedGalerkinPetsc)
+    ->ArgNames({"below", "algorithm"})
+    ->ArgsProduct({{0, 1, 2}, {0, 1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_Floor_TrackedCycle)->Apply(per_thread_count);
 BENCHMARK(BM_Floor_TrackedEvaluate)->Apply(per_thread_count);
 
