@@ -26,7 +26,9 @@ if [ "${1:-}" = --sanitize ]; then
   reports=$build/sanitizer-reports
   rm -rf "$reports"
   mkdir -p "$reports"
-  export ASAN_OPTIONS=detect_leaks=1:check_initialization_order=1:strict_init_order=1:log_path=$reports/asan:${ASAN_OPTIONS:-}
+  # fast_unwind_on_malloc=0: an allocation's stack is unwound in full, through the Debian
+  # libraries built without frame pointers (Open MPI's), so that the suppressions can name them.
+  export ASAN_OPTIONS=detect_leaks=1:fast_unwind_on_malloc=0:check_initialization_order=1:strict_init_order=1:log_path=$reports/asan:${ASAN_OPTIONS:-}
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan.supp:log_path=$reports/ubsan:${UBSAN_OPTIONS:-}
   export LSAN_OPTIONS=suppressions=$supp/lsan.supp:print_suppressions=0:${LSAN_OPTIONS:-}
   cd "$build"
