@@ -17,7 +17,7 @@ void undirected_graph(int n, const std::vector<std::pair<int, int>>& pairs, std:
       ++first[std::size_t(b) + 1];
     }
   for (std::size_t v = 0; v < N; ++v) first[v + 1] += first[v];
-  std::vector<int> all(std::size_t(first[N]));
+  std::vector<int> all(static_cast<std::size_t>(first[N]));
   std::vector<int> fill(first.begin(), first.end() - 1);
   for (const auto& [a, b] : pairs)
     if (a != b) {

@@ -16,6 +16,7 @@ packages=(
   libbenchmark-dev
   libgtest-dev
   clang-format                           # scripts/format.sh and the `format` test
+  clang libclang-rt-dev                  # the fuzz targets (libFuzzer), built and run by the suite
   python3-matplotlib python3-numpy
   slurmctld slurmd slurm-client munge    # the `slurm_live` test starts a single-node Slurm of its own
 )

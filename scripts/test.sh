@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The whole test suite: set-up, build, then every GoogleTest case and script check under ctest.
+# The whole test suite: set-up, build (GCC, and the fuzz targets with clang), then every GoogleTest
+# case and script check under ctest.
 #
-#   scripts/test.sh [CTEST ARGS]             Release build in build/ (or $MCFBENCH_BUILD); CI runs this
+#   scripts/test.sh [CTEST ARGS]             Release build in build/ (or $MCFBENCH_BUILD), the fuzz
+#                                            targets in build/fuzz-clang; CI runs this
 #   scripts/test.sh --sanitize [CTEST ARGS]  the same suite built with AddressSanitizer and
 #                                            UndefinedBehaviorSanitizer in build-sanitize/ (or
 #                                            $MCFBENCH_BUILD_SANITIZE); docs/testing.md
@@ -48,5 +50,8 @@ fi
 build=${MCFBENCH_BUILD:-$root/build}
 bash "$root/scripts/setup.sh"
 bash "$root/scripts/build.sh"
+# The fuzz targets, with clang (the `fuzz_smoke` test runs them): a change that breaks the clang
+# build or a fuzz target fails here.
+MCFBENCH_FUZZ_BUILD=$build/fuzz-clang bash "$root/scripts/fuzz.sh" --build-only
 cd "$build"
 ctest --output-on-failure --parallel "${MCFBENCH_JOBS:-$(nproc)}" --timeout 900 "$@"

@@ -171,7 +171,7 @@ Problem make_problem(int depth, int coarsest, double dt, Drop drop = Drop::none)
     pr.P.push_back(select(Pfull[std::size_t(l)], map[std::size_t(l) + 1], map[std::size_t(l)],
                           count[std::size_t(l) + 1], count[std::size_t(l)]));
   for (int l = 0; l < nl; ++l) {
-    std::vector<std::uint8_t> c(std::size_t(count[std::size_t(l)]));
+    std::vector<std::uint8_t> c(static_cast<std::size_t>(count[std::size_t(l)]));
     for (std::size_t i = 0; i < map[std::size_t(l)].size(); ++i)
       if (map[std::size_t(l)][i] >= 0)
         c[std::size_t(map[std::size_t(l)][i])] = col[std::size_t(l)][i];
