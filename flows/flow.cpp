@@ -52,8 +52,10 @@ struct StepTally {
   double planted_seconds = 0;  ///< added by $MCFBENCH_PLANTED_SLOWDOWN (flows/planted_slowdown.h)
   int solves = 0, iterations = 0;
   double contraction = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
-  int fallbacks = 0, fallback_iterations = 0;  ///< solves whose stalled cycles CG took over
-  int direct_solves = 0;                       ///< of those, the ones a factorization finished
+  /// Solves that needed more than their cycles (solvers/multigrid_fallback.h), the cycles added
+  /// to reach the residual bound, and CG's iterations after them.
+  int fallbacks = 0, extra_cycles = 0, fallback_iterations = 0;
+  int direct_solves = 0;  ///< of those, the ones a factorization finished
   SolveReport worst;
   // Every solve's residuals, in order (Taylor-2 and Neumann-2 solve twice a step).
   std::vector<std::vector<double>> residuals_per_solve;
@@ -125,8 +127,9 @@ class FlowStepContext final : public StepContext {
     t.iterations += r.iterations;
     t.residuals_per_solve.push_back(r.residuals);
     t.contraction = std::max(t.contraction, r.contraction);
-    if (r.fallback_iterations > 0 || r.direct_fallback) {
+    if (r.extra_cycles > 0 || r.fallback_iterations > 0 || r.direct_fallback) {
       ++t.fallbacks;
+      t.extra_cycles += r.extra_cycles;
       t.fallback_iterations += r.fallback_iterations;
       if (r.direct_fallback) ++t.direct_solves;
     }
@@ -256,7 +259,6 @@ class FlowRun {
   void record_references(const Positions& V_new, double t, nlohmann::json& record);
 
   const FlowConfig& config_;
-  const MeshSource& source_;
   nlohmann::json& result_;
   TriangleMesh mesh_;
   // mesh_'s faces by smallest vertex (datasets/face_order.h): the stop rule's pass over the
@@ -279,7 +281,7 @@ class FlowRun {
 };
 
 FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::json& result)
-    : config_(config), source_(source), result_(result), mesh_(source.mesh) {
+    : config_(config), result_(result), mesh_(source.mesh) {
   const Triangles& F = mesh_.faces;
   if (config.normalize_area) apply(unit_area_normalization(mesh_.vertices, F), mesh_.vertices);
   moment_faces_ = faces_by_smallest_vertex(F, mesh_.num_vertices());
@@ -375,6 +377,7 @@ nlohmann::json FlowRun::solver_record(int step, double t) const {
   if (tally.contraction >= 0) record["solver"]["contraction"] = tally.contraction;
   if (tally.fallbacks > 0)
     record["solver"]["fallback"] = {{"solves", tally.fallbacks},
+                                    {"extra_cycles", tally.extra_cycles},
                                     {"iterations", tally.fallback_iterations},
                                     {"direct_solves", tally.direct_solves}};
   if (!tally.columns_per_solve.empty()) record["solver"]["rhs_per_solve"] = tally.columns_per_solve;

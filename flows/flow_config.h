@@ -40,6 +40,11 @@ struct SolverConfig {
   /// reduce it by less per cycle, CG preconditioned by the cycle takes over until they have
   /// (never below `fallback_tolerance`; solvers/multigrid_fallback.h). 0 = never.
   double stall_ratio = 0.2;
+  /// multigrid: a step is converged only at or below this relative residual; one whose cycles end
+  /// above it continues (more cycles, CG by the cycle, the factorization) until it is
+  /// (solvers/multigrid_fallback.h: kDefaultResidualBound, which a test holds this to). 0 = no
+  /// bound.
+  double residual_bound = 1e-4;
   double fallback_tolerance = 1e-10;
   /// multigrid: the fallback CG's iterations after which (or on whose breakdown) CHOLMOD solves
   /// the step, and every later stalled step at once (solvers/multigrid_fallback.h). 0 = never.

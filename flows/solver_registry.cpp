@@ -25,9 +25,11 @@ constexpr double kPetscBytesPerNonzero = 12 + 12.0 / kPetscMatrixCopies;
 constexpr double kPetscVectorBytesPerUnknown = 16 * 8;
 
 std::unique_ptr<LinearSolver> make_multigrid(const SolverConfig& c) {
-  if (c.stall_ratio <= 0) return std::make_unique<MultigridSolver>(multigrid_options(c));
+  if (c.stall_ratio <= 0 && c.residual_bound <= 0)
+    return std::make_unique<MultigridSolver>(multigrid_options(c));
   StallFallbackOptions f;
   f.stall_ratio = c.stall_ratio;
+  f.residual_bound = c.residual_bound;
   f.tolerance = c.fallback_tolerance;
   f.max_iterations = c.max_iterations;
   f.direct_after = c.direct_after;
@@ -81,8 +83,16 @@ NamedTable<SolverRow> built_in() {
                  option("stall_ratio", OptionType::number, 0.2, "--stall-ratio",
                         "Multigrid: where the cycles reduce the residual by less than this per "
                         "cycle, CG preconditioned by the cycle takes over until they have reached "
-                        "what this ratio promises; 0 = never"),
+                        "what this ratio promises (or the residual bound); 0 = never"),
                  [](auto& c) -> auto& { return c.solver.stall_ratio; }),
+             0, 1),
+      ranged(bind(
+                 option("residual_bound", OptionType::number, kDefaultResidualBound,
+                        "--residual-bound",
+                        "Multigrid: a step is converged only at or below this relative residual; "
+                        "one whose cycles end above it continues with more cycles, then CG "
+                        "preconditioned by the cycle, then the factorization; 0 = no bound"),
+                 [](auto& c) -> auto& { return c.solver.residual_bound; }),
              0, 1),
       ranged(bind(
                  option("fallback_tolerance", OptionType::number, 1e-10, "--fallback-tolerance",
@@ -93,7 +103,8 @@ NamedTable<SolverRow> built_in() {
                  option("direct_after", OptionType::integer, 10, "--direct-after",
                         "Multigrid: when the fallback CG has not reached its target after this "
                         "many iterations, or breaks down, a sparse Cholesky factorization solves "
-                        "the step, and later stalled steps at once; 0 = never"),
+                        "the step, and later steps that need more than their cycles at once; "
+                        "0 = never"),
                  [](auto& c) -> auto& { return c.solver.direct_after; }),
              0, 1000000)};
   multigrid.iterative = multigrid.needs_hierarchy = true;

@@ -37,7 +37,8 @@ def family_and_knob(r):
     s = c.get("solver", {}) or {}
     o = c.get("octree", {}) or {}
     name = s.get("name", "?")
-    fallback = " + fallback" if name == "multigrid" and (s.get("stall_ratio") or 0) > 0 else ""
+    guarded = (s.get("stall_ratio") or 0) > 0 or (s.get("residual_bound") or 0) > 0
+    fallback = " + guard" if name == "multigrid" and guarded else ""
     cycle = "%s(%s,%s)" % (s.get("cycle"), s.get("smooth"), s.get("smooth"))
     if c.get("basis") == "hat":
         if name == "cholmod":
@@ -348,40 +349,42 @@ def make(results, out_dir, reference, written):
 
 
 def fallback_steps(result):
-    """(steps whose solves fell back, CG iterations in all, steps a factorization finished) of a
-    result."""
+    """(steps that needed more than their cycles, extra cycles in all, CG iterations in all, steps a
+    factorization finished) of a result."""
     steps = [s for s in result.get("steps") or [] if common.get(s, "solver.fallback")]
-    return (len(steps), sum(common.get(s, "solver.fallback.iterations", 0) or 0 for s in steps),
+    return (len(steps), sum(common.get(s, "solver.fallback.extra_cycles", 0) or 0 for s in steps),
+            sum(common.get(s, "solver.fallback.iterations", 0) or 0 for s in steps),
             sum(1 for s in steps if (common.get(s, "solver.fallback.direct_solves", 0) or 0) > 0))
 
 
 def degenerating_sections(points):
-    """Per degenerating case: each fast setting with its fallback against CHOLMOD on the same
-    system (same basis and octree system): the ratio of their errors, the steps each completed,
-    and how often the fallback ran."""
+    """Per degenerating case: each fixed-work setting with its guard (the residual bound and the
+    stall test) against CHOLMOD on the same system (same basis and octree system): the ratio of
+    their errors, the steps each completed, and what the guard added."""
     out = []
     for case, pts in common.group_by([p for p in points if p["case"][0] == "degenerating"],
                                      lambda p: (p["case"], p["vertices"])).items():
         rows = []
         for p in pts:
-            if not p["family"].endswith(" + fallback"):
+            if not p["family"].endswith(" + guard"):
                 continue
             system = p["family"].split(" V(")[0].split(" W(")[0].replace("hat MG", "hat")
             exact = next((q for q in pts if q["family"] == system + " + CHOLMOD"), None)
             name = "distance to the reference flow"
             e, x = p["errors"].get("RMS distance to the reference flow"), (exact or {}).get("errors", {}).get(
                 "RMS distance to the reference flow")
-            n, its, direct = fallback_steps(p["result"])
+            n, extra, its, direct = fallback_steps(p["result"])
             rows.append([describe(p), common.fmt(e), exact["family"] if exact else "—", common.fmt(x),
                          common.fmt(e / x, "%.2f") if common.finite(e) and common.finite(x) else "—",
                          "%s / %s" % (common.get(p["result"], "stop.step", "?"),
                                       common.get(exact["result"], "stop.step", "?") if exact else "—"),
-                         "%d steps, %d CG iterations, %d factorized" % (n, its, direct)])
+                         "%d steps, %d extra cycles, %d CG iterations, %d factorized" % (
+                             n, extra, its, direct)])
         if rows:
-            out.append("### Degenerating: %s, %s vertices — the fast settings with their fallback\n\n" % (
+            out.append("### Degenerating: %s, %s vertices — the fixed-work settings with their guard\n\n" % (
                 case[0][1], case[1]) + common.markdown_table(
                     ["setting", name, "CHOLMOD on the same system", "its distance", "ratio", "steps (ours / CHOLMOD)",
-                     "fallback"], rows))
+                     "guard"], rows))
     return out
 
 

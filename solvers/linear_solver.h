@@ -42,7 +42,11 @@ struct SolveReport {
   /// Multigrid: the mean reduction of the relative residual per cycle over the solve,
   /// (r_k / r_0)^(1/k) from the warm start's r_0, where the solver measured r_0; -1 otherwise.
   double contraction = -1;
-  /// Iterations of a fallback solver that took over after this one stalled (0: none ran).
+  /// Cycles a guarded multigrid ran beyond its configured count to bring the step under its
+  /// residual bound (solvers/multigrid_fallback.h); included in `iterations`.
+  int extra_cycles = 0;
+  /// Iterations of a fallback solver that took over after this one stalled or ended above its
+  /// residual bound (0: none ran).
   int fallback_iterations = 0;
   /// A sparse factorization solved this system after the iterative solver and its fallback did
   /// not (solvers/multigrid_fallback.h).

@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <new>
 #include <stdexcept>
@@ -921,6 +922,7 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
       m.correction_cycle(options_, have_r);
     else
       m.cycle(top, options_);
+    const double before = rel;
     rel = m.relative_residual(bnorm, mixed);
     have_r = mixed;
     rep.residuals.push_back(rel);
@@ -934,12 +936,22 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
       rep.status = SolveStatus::converged;
       break;
     }
+    if (tol > 0.0 && options_.give_up_ratio > 0.0 && rel > options_.give_up_ratio * before) {
+      char note[128];
+      std::snprintf(note, sizeof note, "a cycle reduced the residual by only %.3g: stopped",
+                    rel / before);
+      rep.message = note;
+      break;
+    }
   }
-  if (tol <= 0.0 && rep.status == SolveStatus::max_iterations && std::isfinite(rel))
+  // Fixed work (no tolerance) ran its cycles without checking where they ended: max_iterations,
+  // never `converged` (a guard that checks them against a bound says that:
+  // solvers/multigrid_fallback.h), except on a single level, where the cycle is the direct solve.
+  if (tol <= 0.0 && top == 0 && rep.iterations > 0 && std::isfinite(rel))
     rep.status = SolveStatus::converged;
   if (rep.iterations == 0 && tol <= 0.0) {  // cycles == 0: report the warm start's residual
     rel = m.relative_residual(bnorm);
-    rep.status = std::isfinite(rel) ? SolveStatus::converged : SolveStatus::numerical_issue;
+    if (!std::isfinite(rel)) rep.status = SolveStatus::numerical_issue;
   }
   rep.relative_residual = rel;
   if (measure_start && rep.iterations > 0 && std::isfinite(rel) && std::isfinite(start) &&

@@ -102,8 +102,13 @@ struct MultigridOptions {
   int cycles = 1;       ///< number of cycles per solve (the cap when tolerance > 0)
   int pre_smooth = 5;   ///< Gauss-Seidel sweeps before the coarse correction, per level
   int post_smooth = 5;  ///< Gauss-Seidel sweeps after the coarse correction, per level
-  /// 0: run exactly `cycles` cycles; > 0: stop early once the relative residual is below.
+  /// 0: run exactly `cycles` cycles (status max_iterations: nothing checked where they ended);
+  /// > 0: stop early once the relative residual is below (status converged).
   double tolerance = 0.0;
+  /// With a tolerance: stop early (status max_iterations) after a cycle that reduces the relative
+  /// residual by less than this factor, where more cycles would waste the time that a better
+  /// solver (CG by the cycle) then has; 0 = never.
+  double give_up_ratio = 0.0;
   /// Measure the warm start's residual (one residual pass) so that the report's contraction is
   /// known even when `tolerance` is 0; with a tolerance it is measured anyway.
   bool measure_contraction = false;

@@ -331,6 +331,7 @@ struct PcgSolver::Recurrence {
     true_residual();
     const bool any = mark_unconverged();
     rep.relative_residual = max_res();
+    initial = rep.relative_residual;
     if (!std::isfinite(rep.relative_residual)) {
       rep.status = SolveStatus::numerical_issue;
       rep.message = "NaN/inf in the initial residual";
@@ -446,7 +447,19 @@ struct PcgSolver::Recurrence {
       return Next::go_on;
     }
     if (it + 1 >= cap) return Next::cap;
+    if (off_course(it + 1, rep)) return Next::cap;
     return update_directions(rep) ? Next::go_on : Next::done;
+  }
+
+  /// give_up_off_course: whether the mean reduction over the `done` iterations so far, r_i =
+  /// r_0 · q^i, needs more than the cap to reach the tolerance.
+  bool off_course(int done, const SolveReport& rep) const {
+    if (!solver.options_.give_up_off_course || done < 3 || !(initial > 0.0)) return false;
+    const double now = rep.residuals.back();
+    const double q = std::pow(now / initial, 1.0 / done);
+    if (!(q < 1.0)) return true;
+    const double more = std::log(tol / now) / std::log(q);
+    return done + more > solver.options_.max_iterations;
   }
 
   /// The iteration cap: the report of the last iterate's true residual.
@@ -458,7 +471,11 @@ struct PcgSolver::Recurrence {
       fail(rep, SolveStatus::numerical_issue, "NaN/inf in the residual");
     else if (!(rep.relative_residual <= tol))
       fail(rep, SolveStatus::max_iterations,
-           "iteration cap " + std::to_string(solver.options_.max_iterations) + " reached");
+           rep.iterations < solver.options_.max_iterations
+               ? "on course to miss the tolerance within the cap of " +
+                     std::to_string(solver.options_.max_iterations) + ": stopped after " +
+                     std::to_string(rep.iterations)
+               : "iteration cap " + std::to_string(solver.options_.max_iterations) + " reached");
     return rep;
   }
 
@@ -473,6 +490,7 @@ struct PcgSolver::Recurrence {
   MatrixRef& X;
   const Index n, k;
   const double tol;
+  double initial = 0.0;  ///< the start's relative residual (begin)
   VectorXd bnorm;
   MatrixXd &R, &Z, &P, &Q;  // the solver's blocks_
   VectorXd res, rz, pq, rr, alpha, beta;

@@ -31,6 +31,10 @@ const char* to_string(PcgPreconditioner p);
 struct PcgOptions {
   double relative_tolerance = 1e-10;  ///< stop when max_c ||b_c - A x_c|| / ||b_c|| <= this
   int max_iterations = 1000;          ///< iteration cap; reaching it gives max_iterations
+  /// Stop early (status max_iterations) once, after at least 3 iterations, the mean reduction per
+  /// iteration so far predicts that the cap will not reach the tolerance: for a caller with a
+  /// better way to finish (the multigrid guard's factorization), the rest would be wasted.
+  bool give_up_off_course = false;
   PcgPreconditioner preconditioner = PcgPreconditioner::jacobi;
 };
 

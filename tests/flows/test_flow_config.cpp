@@ -4,6 +4,7 @@
 #include "flows/flow.h"
 #include "flows/flow_config.h"
 #include "solvers/blas_threads.h"
+#include "solvers/multigrid_fallback.h"
 
 #include <gtest/gtest.h>
 
@@ -31,6 +32,10 @@ TEST(FlowConfig, DefaultsFilledAndRoundTrip) {
       json{{"mesh", "x.off"}, {"basis", "octree"}, {"solver", {{"name", "multigrid"}}}},
       "cfg.json");
   EXPECT_EQ(mg.solver.tolerance, 0.0);
+  // The residual bound's one default, in the struct, the config reader and the solver.
+  EXPECT_EQ(FlowConfig{}.solver.residual_bound, kDefaultResidualBound);
+  EXPECT_EQ(mg.solver.residual_bound, kDefaultResidualBound);
+  EXPECT_EQ(StallFallbackOptions{}.residual_bound, kDefaultResidualBound);
 }
 
 // octree.stabilization_weight left out is the solver's, filled in when the config is read: the

@@ -33,11 +33,13 @@ json octree(const std::string& mesh, const std::string& tracking, int depth, con
 }
 
 /// The same on the paper's system (no stabilization): what the tests of its properties run. Its
-/// cycles run as given, without the fallback that takes over from stalled cycles.
+/// cycles run as given, without the guard that takes over from stalled cycles or from cycles that
+/// end above the residual bound.
 json paper(const std::string& mesh, const std::string& tracking, int depth, const json& solver) {
   json j = octree(mesh, tracking, depth, solver);
   j["octree"]["stabilization"] = "none";
   j["solver"]["stall_ratio"] = 0;
+  j["solver"]["residual_bound"] = 0;
   return j;
 }
 

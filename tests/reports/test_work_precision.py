@@ -88,18 +88,18 @@ check(wp.family_and_knob(fake(9, "octree", {"name": "pcg", "preconditioner": "mu
 check(wp.family_and_knob(fake(9, "hat", {"name": "cholmod"}, 1.0, 1e-5, octree={"refine_input": True}))[0].startswith("reference"),
       "the refined reference")
 
-# 4. The degenerating case's table: a fast setting with its fallback against CHOLMOD on its system.
+# 4. The degenerating case's table: a fixed-work setting with its guard against CHOLMOD on its system.
 def degenerate(index, solver, distance):
     r = fake(index, "hat", solver, 0.1, 1.0, mesh="cgal:dino")
     r["reference_distance"] = [{"step": 3, "rms": distance}]
-    r["steps"][1]["solver"] = {"fallback": {"solves": 1, "iterations": 7}}
+    r["steps"][1]["solver"] = {"fallback": {"solves": 1, "extra_cycles": 2, "iterations": 7}}
     return r
 
 
 dino = [degenerate(20, {"name": "cholmod"}, 2e-4),
         degenerate(21, dict(mg(2), stall_ratio=0.5), 2.5e-4)]
 section = "\n".join(wp.degenerating_sections(wp.points_of(dino)))
-check("| hat MG V(2,2) + fallback x2 | 0.00025 | hat + CHOLMOD | 0.0002 | 1.25 | 3 / 3 | 1 steps, 7 CG iterations, 0 factorized |"
+check("| hat MG V(2,2) + guard x2 | 0.00025 | hat + CHOLMOD | 0.0002 | 1.25 | 3 / 3 | 1 steps, 2 extra cycles, 7 CG iterations, 0 factorized |"
       in section, "degenerating table:\n" + section)
 results += dino
 

@@ -155,6 +155,41 @@ TEST(PcgSolver, IterationCapIsRespected) {
   }
 }
 
+// give_up_off_course: a cap of 20 iterations that CG cannot meet at its pace (a 1e-12 tolerance
+// without a preconditioner) is given up after the first three, said as such; with a tolerance it
+// meets, the option changes nothing.
+TEST(PcgSolver, GivesUpOnceOffCourseForTheCap) {
+  const SparseMatrix A = laplacian3d(12, 12, 12, 0.01);
+  const Eigen::MatrixXd B = random_rhs(A.rows());
+  PcgOptions o = tight(PcgPreconditioner::none);
+  o.max_iterations = 20;
+  o.give_up_off_course = true;
+  PcgSolver pcg(o);
+  ASSERT_EQ(pcg.set_matrix(A).status, SolveStatus::converged);
+  Eigen::MatrixXd X;
+  const SolveReport r = pcg.solve(B, X);
+  EXPECT_EQ(r.status, SolveStatus::max_iterations);
+  EXPECT_EQ(r.iterations, 3);
+  EXPECT_NE(r.message.find("on course to miss"), std::string::npos) << r.message;
+  o.give_up_off_course = false;
+  pcg.set_options(o);
+  X.resize(0, 0);
+  EXPECT_EQ(pcg.solve(B, X).iterations, 20);
+  // Reachable: the same iterate as without the option.
+  o.relative_tolerance = 1e-2;
+  o.max_iterations = 1000;
+  pcg.set_options(o);
+  Eigen::MatrixXd Y;
+  const SolveReport plain = pcg.solve(B, Y);
+  o.give_up_off_course = true;
+  pcg.set_options(o);
+  Eigen::MatrixXd Z;
+  const SolveReport guarded = pcg.solve(B, Z);
+  EXPECT_EQ(guarded.status, SolveStatus::converged);
+  EXPECT_EQ(guarded.iterations, plain.iterations);
+  EXPECT_EQ(Y, Z);
+}
+
 TEST(PcgSolver, ResidualHistoryDecreasesAndEndsAtTrueResidual) {
   const SparseMatrix A = graph_laplacian(2000, 5, 0.02, 9);
   const Eigen::MatrixXd B = random_rhs(A.rows());
