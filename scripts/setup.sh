@@ -18,6 +18,9 @@ packages=(
   clang-format                           # scripts/format.sh and the `format` test
   clang libclang-rt-dev                  # the fuzz targets (libFuzzer), built and run by the suite
   python3-matplotlib python3-numpy
+  pybind11-dev python3-dev               # the Python module `mcfbench` (docs/python.md)
+  python3-pytest python3-pandas          # its tests; mcfbench.results' DataFrame
+  python3-scipy                          # mcfbench.matrices as scipy.sparse, the tests' Python solver
   slurmctld slurmd slurm-client munge    # the `slurm_live` test starts a single-node Slurm of its own
 )
 
