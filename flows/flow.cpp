@@ -548,11 +548,16 @@ FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
   out.result["mesh"] = mesh_json(source);
   if (!source.notes.empty()) out.result["mesh"]["notes"] = source.notes;
   FlowRun flow(config, source, out.result);
-  if (observer.on_step) observer.on_step(0, 0.0, flow.vertices());
-  for (int step = 1; step <= config.steps; ++step) {
-    if (!flow.advance(step)) break;
+  // Hands step `step` to the observer; false when the observer ends the flow there.
+  const auto observed = [&](int step) {
     if (observer.on_step) observer.on_step(step, step * config.dt, flow.vertices());
-  }
+    if (!observer.stop || !observer.stop(step)) return true;
+    out.result["stop"] = {{"step", step}, {"reason", "stopped by the caller"}};
+    return false;
+  };
+  if (observed(0))
+    for (int step = 1; step <= config.steps; ++step)
+      if (!flow.advance(step) || !observed(step)) break;
   out.final_mesh = flow.finish();
   return out;
 }

@@ -16,6 +16,9 @@ namespace mcf {
 struct FlowObserver {
   /// After each step with the new vertex positions (frames, progress). Step 0 = the input.
   std::function<void(int step, double t, const Positions& vertices)> on_step;
+  /// Asked after on_step (step 0 too): true ends the flow there. That is not a failure: the
+  /// status stays "ok" and result["stop"] is {"step": step, "reason": "stopped by the caller"}.
+  std::function<bool(int step)> stop;
 };
 
 struct FlowOutcome {
