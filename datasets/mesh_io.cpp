@@ -203,6 +203,14 @@ void check_half_edge_faces(const TriangleMesh& mesh, const std::string& name) {
   half_edge_mesh_in_memory(name, "", mesh);
 }
 
+long long orient_and_check_faces(TriangleMesh& mesh, const std::string& name) {
+  const auto name_face = [](Eigen::Index f) { return "face " + std::to_string(f); };
+  const auto name_vertex = [](int v) { return std::to_string(v); };
+  const long long reoriented = orient_or_fail(name, mesh, name_face, name_vertex);
+  half_edge_mesh(name, "", mesh, name_face, name_vertex);
+  return reoriented;
+}
+
 namespace {
 
 // OFF, OBJ and PLY are written here rather than by OpenMesh, whose writers round coordinates to

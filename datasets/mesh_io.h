@@ -35,6 +35,12 @@ TriangleMesh read_mesh(const std::string& path, ReadReport* report = nullptr);
 /// FaceCheck::trusted.
 void check_half_edge_faces(const TriangleMesh& mesh, const std::string& name);
 
+/// What read_mesh does to a file's faces, for a mesh in memory (faces and vertices named by their
+/// 0-based indices): checks every face's corners (in range, three different ones), orients the
+/// faces consistently (orient_faces) and adds them to a half-edge mesh. Returns how many faces
+/// were reversed; throws MeshError naming `name` and the first face it cannot take, and why.
+long long orient_and_check_faces(TriangleMesh& mesh, const std::string& name);
+
 /// What write_mesh checks of the faces before it writes.
 enum class FaceCheck {
   /// Every face is added to a half-edge mesh, as on reading: a face it cannot hold (non-manifold

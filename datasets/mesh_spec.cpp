@@ -20,6 +20,7 @@
 #include <map>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mcf {
@@ -360,6 +361,56 @@ std::string count_of(long long n, const std::string& what) {
 
 }  // namespace
 
+namespace {
+
+/// What every mesh goes through once it is read or built, before anything uses it: the note of
+/// the faces its reading reoriented, the zero-area faces treated as `options` says (before
+/// subdivision, which would make four of each), subdivision to `target_faces` (0: none) and
+/// validation under `validate_name`. Errors name `spec`.
+void finish_loading(MeshSource& src, long long reoriented_faces, const MeshLoadOptions& options,
+                    const std::string& validate_name, long long target_faces) {
+  const std::string& spec = src.spec;
+  const Eigen::Index faces_read = src.mesh.num_faces();
+  if (reoriented_faces > 0)
+    src.notes.push_back("reoriented " + std::to_string(reoriented_faces) + " of " +
+                        count_of(faces_read, "face") +
+                        " so that every face agrees with its neighbours (the file lists them "
+                        "with mixed orientation)");
+  DegenerateRepair repaired;
+  if (options.degenerate == DegenerateFaces::repair) {
+    repaired = repair_degenerate_faces(src.mesh);
+    if (repaired.degenerate_faces > 0) {
+      try {
+        check_half_edge_faces(src.mesh, validate_name);
+      } catch (const MeshError& e) {
+        fail(spec, std::string("removing its zero-area faces left a mesh a half-edge mesh "
+                               "cannot hold: ") +
+                       e.what());
+      }
+      const long long collapsed = repaired.degenerate_faces - repaired.flipped_faces;
+      src.notes.push_back(
+          "removed " + count_of(repaired.degenerate_faces, "zero-area face") +
+          " (repair_degenerate): " + std::to_string(repaired.flipped_faces) +
+          " flipped away across their longest edge, " + std::to_string(collapsed) + " collapsed (" +
+          std::to_string(repaired.removed_faces) + " of " + count_of(faces_read, "face") +
+          " gone, " + std::to_string(repaired.merged_vertices) +
+          (repaired.merged_vertices == 1 ? " vertex" : " vertices") + " merged into a neighbour)");
+    }
+  }
+  if (target_faces > 0) subdivide_source(src, target_faces);
+  ValidateOptions validate;
+  validate.keep_degenerate = options.degenerate == DegenerateFaces::keep;
+  validate.degenerate_hint = options.degenerate_hint;
+  src.report = validate_mesh(src.mesh, validate_name, validate);
+  src.report.reoriented_faces = reoriented_faces;
+  src.report.repaired_faces = repaired.degenerate_faces;
+  if (src.report.degenerate_faces > 0)
+    src.notes.push_back("kept " + count_of(src.report.degenerate_faces, "zero-area face") +
+                        " as they are");
+}
+
+}  // namespace
+
 MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& options) {
   MeshSource src;
   src.spec = spec;
@@ -391,44 +442,18 @@ MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& option
       load_generated(spec, name, args, colon != std::string::npos, src);
     }
   }
-  const Eigen::Index faces_read = src.mesh.num_faces();
-  if (read.reoriented_faces > 0)
-    src.notes.push_back("reoriented " + std::to_string(read.reoriented_faces) + " of " +
-                        count_of(faces_read, "face") +
-                        " so that every face agrees with its neighbours (the file lists them "
-                        "with mixed orientation)");
-  DegenerateRepair repaired;
-  if (options.degenerate == DegenerateFaces::repair) {
-    // Before subdivision, which would make four zero-area faces of each.
-    repaired = repair_degenerate_faces(src.mesh);
-    if (repaired.degenerate_faces > 0) {
-      try {
-        check_half_edge_faces(src.mesh, validate_name);
-      } catch (const MeshError& e) {
-        fail(spec, std::string("removing its zero-area faces left a mesh a half-edge mesh "
-                               "cannot hold: ") +
-                       e.what());
-      }
-      const long long collapsed = repaired.degenerate_faces - repaired.flipped_faces;
-      src.notes.push_back(
-          "removed " + count_of(repaired.degenerate_faces, "zero-area face") +
-          " (repair_degenerate): " + std::to_string(repaired.flipped_faces) +
-          " flipped away across their longest edge, " + std::to_string(collapsed) + " collapsed (" +
-          std::to_string(repaired.removed_faces) + " of " + count_of(faces_read, "face") +
-          " gone, " + std::to_string(repaired.merged_vertices) +
-          (repaired.merged_vertices == 1 ? " vertex" : " vertices") + " merged into a neighbour)");
-    }
-  }
-  if (target_faces > 0) subdivide_source(src, target_faces);
-  ValidateOptions validate;
-  validate.keep_degenerate = options.degenerate == DegenerateFaces::keep;
-  validate.degenerate_hint = options.degenerate_hint;
-  src.report = validate_mesh(src.mesh, validate_name, validate);
-  src.report.reoriented_faces = read.reoriented_faces;
-  src.report.repaired_faces = repaired.degenerate_faces;
-  if (src.report.degenerate_faces > 0)
-    src.notes.push_back("kept " + count_of(src.report.degenerate_faces, "zero-area face") +
-                        " as they are");
+  finish_loading(src, read.reoriented_faces, options, validate_name, target_faces);
+  return src;
+}
+
+MeshSource mesh_source_from_arrays(TriangleMesh mesh, const std::string& name,
+                                   const MeshLoadOptions& options) {
+  MeshSource src;
+  src.spec = name;
+  src.kind = "arrays";
+  src.mesh = std::move(mesh);
+  const long long reoriented = orient_and_check_faces(src.mesh, name);
+  finish_loading(src, reoriented, options, name, 0);
   return src;
 }
 

@@ -66,6 +66,15 @@ MeshSpecRequest parse_mesh_spec(const std::string& spec);
 /// generator or parameter.
 MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& options = {});
 
+/// A mesh given as arrays (a library caller's, docs/library.md), loaded as a file is — every
+/// face's corners checked, the faces oriented consistently, zero-area faces treated as `options`
+/// says, validated — but not scaled: the caller's frame is kept. `name` stands for the spec in
+/// messages and in MeshSource::spec; faces and vertices are named by their 0-based indices.
+/// Throws MeshError naming `name` on any problem (an empty mesh, a non-finite coordinate, a corner
+/// out of range or repeated, a non-manifold edge or vertex, a non-orientable surface).
+MeshSource mesh_source_from_arrays(TriangleMesh mesh, const std::string& name,
+                                   const MeshLoadOptions& options = {});
+
 /// Uniform scale and translation into the unit cube [0,1]^3: the longest bounding-box side
 /// becomes [0,1], the other axes are centred. What load_mesh_spec does to real models.
 void fit_unit_cube(TriangleMesh& mesh);
