@@ -1,6 +1,6 @@
 #include "api/detail.h"
 
-#include "flows/flow.h"
+#include "datasets/mesh_info.h"
 
 #include <nlohmann/json.hpp>
 
@@ -52,9 +52,7 @@ const std::string& Mesh::spec() const {
 }
 
 std::string Mesh::report_json() const {
-  nlohmann::json j = mcf::mesh_json(impl_->source);
-  if (!impl_->source.notes.empty()) j["notes"] = impl_->source.notes;
-  return j.dump();
+  return mcf::mesh_description(impl_->source).dump();
 }
 
 }  // namespace mcfbench

@@ -5,9 +5,7 @@
 
 namespace mcf {
 
-nlohmann::json mesh_info(const std::string& spec, const std::string& write_to,
-                         const MeshLoadOptions& options) {
-  const MeshSource m = load_mesh_spec(spec, options);
+nlohmann::json mesh_description(const MeshSource& m) {
   const MeshReport& r = m.report;
   const Eigen::Vector3d lo = m.mesh.vertices.colwise().minCoeff(),
                         hi = m.mesh.vertices.colwise().maxCoeff();
@@ -30,6 +28,13 @@ nlohmann::json mesh_info(const std::string& spec, const std::string& write_to,
   if (!m.notes.empty()) j["notes"] = m.notes;
   if (m.sphere_radius) j["sphere_radius"] = *m.sphere_radius;
   if (m.cylinder_radius) j["cylinder_radius"] = *m.cylinder_radius;
+  return j;
+}
+
+nlohmann::json mesh_info(const std::string& spec, const std::string& write_to,
+                         const MeshLoadOptions& options) {
+  const MeshSource m = load_mesh_spec(spec, options);
+  nlohmann::json j = mesh_description(m);
   // Written before the report is printed: a write that fails (an unknown extension, a missing
   // folder) exits non-zero with nothing on stdout, not after a complete-looking report.
   if (!write_to.empty()) write_mesh(write_to, m.mesh, true, FaceCheck::trusted);

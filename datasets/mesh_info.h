@@ -18,4 +18,7 @@ namespace mcf {
 nlohmann::json mesh_info(const std::string& spec, const std::string& write_to,
                          const MeshLoadOptions& options = {});
 
+/// The same description of a mesh already loaded (a mesh given as arrays too).
+nlohmann::json mesh_description(const MeshSource& mesh);
+
 }  // namespace mcf

@@ -108,6 +108,28 @@ py::tuple load_mesh(const std::string& spec, py::handle config, const py::kwargs
   return py::make_tuple(to_numpy(mesh->vertices()), to_numpy(mesh->faces()));
 }
 
+py::object mesh_info(py::handle V, py::handle F, py::handle config, const py::kwargs& options) {
+  Options o = options_from(options, config, py::none(), "mcfbench.mesh_info");
+  std::optional<Mesh> mesh = mesh_from(V, F, o);
+  std::string report;
+  {
+    py::gil_scoped_release nogil;
+    if (!mesh) {
+      std::string spec;
+      std::erase_if(o.settings, [&](const auto& s) {
+        if (s.first != "mesh") return false;
+        if (const auto* text = std::get_if<std::string>(&s.second.value)) spec = *text;
+        return true;
+      });
+      if (spec.empty())
+        throw InputError("mcfbench.mesh_info: give V and F, or a mesh spec as mesh=...");
+      mesh = Mesh::load(spec, o);
+    }
+    report = mesh->report_json();
+  }
+  return from_json(report);
+}
+
 /// Registered solvers' factories, by name: module attribute _solver_factories, so that the
 /// Python objects live and die with the module, not with the library's static table.
 py::dict factories() {
@@ -227,7 +249,8 @@ PYBIND11_MODULE(mcfbench, m) {
       "register_solver(name, factory): a solver written in Python, for flows and studies\n"
       "run(config, out): an experiment config's cells, as `mcfbench run` runs them\n"
       "results(folder): a results folder as a pandas DataFrame, one row per cell\n"
-      "load_mesh(spec): a mesh as a flow loads it; flow_options(): every option\n";
+      "load_mesh(spec), mesh_info(...): a mesh as a flow loads it, and its report\n"
+      "flow_options(): every option of flow\n";
   m.attr("_solver_factories") = py::dict();
 
   py::register_exception_translator([](std::exception_ptr p) {
@@ -292,6 +315,14 @@ PYBIND11_MODULE(mcfbench, m) {
         "load_mesh(spec, *, config=None, **options) -> (V, F)\n\n"
         "A mesh spec loaded and validated as a flow with these options loads it: files and\n"
         "catalogue models scaled into the unit cube, faces oriented consistently.");
+
+  m.def("mesh_info", &mesh_info, "V"_a = py::none(), "F"_a = py::none(), py::kw_only(),
+        "config"_a = py::none(),
+        "mesh_info(V=None, F=None, *, config=None, **options) -> dict\n\n"
+        "What `mcfbench mesh-info` prints of a mesh (arrays V, F, or mesh=SPEC), loaded and\n"
+        "validated as a flow with these options loads it: vertices, faces, boundary_loops,\n"
+        "connected_components, genus, area, bbox_min, bbox_max, reoriented_faces, ..., and\n"
+        "notes where loading changed something.");
 
   m.def("register_solver", &register_solver, "name"_a, "factory"_a, py::kw_only(),
         "iterative"_a = false, "help"_a = "",

@@ -38,8 +38,9 @@ class MCFBENCH_API Mesh {
   const Vertices& vertices() const;  ///< n x 3, as loaded (scaled, reoriented, repaired)
   const Faces& faces() const;        ///< m x 3
   const std::string& spec() const;   ///< the spec, or the arrays' name
-  /// What loading found, as JSON text: result.json's "mesh" (vertices, faces, boundary_loops,
-  /// components, genus, area, reoriented_faces, ...; "notes" when loading changed something).
+  /// What loading found, as JSON text: what `mcfbench mesh-info` prints (vertices, faces,
+  /// boundary_loops, connected_components, genus, area, bbox_min, bbox_max, reoriented_faces,
+  /// ...; "notes" when loading changed something).
   std::string report_json() const;
 
   struct Impl;

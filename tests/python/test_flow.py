@@ -218,3 +218,16 @@ def test_help_lists_every_option_of_the_command_line():
         assert "    " + o["name"] + " (" in doc, o["name"]
     names = {o["name"] for o in mcfbench.flow_options()}
     assert {"mesh", "dt", "steps", "solver", "cycles", "normalize_area", "frozen"} <= names
+
+
+def test_mesh_info_is_the_command_lines_report(mcfbench_binary):
+    cli = json.loads(run_cli(mcfbench_binary, "mesh-info", "cgal:cow").stdout)
+    assert mcfbench.mesh_info(mesh="cgal:cow") == cli
+    V, F = tetrahedron()
+    F = F.copy()
+    F[3] = F[3, ::-1]
+    report = mcfbench.mesh_info(V, F)
+    assert report["spec"] == "arrays" and report["kind"] == "arrays"
+    assert (report["vertices"], report["faces"], report["genus"]) == (4, 4, 0)
+    assert report["reoriented_faces"] == 1 and "reoriented 1 of 4 faces" in report["notes"][0]
+    assert report["bbox_max"] == [1.0, 1.0, 1.0]  # arrays keep their frame
