@@ -41,6 +41,22 @@ auto translated(F&& f) -> decltype(f());
 /// Held while a flow or a study runs: their thread counts are process-wide settings.
 std::mutex& run_lock();
 
+/// One flow or study at a time: waits for another thread's to end. A call from inside a running
+/// one (its step callback or solver) would wait for itself: that is an InputError naming `what`.
+class RunScope {
+ public:
+  explicit RunScope(const std::string& what);
+  ~RunScope();
+  RunScope(const RunScope&) = delete;
+  RunScope& operator=(const RunScope&) = delete;
+
+  /// Whether this thread is inside a flow or study.
+  static bool inside();
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
 [[noreturn]] void rethrow_as_input_error();
 
 template <class F>

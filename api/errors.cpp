@@ -31,5 +31,26 @@ std::mutex& run_lock() {
   return lock;
 }
 
+namespace {
+thread_local bool running_here = false;
+}  // namespace
+
+RunScope::RunScope(const std::string& what) {
+  if (running_here)
+    throw InputError(what +
+                     ": called from inside a running flow or study (its callback or a "
+                     "registered solver); one runs at a time per process");
+  lock_ = std::unique_lock<std::mutex>(run_lock());
+  running_here = true;
+}
+
+RunScope::~RunScope() {
+  running_here = false;
+}
+
+bool RunScope::inside() {
+  return running_here;
+}
+
 }  // namespace detail
 }  // namespace mcfbench

@@ -82,7 +82,7 @@ mcf::MemoryBudget budget_of(const Options& options) {
 }  // namespace
 
 FlowResult flow(const Options& options, const StepCallback& on_step) {
-  const std::lock_guard<std::mutex> one_at_a_time(detail::run_lock());
+  const detail::RunScope one_at_a_time(options.name);
   mcf::FlowConfig config;
   mcf::MemoryBudget budget;
   mcf::MeshSource mesh;
@@ -100,7 +100,7 @@ FlowResult flow(const Options& options, const StepCallback& on_step) {
 }
 
 FlowResult flow(const Mesh& mesh, const Options& options, const StepCallback& on_step) {
-  const std::lock_guard<std::mutex> one_at_a_time(detail::run_lock());
+  const detail::RunScope one_at_a_time(options.name);
   mcf::FlowConfig config;
   mcf::MemoryBudget budget;
   detail::translated([&] {

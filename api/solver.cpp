@@ -136,10 +136,10 @@ void register_solver(SolverDefinition definition) {
   if (definition.name.empty()) throw InputError("register_solver: the solver needs a name");
   if (!definition.factory) throw InputError("register_solver: " + definition.name + ": no factory");
   // The solver table is read without a lock while a flow runs: it changes only between runs.
-  std::unique_lock<std::mutex> quiet(detail::run_lock(), std::try_to_lock);
-  if (!quiet.owns_lock())
+  if (detail::RunScope::inside())
     throw InputError("register_solver: " + definition.name +
-                     ": a flow or study is running; register solvers before it starts");
+                     ": called from inside a running flow or study; register solvers before");
+  const std::lock_guard<std::mutex> quiet(detail::run_lock());  // another thread's run ends first
   Definitions& d = definitions();
   const std::lock_guard<std::mutex> hold(d.lock);
   const std::string name = definition.name;

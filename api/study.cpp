@@ -57,7 +57,7 @@ void leaves(const json& j, const std::string& prefix, std::map<std::string, Valu
 int run(const std::string& config, const RunOptions& options) {
   if (options.out.empty())
     throw InputError("run: " + config + ": the results folder (out) is required");
-  const std::lock_guard<std::mutex> one_at_a_time(detail::run_lock());
+  const detail::RunScope one_at_a_time("run: " + config);
   mcf::RunRequest request;
   request.config = config;
   request.out = options.out;

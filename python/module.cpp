@@ -168,8 +168,10 @@ void register_solver(const std::string& name, py::object factory, bool iterative
       X = std::move(solution);
     };
   };
-  mcfbench::register_solver(std::move(d));
+  // The factory first: a flow that starts once the row is there finds it.
   factories()[py::str(name)] = factory;
+  py::gil_scoped_release nogil;  // waits for a flow another thread runs, whose callbacks need it
+  mcfbench::register_solver(std::move(d));
 }
 
 std::string run(const std::string& config, const std::string& out, bool quick,

@@ -231,3 +231,13 @@ def test_mesh_info_is_the_command_lines_report(mcfbench_binary):
     assert (report["vertices"], report["faces"], report["genus"]) == (4, 4, 0)
     assert report["reoriented_faces"] == 1 and "reoriented 1 of 4 faces" in report["notes"][0]
     assert report["bbox_max"] == [1.0, 1.0, 1.0]  # arrays keep their frame
+
+
+def test_a_flow_started_inside_a_running_flow_is_refused():
+    def callback(step, t, V):
+        mcfbench.flow(mesh="icosphere:level=1", steps=1)
+
+    with pytest.raises(ValueError, match="called from inside a running flow"):
+        mcfbench.flow(mesh="icosphere:level=1", steps=2, callback=callback)
+    # The lock was let go: the next flow runs.
+    assert mcfbench.flow(mesh="icosphere:level=1", steps=1).result["status"] == "ok"
