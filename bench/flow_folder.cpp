@@ -1,5 +1,8 @@
 #include "bench/flow_folder.h"
 
+#include "distributed/comm.h"
+#include "distributed/distributed_flow.h"
+#include "flows/memory_estimate.h"
 #include "flows/registry.h"
 #include "flows/solver_registry.h"
 #include "solvers/petsc_runtime.h"
@@ -18,6 +21,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -97,6 +101,127 @@ void publish(const fs::path& out, const fs::path& staging, const std::set<std::s
   fs::remove_all(staging);
 }
 
+/// Creates OUT's staging folder (and OUT where it is missing); `created` says whether OUT was.
+fs::path make_staging(const fs::path& out, bool& created) {
+  created = !fs::exists(out);
+  const fs::path staging = out / kStagingFolder;
+  std::error_code ec;
+  fs::remove_all(staging, ec);  // a killed run's
+  if (!ec) fs::create_directories(staging, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    if (created) fs::remove_all(out, ec);
+    throw std::runtime_error(staging.string() + ": cannot create the staging folder: " + why);
+  }
+  return staging;
+}
+
+/// A rank's share of a flow's memory estimate: the mesh's, the basis's and the solver's parts
+/// divided over the ranks, plus on rank 0 the mesh as read and what it keeps for the output
+/// (its vertices and faces, 48 bytes a vertex of a closed mesh).
+MemoryEstimate rank_share(MemoryEstimate e, int ranks) {
+  e.mesh_bytes = e.mesh_bytes / ranks + 48.0 * e.vertices;
+  e.basis_bytes /= ranks;
+  e.solver_bytes /= ranks;
+  return e;
+}
+
+/// `mcfbench flow` under mpirun -n P: rank 0 checks the memory, reads the mesh and owns the
+/// output folder; every rank runs its share of the flow. A failure before the flow (a missing
+/// file, a mesh the flow refuses, memory) is rank 0's to report: the other ranks exit with it
+/// silently (dist::RankFailure).
+int run_distributed_into_folder(const FlowConfig& config, const FlowRequest& request) {
+  // PETSc's options checked by a trial solve on every rank, before anything is read or written
+  // (solvers/petsc_solver.h): the same error on every rank, said once (tools/main.cpp).
+  if (config.solver.name == "petsc") make_solver(config.solver);
+  const int me = dist::rank(), P = dist::ranks();
+  MeshSource mesh;
+  MemoryBudget budget;
+  MemoryEstimate memory;
+  double line_seconds = 0;
+  fs::path out(request.out), staging;
+  bool created = false;
+  std::exception_ptr failure;
+  std::string message;
+  if (me == 0) {
+    try {
+      budget = memory_budget(request.max_memory);
+      checked_memory_estimate(config, spec_sizes(parse_mesh_spec(config.mesh)), budget,
+                              config.mesh);
+      mesh = load_mesh_spec(config.mesh, mesh_load_options(config));
+      for (const std::string& note : mesh.notes)
+        std::fprintf(stderr, "mcfbench flow: %s: %s\n", config.mesh.c_str(), note.c_str());
+      validate_flow_mesh(config, mesh.report, config.mesh);
+      memory = rank_share(estimate_flow_memory(config, mesh_sizes(config, mesh.mesh, mesh.analytic),
+                                               resident_memory_bytes()),
+                          P);
+      check_memory(memory, budget, config, config.mesh);
+      line_seconds = progress_line_seconds();
+      staging = make_staging(out, created);
+    } catch (const std::exception& e) {
+      failure = std::current_exception();
+      message = e.what();
+    }
+  }
+  if (!dist::broadcast_message(message).empty()) {
+    if (failure) std::rethrow_exception(failure);
+    throw dist::RankFailure("rank 0 could not start the flow");
+  }
+  std::set<std::string> frames;
+  FlowOutcome outcome;
+  const ResultRecorder recorder(/*peak_of_this_flow=*/false);
+  const StopSignals signals;
+  std::optional<Progress> progress;
+  if (me == 0) progress.emplace("step", config.steps, line_seconds);
+  dist::DistributedObserver observer;
+  observer.wants_vertices = [&](int step) {
+    return config.save_every > 0 && step % config.save_every == 0;
+  };
+  observer.on_step = [&](int step, double, const Positions* V) {
+    if (const int signal = StopSignals::received()) {
+      progress->clear();
+      throw FlowInterrupted{signal, step};
+    }
+    progress->update(step);
+    if (V) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05d.ply", step);
+      write_mesh((staging / name).string(), TriangleMesh{*V, mesh.mesh.faces}, true,
+                 FaceCheck::trusted);
+      frames.insert(name);
+    }
+  };
+  std::error_code ec;
+  try {
+    outcome = dist::run_distributed_flow(config, me == 0 ? &mesh : nullptr, observer);
+    if (me != 0) return 0;
+    progress->finish();
+    nlohmann::json estimate = memory.to_json();
+    estimate["ranks"] = P;
+    estimate["scope"] = "rank 0's share";
+    recorder.complete(outcome.result, config.threads, estimate, budget);
+    outcome.result["peak_memory_scope"] = "rank 0 of " + std::to_string(P);
+    write_mesh((staging / "final.ply").string(), outcome.final_mesh, true, FaceCheck::trusted);
+    write_file_atomic((staging / "result.json").string(), outcome.result.dump(1) + "\n");
+  } catch (const FlowInterrupted& stop) {
+    fs::remove_all(created ? out : staging, ec);
+    std::fprintf(stderr, "mcfbench flow: stopped by %s after step %d of %d; %s\n",
+                 signal_name(stop.signal).c_str(), stop.step, config.steps,
+                 created ? ("nothing written (" + out.string() + " removed)").c_str()
+                         : (out.string() + " holds what it held before").c_str());
+    return 128 + stop.signal;
+  } catch (...) {
+    if (me == 0) fs::remove_all(created ? out : staging, ec);
+    throw;
+  }
+  publish(out, staging, frames);
+  const auto& stop = outcome.result["stop"];
+  std::fprintf(stderr, "mcfbench flow: %s after %d steps (%s) on %d ranks; wrote %s\n",
+               outcome.result["status"].get<std::string>().c_str(), stop["step"].get<int>(),
+               stop["reason"].get<std::string>().c_str(), P, (out / "result.json").c_str());
+  return 0;
+}
+
 }  // namespace
 
 int run_flow_into_folder(const FlowRequest& request) {
@@ -110,25 +235,15 @@ int run_flow_into_folder(const FlowRequest& request) {
                       std::to_string(launched_ranks()) + "; start it as mpirun -n " +
                       std::to_string(config.mpi_ranks) + " mcfbench flow ..., or as a cell of " +
                       "mcfbench run, which does");
+  // Under mpirun the flow is divided across the ranks (distributed/distributed_flow.h).
+  if (launched_ranks() > 1) {
+    if (const std::string why = dist::distributed_refusal(config, launched_ranks()); !why.empty())
+      throw ConfigError(why);
+    return run_distributed_into_folder(config, request);
+  }
   // PETSc's options are checked (a trial solve, solvers/petsc_solver.h), and a build without
   // PETSc refuses, before anything is read or written.
-  const bool distributed = solver_row(config.solver.name).distributed;
-  if (distributed) make_solver(config.solver);
-  // Under mpirun every rank runs the whole flow and only PETSc's solves are shared
-  // (docs/petsc.md, "Across MPI ranks"); any other solver would run the same flow P times into
-  // one folder.
-  if (!distributed && launched_ranks() > 1)
-    throw ConfigError("solver.name: \"" + config.solver.name +
-                      "\" runs in one process; only "
-                      "\"petsc\" runs across the " +
-                      std::to_string(launched_ranks()) + " ranks mpirun started");
-  // Ranks other than 0 run the same flow, so that every collective solve has all its ranks,
-  // and write nothing.
-  if (distributed && PetscRuntime::instance().rank() != 0) {
-    const MeshSource mesh = load_mesh_spec(config.mesh, mesh_load_options(config));
-    run_flow(config, mesh);
-    return 0;
-  }
+  if (config.solver.name == "petsc") make_solver(config.solver);
   const MemoryBudget budget = memory_budget(request.max_memory);
   // Before the mesh is generated or read (a generator's size is known from its spec), then with
   // the mesh's own sizes before the basis is built.
@@ -146,16 +261,9 @@ int run_flow_into_folder(const FlowRequest& request) {
   // `--cube unit` on a mesh outside the unit cube, a full disk): no empty folder or partial
   // frames left.
   // In a folder that exists, only the staging folder is this run's until the flow is done.
-  const bool created = !fs::exists(out);
-  const fs::path staging = out / kStagingFolder;
+  bool created = false;
+  const fs::path staging = make_staging(out, created);
   std::error_code ec;
-  fs::remove_all(staging, ec);  // a killed run's
-  if (!ec) fs::create_directories(staging, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    if (created) fs::remove_all(out, ec);
-    throw std::runtime_error(staging.string() + ": cannot create the staging folder: " + why);
-  }
   std::set<std::string> frames;
   FlowOutcome outcome;
   // The process runs this one flow: its peak is the flow's (with the mesh's loading).

@@ -155,8 +155,7 @@ bool any_rank(bool flag) {
 
 std::vector<double> all_values(double value) {
   std::vector<double> out(static_cast<std::size_t>(ranks()));
-  check(MPI_Allgather(&value, 1, MPI_DOUBLE, out.data(), 1, MPI_DOUBLE, world()),
-        "MPI_Allgather");
+  check(MPI_Allgather(&value, 1, MPI_DOUBLE, out.data(), 1, MPI_DOUBLE, world()), "MPI_Allgather");
   return out;
 }
 
@@ -172,16 +171,16 @@ std::vector<std::uint8_t> broadcast_bytes(const std::vector<std::uint8_t>& bytes
   check(MPI_Bcast(&n, 1, MPI_INT64_T, 0, world()), "MPI_Bcast");
   std::vector<std::uint8_t> out = rank() == 0 ? bytes : std::vector<std::uint8_t>(std::size_t(n));
   for (std::size_t at = 0; at < out.size(); at += kPiece)
-    check(MPI_Bcast(out.data() + at, int(std::min(kPiece, out.size() - at)), MPI_UINT8_T, 0,
-                    world()),
-          "MPI_Bcast");
+    check(
+        MPI_Bcast(out.data() + at, int(std::min(kPiece, out.size() - at)), MPI_UINT8_T, 0, world()),
+        "MPI_Bcast");
   return out;
 }
 
 std::string broadcast_message(const std::string& message) {
-  const std::vector<std::uint8_t> bytes = broadcast_bytes(
-      rank() == 0 ? std::vector<std::uint8_t>(message.begin(), message.end())
-                  : std::vector<std::uint8_t>{});
+  const std::vector<std::uint8_t> bytes =
+      broadcast_bytes(rank() == 0 ? std::vector<std::uint8_t>(message.begin(), message.end())
+                                  : std::vector<std::uint8_t>{});
   return std::string(bytes.begin(), bytes.end());
 }
 

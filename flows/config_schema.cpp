@@ -109,8 +109,10 @@ std::vector<OptionSpec> tail_options() {
                             1, 4096);
   ranks.recorded = Recorded::when_set;
   ranks.refused_elsewhere = true;
-  ranks.owner_text = "a solver that runs across MPI ranks (petsc)";
-  ranks.selected = [](const FlowConfig& c) { return solver_row(c.solver.name).distributed; };
+  ranks.owner_text =
+      "a solver that runs across MPI ranks (petsc, multigrid, pcg with the multigrid "
+      "preconditioner)";
+  ranks.selected = [](const FlowConfig& c) { return runs_across_ranks(c.solver); };
   OptionSpec blas = ranged(bind(
                                option("blas_threads", OptionType::integer, 0, "--blas-threads",
                                       "OpenBLAS threads under CHOLMOD: auto (one below 20000 "

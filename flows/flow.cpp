@@ -210,6 +210,8 @@ double difference_norm(const Eigen::MatrixX3d& A, const Eigen::MatrixX3d& B) {
       }));
 }
 
+}  // namespace
+
 nlohmann::json mesh_json(const MeshSource& source) {
   const MeshReport& rep = source.report;
   return {{"spec", source.spec},
@@ -225,6 +227,8 @@ nlohmann::json mesh_json(const MeshSource& source) {
           {"repaired_faces", rep.repaired_faces},
           {"degenerate_faces", rep.degenerate_faces}};
 }
+
+namespace {
 
 /// x -> (x - centroid) * scale, row by row (in parallel over row chunks).
 void apply(const Normalization& n, Coefficients& x) {

@@ -29,6 +29,9 @@ struct FlowOutcome {
 FlowOutcome run_flow(const FlowConfig& config, const MeshSource& source,
                      const FlowObserver& observer = {});
 
+/// result.json's "mesh": the spec and the loaded mesh's validation report.
+nlohmann::json mesh_json(const MeshSource& source);
+
 /// Scales the mesh to unit area about its area-weighted centroid, moved to the origin:
 /// returns (scale, centroid) so the same map can be applied to coefficients (B-splines
 /// reproduce affine maps, so x ↦ s (x - c) maps the surface the same way).

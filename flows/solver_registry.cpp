@@ -107,7 +107,7 @@ NamedTable<SolverRow> built_in() {
                         "0 = never"),
                  [](auto& c) -> auto& { return c.solver.direct_after; }),
              0, 1000000)};
-  multigrid.iterative = multigrid.needs_hierarchy = true;
+  multigrid.iterative = multigrid.needs_hierarchy = multigrid.distributed = true;
   multigrid.default_tolerance = 0;  // run `cycles` cycles
   SolverRow petsc{"petsc", "PETSc's KSP, default CG + GAMG (docs/petsc.md)", make_petsc,
                   [](const SolverConfig&, const SystemFigures& s) {
@@ -243,6 +243,11 @@ bool needs_hierarchy(const SolverConfig& config) {
   const SolverRow& row = solver_row(config.name);
   return row.needs_hierarchy ||
          (row.uses_preconditioner && preconditioner_row(config.preconditioner).needs_hierarchy);
+}
+
+bool runs_across_ranks(const SolverConfig& config) {
+  const SolverRow& row = solver_row(config.name);
+  return row.distributed || (row.uses_preconditioner && config.preconditioner == "multigrid");
 }
 
 MultigridOptions multigrid_options(const SolverConfig& c) {

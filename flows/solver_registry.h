@@ -67,6 +67,9 @@ const SolverRow& solver_row(const std::string& name);
 const std::vector<OptionSpec>& solver_options();
 /// Whether the config's solver (or its preconditioner) needs the basis's geometric hierarchy.
 bool needs_hierarchy(const SolverConfig& config);
+/// Whether the config's solver runs one flow divided across MPI ranks (distributed/): a row
+/// marked `distributed` (petsc, multigrid), or CG with the multigrid preconditioner.
+bool runs_across_ranks(const SolverConfig& config);
 /// The multigrid cycle the config describes (the multigrid solver's and preconditioner's).
 MultigridOptions multigrid_options(const SolverConfig& config);
 

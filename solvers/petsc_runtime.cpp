@@ -24,6 +24,15 @@ int launched_ranks() {
   return 1;
 }
 
+int launched_rank() {
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMI_RANK"})
+    if (const char* value = std::getenv(name)) {
+      const int n = std::atoi(value);
+      if (n >= 0) return n;
+    }
+  return 0;
+}
+
 #ifndef MCFBENCH_HAVE_PETSC
 
 bool petsc_available() {

@@ -58,6 +58,9 @@ class PetscRuntime {
 /// The number of processes the MPI launcher started, read from its environment before MPI is
 /// started (Open MPI's OMPI_COMM_WORLD_SIZE, MPICH's and Slurm's PMI_SIZE); 1 without a launcher.
 int launched_ranks();
+/// This process's rank as the launcher numbered it (OMPI_COMM_WORLD_RANK, PMI_RANK); 0 without
+/// a launcher. Read before MPI starts (to print an error once, from rank 0).
+int launched_rank();
 
 /// Turns a PETSc error code into a PetscFailure naming `what` and PETSc's message (no-op on 0).
 void petsc_check(int code, const char* what);

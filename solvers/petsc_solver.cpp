@@ -28,11 +28,8 @@ SolveReport failed_report(std::string message) {
   return r;
 }
 
-#ifdef MCFBENCH_HAVE_PETSC
-/// The options every PETSc solver starts from, before the user's: CG, GAMG keeping its
-/// interpolation while the pattern stays, the warm start used. CG is then set to test the true
-/// (unpreconditioned) residual unless -ksp_norm_type is given, so that the tolerance means
-/// ||b - A x|| / ||b|| as for the other solvers.
+}  // namespace
+
 std::string petsc_default_options(double relative_tolerance, int max_iterations) {
   char numbers[96];
   std::snprintf(numbers, sizeof numbers, "-ksp_rtol %.17g -ksp_max_it %d", relative_tolerance,
@@ -50,9 +47,6 @@ std::string petsc_default_options(double relative_tolerance, int max_iterations)
              "-ksp_initial_guess_nonzero true ") +
          numbers;
 }
-#endif
-
-}  // namespace
 
 #ifndef MCFBENCH_HAVE_PETSC
 

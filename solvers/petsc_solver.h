@@ -36,6 +36,13 @@ struct PetscSolverOptions {
   int max_iterations = 3000;          ///< -ksp_max_it of the defaults
 };
 
+/// The options every PETSc solver starts from, before the user's: CG, GAMG keeping its
+/// interpolation while the pattern stays, Richardson with symmetric SOR on its levels, the warm
+/// start used, and the tolerance and iteration cap. CG is then set to test the true
+/// (unpreconditioned) residual unless -ksp_norm_type is given, so that the tolerance means
+/// ||b - A x|| / ||b|| as for the other solvers.
+std::string petsc_default_options(double relative_tolerance, int max_iterations);
+
 class PetscSolver final : public LinearSolver {
  public:
   /// Starts PETSc (PetscRuntime) and checks the options before any flow uses them: a KSP with

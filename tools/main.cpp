@@ -2,8 +2,13 @@
 
 #include "tools/commands.h"
 
+#include "distributed/comm.h"
+#include "flows/config_reader.h"
+#include "solvers/petsc_runtime.h"
+
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
 #include <string>
 
 int main(int argc, char** argv) {
@@ -48,8 +53,15 @@ int main(int argc, char** argv) {
   }
   try {
     return run ? run() : 0;
+  } catch (const mcf::dist::RankFailure&) {
+    return 1;  // rank 0 has said why (distributed/comm.h)
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "mcfbench: error: %s\n", e.what());
+    // Under mpirun every rank reads the same config and meets the same error in it: rank 0
+    // alone says so, so that a bad input gives one message.
+    const bool everyone = dynamic_cast<const mcf::ConfigError*>(&e) != nullptr ||
+                          dynamic_cast<const std::invalid_argument*>(&e) != nullptr;
+    if (!everyone || mcf::launched_rank() == 0)
+      std::fprintf(stderr, "mcfbench: error: %s\n", e.what());
     return 1;
   }
 }

@@ -1,10 +1,17 @@
 #!/usr/bin/env bash
-# One flow's PETSc solves across two MPI ranks (docs/petsc.md, "Across MPI ranks"):
-# `mpirun -n 2 mcfbench flow ... --solver petsc` writes one result whose final surface matches the
-# same flow run without mpirun to 1e-8 of the bounding box's diagonal, records two ranks, and
-# leaves no second output, and holds about half of the matrix and of GAMG's hierarchy on each rank; a
-# solver other than petsc under mpirun is refused, writing nothing; a flow asking for 2 ranks without
-# them is refused; a study cell with mpi_ranks 2 runs under mpirun started by `mcfbench run`.
+# One flow divided across MPI ranks (distributed/, docs/petsc.md "Across MPI ranks"):
+# - `mpirun -n 1, 2, 4 mcfbench flow` on the hat basis (one rank: the one-process flow) — MCF on a sphere and cMCF with unit area
+#   on a scanned model, with PETSc's CG + GAMG, the distributed surface multigrid and CG
+#   preconditioned by its cycle, each at a tight tolerance — ends within 1e-8 of the bounding
+#   box's diagonal of the one-process CHOLMOD flow; so do a fixed boundary (an open cylinder), the
+#   lumped mass, BDF2 and Taylor-2, and the frames written under ranks;
+# - result.json records the ranks, the partitioner, per rank its owned and ghost vertices (the
+#   owned ones adding up to the mesh's), its peak memory, and per phase the slowest rank and the
+#   imbalance; the fixed cycles of the multigrid are converged only at their residual bound;
+# - bad input fails on every rank with one message and no output: a missing file, the octree
+#   basis, a solver that runs in one process, an option PETSc refuses; a flow asking for 2 ranks
+#   without them is refused;
+# - a study cell with mpi_ranks 2 runs under the mpirun `mcfbench run` starts.
 #
 # usage: test_mpi_flow.sh MCFBENCH
 #
@@ -17,58 +24,148 @@ command -v mpirun >/dev/null 2>&1 || { echo "skipped: no mpirun (apt-get install
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-flow=(flow --mesh sphere:vertices=3000 --solver petsc --threads 1 --dt 1e-3 --steps 3)
-if ! "$mcfbench" "${flow[@]}" --out "$work/serial" 2>"$work/serial.log"; then
-  if grep -q "built without PETSc" "$work/serial.log"; then echo "skipped: built without PETSc"; exit 77; fi
-  cat "$work/serial.log"; echo "FAIL: the serial flow failed"; exit 1
-fi
 fail() { echo "FAIL: $*"; exit 1; }
-mpirun -n 2 "$mcfbench" "${flow[@]}" --out "$work/mpi" >"$work/mpi.log" 2>&1 ||
-  { cat "$work/mpi.log"; fail "mpirun -n 2 failed"; }
-[ -f "$work/mpi/result.json" ] || fail "no result.json from the MPI run"
-[ "$(ls "$work" | sort | tr '\n' ' ')" = "mpi mpi.log serial serial.log " ] || fail "other output: $(ls "$work")"
-"$py" - "$work/serial" "$work/mpi" <<'PY' || exit 1
-import json, sys
+if ! "$mcfbench" flow --mesh sphere:vertices=500 --solver petsc --threads 1 --steps 1 \
+    --out "$work/probe" >"$work/probe.log" 2>&1; then
+  if grep -q "built without PETSc" "$work/probe.log"; then echo "skipped: built without PETSc"; exit 77; fi
+  cat "$work/probe.log"; fail "a one-process PETSc flow failed"
+fi
+
+# compare.py EXACT DIVIDED RANKS: final.ply (and frames) vertex by vertex, and the records.
+cat >"$work/compare.py" <<'PY'
+import glob, json, os, sys
 import numpy as np
-def read(p):
-    d = open(p + "/final.ply", "rb").read()
+def read(path):
+    d = open(path, "rb").read()
     h = d.index(b"end_header\n") + len(b"end_header\n")
     n = int([l for l in d[:h].decode().split("\n") if l.startswith("element vertex")][0].split()[-1])
     return np.frombuffer(d[h:h + 24 * n], dtype="<f8").reshape(n, 3)
-a, b = read(sys.argv[1]), read(sys.argv[2])
+exact, divided, ranks = sys.argv[1], sys.argv[2], int(sys.argv[3])
+a = read(exact + "/final.ply")
 diag = np.linalg.norm(a.max(0) - a.min(0))
-dev = np.abs(a - b).max() / diag
-r = json.load(open(sys.argv[2] + "/result.json"))
-one = json.load(open(sys.argv[1] + "/result.json"))
-ranks = r["solver_settings"]["ranks"]
-ok = dev < 1e-8 and ranks == "2" and r["status"] == "ok"
-# The matrix's storage on one rank: a double and a 32- or 64-bit index per entry, an offset per
-# row. The hat basis on a closed genus-0 mesh has a row per vertex and an entry per vertex and per
-# edge end, n + 2 (3n - 6) (Euler). Two ranks hold about half of it each.
-n = one["system"]["dimension"]
-nnz = 7 * n - 12
-serial_bytes = int(one["solver_settings"]["matrix_bytes_per_rank"])
-layouts = [nnz * (8 + w) + (n + 1) * w for w in (4, 8)]
-ok = ok and serial_bytes in layouts
-ratio = int(r["solver_settings"]["matrix_bytes_per_rank"]) / serial_bytes
-ok = ok and 0.45 <= ratio <= 0.6
-pc_one = int(one["solver_settings"]["preconditioner_bytes_per_rank"])
-pc_ratio = int(r["solver_settings"]["preconditioner_bytes_per_rank"]) / pc_one
-ok = ok and pc_one > 0 and pc_ratio <= 0.75
-print("matrix storage per rank: %d bytes on one rank (layouts %s), 2 ranks %.3f of it; "
-      "GAMG's hierarchy per rank, 2 ranks %.3f of one's" % (serial_bytes, layouts, ratio, pc_ratio))
-for step in r["steps"]:
-    ok = ok and step["solver"]["status"] == "converged" and step["solver"]["relative_residual"] <= 1e-10
-print("mpi vs serial: %.3g of the diagonal, ranks %s, status %s" % (dev, ranks, r["status"]))
-sys.exit(0 if ok else 1)
+dev = np.abs(a - read(divided + "/final.ply")).max() / diag
+frames = sorted(os.path.basename(f) for f in glob.glob(divided + "/frame_*.ply"))
+for f in frames:
+    dev = max(dev, np.abs(read(exact + "/" + f) - read(divided + "/" + f)).max() / diag)
+r = json.load(open(divided + "/result.json"))
+problems = []
+if ranks == 1:  # mpirun -n 1 runs the one-process flow
+    print("%s in one process: %.3g of the diagonal" % (os.path.basename(divided), dev))
+    sys.exit(0 if dev < 1e-8 and r["status"] == "ok" else 1)
+d = r["distribution"]
+if dev >= 1e-8: problems.append("%.3g of the diagonal from the one-process CHOLMOD flow" % dev)
+if r["status"] != "ok": problems.append("status " + r["status"])
+if d["ranks"] != ranks or len(d["owned_vertices"]) != ranks: problems.append("ranks %s" % d["ranks"])
+if sum(d["owned_vertices"]) != r["system"]["dimension"]: problems.append("owned vertices %s" % d["owned_vertices"])
+if ranks > 1 and min(d["ghost_vertices"]) <= 0: problems.append("no ghosts %s" % d["ghost_vertices"])
+if len(d["peak_memory_bytes"]) != ranks or min(d["peak_memory_bytes"]) <= 0: problems.append("peak memory")
+for phase in ("setup", "update", "solve", "steps"):
+    p = d["phase_seconds"][phase]
+    if not (p["max"] >= p["mean"] >= 0 and p["imbalance"] >= 1): problems.append("phase " + phase)
+if ranks > 1 and d["partitioner"] not in ("ptscotch", "blocks of the bandwidth ordering"):
+    problems.append("partitioner " + d["partitioner"])
+for s in r["steps"]:
+    if s["solver"]["status"] != "converged": problems.append("step %d %s" % (s["step"], s["solver"]["status"]))
+print("%s on %d ranks: %.3g of the diagonal, %d frames, owned %s, ghosts %s, partitioner %s" % (
+    os.path.basename(divided), ranks, dev, len(frames), d["owned_vertices"], d["ghost_vertices"],
+    d["partitioner"]))
+if problems: print("  problems: " + "; ".join(problems))
+sys.exit(1 if problems else 0)
 PY
-mpirun -n 2 "$mcfbench" flow --mesh sphere:vertices=500 --threads 1 --steps 1 --out "$work/cholmod" \
-  >"$work/cholmod.log" 2>&1 && fail "cholmod under mpirun -n 2 was not refused"
-grep -q 'only "petsc" runs across the 2 ranks' "$work/cholmod.log" || fail "no refusal message: $(cat "$work/cholmod.log")"
-[ ! -e "$work/cholmod" ] || fail "the refused run wrote $work/cholmod"
+
+# case NAME FLOW-FLAGS...: the one-process CHOLMOD flow, then each solver on 1, 2 and 4 ranks.
+case_() {
+  local name=$1
+  shift
+  "$mcfbench" flow "$@" --solver cholmod --threads 1 --out "$work/$name-exact" >"$work/$name.log" 2>&1 ||
+    { cat "$work/$name.log"; fail "$name: the one-process flow failed"; }
+  local solver ranks
+  for solver in "petsc" "multigrid --cycle V --smooth 2 --tolerance 1e-12 --cycles 100" \
+      "pcg --preconditioner multigrid --cycle V --smooth 2 --tolerance 1e-12"; do
+    for ranks in 1 2 4; do
+      # shellcheck disable=SC2086
+      mpirun -n "$ranks" "$mcfbench" flow "$@" --solver $solver --threads 1 \
+        --out "$work/$name-$ranks" >"$work/$name-$ranks.log" 2>&1 ||
+        { cat "$work/$name-$ranks.log"; fail "$name, $solver, $ranks ranks: the flow failed"; }
+      "$py" "$work/compare.py" "$work/$name-exact" "$work/$name-$ranks" "$ranks" ||
+        fail "$name, $solver, $ranks ranks"
+    done
+  done
+}
+tight=(--tolerance 1e-12)
+case_ mcf --mesh sphere:vertices=3000 --dt 1e-3 --steps 3 --save-every 3
+case_ cmcf --mesh cgal:elephant --flow cmcf --normalize-area --dt 1e-3 --steps 3
+
+# Fewer combinations: a held boundary, the lumped mass, two integrators; PETSc's CG + GAMG on 2
+# and 4 ranks.
+more() {
+  local name=$1
+  shift
+  "$mcfbench" flow "$@" --solver cholmod --threads 1 --out "$work/$name-exact" >"$work/$name.log" 2>&1 ||
+    { cat "$work/$name.log"; fail "$name: the one-process flow failed"; }
+  for ranks in 2 4; do
+    mpirun -n "$ranks" "$mcfbench" flow "$@" --solver petsc "${tight[@]}" --threads 1 \
+      --out "$work/$name-$ranks" >"$work/$name-$ranks.log" 2>&1 ||
+      { cat "$work/$name-$ranks.log"; fail "$name, $ranks ranks: the flow failed"; }
+    "$py" "$work/compare.py" "$work/$name-exact" "$work/$name-$ranks" "$ranks" || fail "$name, $ranks ranks"
+  done
+}
+more boundary --mesh open_cylinder:radius=0.5,length=2,n_around=48 --dt 1e-3 --steps 3
+more lumped --mesh sphere:vertices=3000 --mass lumped --dt 1e-3 --steps 3
+more bdf2 --mesh cgal:elephant --integrator bdf2 --dt 1e-4 --steps 3
+more taylor2 --mesh sphere:vertices=3000 --integrator taylor2 --dt 1e-5 --steps 3
+"$py" - "$work/boundary-2/result.json" <<'PY' || fail "the boundary's held functions"
+import json, sys
+r = json.load(open(sys.argv[1]))
+held = r["system"]["dimension"] - r["system"]["free_functions"]
+print("open cylinder: %d held functions of %d" % (held, r["system"]["dimension"]))
+sys.exit(0 if held == 2 * 48 else 1)
+PY
+
+# A rerun on the same ranks gives the same bits (the surface multigrid: its hierarchy, PtAP and
+# SOR sweeps are fixed per partition, and PT-Scotch's partition is made the same every run).
+for i in 1 2; do
+  mpirun -n 2 "$mcfbench" flow --mesh cgal:elephant --solver pcg --preconditioner multigrid \
+    --threads 1 --dt 1e-3 --steps 2 --out "$work/again-$i" >"$work/again.log" 2>&1 ||
+    { cat "$work/again.log"; fail "the rerun"; }
+done
+cmp -s "$work/again-1/final.ply" "$work/again-2/final.ply" || fail "two runs on 2 ranks differ"
+echo "a rerun on 2 ranks: the same bits"
+
+# The default fixed cycles (one W(5,5)) across ranks: each step converged at its residual bound.
+mpirun -n 2 "$mcfbench" flow --mesh sphere:vertices=3000 --solver multigrid --threads 1 --dt 1e-3 \
+  --steps 3 --out "$work/cycles" >"$work/cycles.log" 2>&1 || { cat "$work/cycles.log"; fail "fixed cycles"; }
+"$py" - "$work/cycles/result.json" <<'PY' || fail "the fixed cycles' bound"
+import json, sys
+r = json.load(open(sys.argv[1]))
+bound = r["config"]["solver"]["residual_bound"]
+steps = [(s["solver"]["status"], s["solver"]["relative_residual"]) for s in r["steps"]]
+print("fixed cycles on 2 ranks, bound %g: %s, %d levels" % (bound, steps, r["system"]["levels"]))
+sys.exit(0 if r["system"]["levels"] > 1 and all(s == "converged" and x <= bound for s, x in steps) else 1)
+PY
+
+# Bad input: one message, from rank 0, and nothing written.
+refused() {
+  local what=$1 expect=$2
+  shift 2
+  mpirun -n 2 "$mcfbench" flow "$@" --threads 1 --steps 1 --out "$work/refused" >"$work/refused.log" 2>&1 &&
+    fail "$what was not refused"
+  [ "$(grep -c 'mcfbench: error:' "$work/refused.log")" = 1 ] ||
+    fail "$what: not one message: $(grep 'mcfbench: error:' "$work/refused.log")"
+  grep -q "$expect" "$work/refused.log" || fail "$what: no message saying '$expect': $(cat "$work/refused.log")"
+  [ ! -e "$work/refused" ] || fail "$what: the refused run wrote $work/refused"
+  echo "refused under 2 ranks, with one message: $what"
+}
+refused "a missing file" "no-such-file.ply" --mesh "$work/no-such-file.ply" --solver petsc
+refused "the octree basis" 'basis: "octree" runs in one process' --mesh sphere:vertices=500 --basis octree --solver petsc
+refused "CHOLMOD" 'solver.name: "cholmod" runs in one process' --mesh sphere:vertices=500 --solver cholmod
+refused "a KSP type PETSc lacks" "Unable to find requested KSP type" --mesh sphere:vertices=500 \
+  --solver petsc --petsc-options="-ksp_type nonsense"
+refused "an option nothing reads" "PETSc did not use -pc_type_jacobi" --mesh sphere:vertices=500 \
+  --solver petsc --petsc-options="-pc_type_jacobi"
 # A flow that asks for 2 ranks is refused when not started on them, writing nothing.
-"$mcfbench" "${flow[@]}" --mpi-ranks 2 --out "$work/unranked" >"$work/unranked.log" 2>&1 &&
-  fail "--mpi-ranks 2 without mpirun was not refused"
+"$mcfbench" flow --mesh sphere:vertices=500 --solver petsc --threads 1 --mpi-ranks 2 --out "$work/unranked" \
+  >"$work/unranked.log" 2>&1 && fail "--mpi-ranks 2 without mpirun was not refused"
 grep -q 'mpi_ranks: 2 ranks asked for, but this process is one of 1' "$work/unranked.log" ||
   fail "no refusal message: $(cat "$work/unranked.log")"
 [ ! -e "$work/unranked" ] || fail "the refused run wrote $work/unranked"
@@ -88,13 +185,13 @@ import glob, json, sys
 cells = [json.load(open(f)) for f in glob.glob(sys.argv[1] + "/*.json")]
 cells = {c["config"].get("mpi_ranks", 1): c for c in cells if "cell" in c}
 two = cells[2]
-ok = sorted(cells) == [1, 2] and two["status"] == "ok" and two["solver_settings"]["ranks"] == "2"
+ok = sorted(cells) == [1, 2] and two["status"] == "ok" and two["distribution"]["ranks"] == 2
 d = two["reference_distance"][0]
 ok = ok and d["step"] == 3 and d["max"] < 1e-8
 ok = ok and two["peak_memory_scope"] == "rank 0 of mpirun -n 2"
 ok = ok and "sphericity" in two["steps"][-1]["metrics"] and "sphericity" in two["initial_metrics"]
 print("run's 2-rank cell: status %s, ranks %s, max distance to the 1-rank cell at step 3 %.3g, "
-      "peak scope %r" % (two["status"], two["solver_settings"]["ranks"], d["max"], two["peak_memory_scope"]))
+      "peak scope %r" % (two["status"], two["distribution"]["ranks"], d["max"], two["peak_memory_scope"]))
 sys.exit(0 if ok else 1)
 PY
 [ ! -e "$work/ranks/.mpi" ] || [ -z "$(ls -A "$work/ranks/.mpi")" ] || fail "the scratch folder of the 2-rank cell was left"
