@@ -152,6 +152,7 @@ RankMesh scatter_mesh(const TriangleMesh& whole, OutputMap* output) {
   std::vector<std::int64_t> header;  // global vertices, global faces, first_of[0 .. P]
   std::vector<int> part;
   std::vector<std::int64_t> global_of;  // per input vertex
+  std::vector<int> order;               // the input vertices in the bandwidth ordering
   std::string method;
   if (m.rank == 0) {
     const int nv = int(whole.num_vertices());
@@ -159,10 +160,12 @@ RankMesh scatter_mesh(const TriangleMesh& whole, OutputMap* output) {
     std::vector<std::int64_t> first(std::size_t(P) + 1, 0);
     for (const int p : part) ++first[std::size_t(p) + 1];
     for (int r = 0; r < P; ++r) first[std::size_t(r) + 1] += first[std::size_t(r)];
+    // Each part numbered in the bandwidth ordering (bases/vertex_ordering.h): neighbours get
+    // nearby numbers, the order in which the smoothers' Gauss-Seidel sweeps go.
+    order = bandwidth_ordering(whole.faces, nv);
     global_of.resize(std::size_t(nv));
     std::vector<std::int64_t> next(first.begin(), first.end() - 1);
-    for (int v = 0; v < nv; ++v)
-      global_of[std::size_t(v)] = next[std::size_t(part[std::size_t(v)])]++;
+    for (const int v : order) global_of[std::size_t(v)] = next[std::size_t(part[std::size_t(v)])]++;
     header = {whole.num_vertices(), whole.num_faces()};
     header.insert(header.end(), first.begin(), first.end());
   }
@@ -205,7 +208,7 @@ RankMesh scatter_mesh(const TriangleMesh& whole, OutputMap* output) {
           bucket[std::size_t(at[std::size_t(ps[k])]++)] = int(f);
     }
     std::vector<std::vector<int>> owned_of(static_cast<std::size_t>(P));
-    for (int v = 0; v < nv; ++v) owned_of[std::size_t(part[std::size_t(v)])].push_back(v);
+    for (const int v : order) owned_of[std::size_t(part[std::size_t(v)])].push_back(v);
     // Rank 0's own piece last, so that the others start their set-up early.
     for (int step = 1; step <= P; ++step) {
       const int r = step % P;

@@ -116,7 +116,7 @@ struct RankSystem::Impl {
   // The owned rows in CSR with global, increasing column numbers; source[k] is entry k's position
   // in the local basis's value arrays (its column j = the owned row, full symmetric storage).
   std::vector<PetscInt> ia, ja;
-  std::vector<std::size_t> source;
+  std::vector<int> source;
   std::vector<PetscScalar> values;
   std::vector<PetscInt> held_rows;  // global numbers of the owned held rows
 
@@ -145,14 +145,17 @@ struct RankSystem::Impl {
   void build_pattern() {
     const SparseView M = basis.mass();
     const int n = mesh.owned;
+    const auto entries = std::size_t(M.outerIndexPtr()[n]);  // the owned columns' (= rows')
     ia.assign(std::size_t(n) + 1, 0);
     ja.clear();
+    ja.reserve(entries);
     source.clear();
-    std::vector<std::pair<std::int64_t, std::size_t>> row;
+    source.reserve(entries);
+    std::vector<std::pair<std::int64_t, int>> row;
     for (int j = 0; j < n; ++j) {
       row.clear();
       for (auto p = M.outerIndexPtr()[j]; p < M.outerIndexPtr()[j + 1]; ++p)
-        row.emplace_back(mesh.global(M.innerIndexPtr()[p]), std::size_t(p));
+        row.emplace_back(mesh.global(M.innerIndexPtr()[p]), int(p));
       std::sort(row.begin(), row.end());
       for (const auto& [g, p] : row) {
         ja.push_back(PetscInt(g));
@@ -167,7 +170,7 @@ struct RankSystem::Impl {
     const double* m = basis.mass().valuePtr();
     const double* k = basis.stiffness().valuePtr();
     for (std::size_t e = 0; e < values.size(); ++e)
-      values[e] = sum_entry(a, m[source[e]], bk, k[source[e]]);
+      values[e] = sum_entry(a, m[std::size_t(source[e])], bk, k[std::size_t(source[e])]);
   }
 
   void make_matrix() {
