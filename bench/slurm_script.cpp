@@ -144,6 +144,7 @@ std::string run_array_script(const BatchScriptInput& in) {
   s += common_lines(in);
   if (in.job.ntasks > 1)  // the ranks of the cells that run across MPI ranks (mpi_ranks)
     s += "#SBATCH --ntasks=" + std::to_string(in.job.ntasks) + "\n";
+  if (in.job.nodes > 0) s += "#SBATCH --nodes=" + std::to_string(in.job.nodes) + "\n";
   s += "set -eu\n";
   s += "exec " + run_words(in) + " \\\n";
   s += "  --shard \"${SLURM_ARRAY_TASK_ID:?submit this script with sbatch}/" + n + "\" \\\n";

@@ -29,6 +29,9 @@ struct SlurmJobSettings {
   /// Slurm tasks of each array job: the MPI ranks its cells' flows run on (a cell with
   /// mpi_ranks P starts mpirun -n P inside the job's allocation). 1: no --ntasks line.
   int ntasks = 1;
+  /// Nodes of each array job, over which Slurm spreads its tasks (a flow divided across ranks
+  /// larger than one node's memory). 0: no --nodes line (Slurm's choice).
+  int nodes = 0;
 };
 
 struct BatchScriptInput {

@@ -38,6 +38,7 @@ constexpr ReservedOption kReserved[] = {
      "use submit's own --cpus-per-task, which is also every cell's thread count"},
     {"parsable", 0, "submit reads the job ids with it"},
     {"ntasks", 'n', "use submit's own --ntasks (default: the largest mpi_ranks of the cells)"},
+    {"nodes", 'N', "use submit's own --nodes"},
     {"wrap", 0, "submit writes the batch scripts itself"},
 };
 
@@ -83,6 +84,7 @@ std::string resubmit_command(const SubmitRequest& r, const BatchScriptInput& in)
   words.insert(words.end(), {"--out", in.out_dir, "--tasks", std::to_string(in.tasks),
                              "--cpus-per-task", std::to_string(r.cpus_per_task)});
   if (r.ntasks > 0) words.insert(words.end(), {"--ntasks", std::to_string(r.ntasks)});
+  if (r.nodes > 0) words.insert(words.end(), {"--nodes", std::to_string(r.nodes)});
   if (!r.partition.empty()) words.insert(words.end(), {"--partition", r.partition});
   if (!r.time.empty()) words.insert(words.end(), {"--time", r.time});
   if (!r.mem.empty()) words.insert(words.end(), {"--mem", r.mem});
@@ -218,6 +220,8 @@ void check_submit_request(const SubmitRequest& r) {
   if (r.ntasks < 0)
     throw std::invalid_argument("--ntasks: expected a number >= 1, got " +
                                 std::to_string(r.ntasks));
+  if (r.nodes < 0)
+    throw std::invalid_argument("--nodes: expected a number >= 1, got " + std::to_string(r.nodes));
   for (const std::string& a : r.sbatch_args) check_sbatch_argument(a);
 }
 
@@ -267,6 +271,10 @@ int submit_study(const SubmitRequest& r) {
                                 " asks for mpi_ranks " + std::to_string(ranks) +
                                 "; give at least that many, or leave --ntasks out");
   in.job.ntasks = r.ntasks > 0 ? r.ntasks : ranks;
+  if (r.nodes > in.job.ntasks)
+    throw std::invalid_argument("--nodes " + std::to_string(r.nodes) + ": more nodes than the " +
+                                std::to_string(in.job.ntasks) + " tasks of each job");
+  in.job.nodes = r.nodes;
   in.tasks = std::max(1, std::min(r.tasks > 0 ? r.tasks : kMaxArrayTasks, cells));
   std::set<int> shards;
   int to_run = 0;

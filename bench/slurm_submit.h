@@ -20,6 +20,8 @@ struct SubmitRequest {
   int cpus_per_task = 1;             ///< CPUs of every job, and threads of every cell
   /// Slurm tasks of every array job, at least the cells' largest mpi_ranks; 0: that largest.
   int ntasks = 0;
+  /// Nodes of every array job, its tasks spread over them; 0: Slurm's choice (no --nodes line).
+  int nodes = 0;
   bool dry_run = false;                  ///< write the scripts, submit nothing
   std::vector<std::string> sbatch_args;  ///< passed to both sbatch calls as they are
   /// The binary the jobs run; empty: this process's own (/proc/self/exe).

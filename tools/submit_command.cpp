@@ -39,6 +39,10 @@ void add_submit_command(CLI::App& app, std::function<int()>& run) {
                   "Slurm tasks (MPI ranks) of every array job (default: the largest mpi_ranks of "
                   "the cells; 1 writes no --ntasks line)")
       ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--nodes", a->nodes,
+                  "Nodes of every array job, its tasks spread over them (a flow divided across "
+                  "more memory than one node has; default: Slurm's choice)")
+      ->check(CLI::Range(1, 1000000));
   cmd->add_flag("--dry-run", a->dry_run, "Write the scripts, submit nothing");
   cmd->add_option("sbatch_args", a->sbatch_args,
                   "Options passed to both sbatch calls, after --, one word each");

@@ -118,7 +118,13 @@ TEST(SlurmScript, ScriptsSayWhatTheyRunWithEveryPathQuoted) {
   in.job.ntasks = 4;                        // cells that run their solve on 4 MPI ranks
   const std::string ranked = run_array_script(in);
   EXPECT_TRUE(contains(ranked, "#SBATCH --ntasks=4\n")) << ranked;
+  EXPECT_FALSE(contains(ranked, "--nodes"));  // Slurm's choice unless asked
   EXPECT_LT(ranked.rfind("#SBATCH"), ranked.find("\nset -eu"));
+  in.job.nodes = 2;  // a flow divided over two nodes' memory
+  const std::string spread = run_array_script(in);
+  EXPECT_TRUE(contains(spread, "#SBATCH --nodes=2\n")) << spread;
+  EXPECT_LT(spread.rfind("#SBATCH"), spread.find("\nset -eu"));
+  in.job.nodes = 0;
   in.job.ntasks = 1;
   in.with_reference = true;
   const std::string collect = collect_script(in);

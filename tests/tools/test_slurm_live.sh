@@ -241,4 +241,31 @@ PY
 grep -qi incomplete "$out/report/index.md" && fail "the final report is marked incomplete"
 left=$(find "$out" -name '*.tmp.*')
 [ -z "$left" ] || fail "temporary files left: $left"
+# --- A cell divided across MPI ranks: --nodes and the cells' ranks as each job's tasks ---
+ranked="$work/ranked results"
+cat >"$work/ranked.json" <<'JSON'
+{"name": "ranked", "defaults": {"mesh": "sphere:vertices=3000", "solver.name": "multigrid",
+  "dt": 1e-3, "steps": 2, "mpi_ranks": 2}}
+JSON
+t=$SECONDS
+# sbatch passes the submitter's environment on: Open MPI's consent to run as root (CI is root).
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+"$mcfbench" submit "$work/ranked.json" --out "$ranked" --nodes 1 --time 10:00 >"$work/submit3.txt" 2>&1 ||
+  fail "submit of the ranked cell: $(cat "$work/submit3.txt")"
+grep -q '^#SBATCH --ntasks=2$' "$ranked/slurm/run.sbatch" || fail "no --ntasks=2 in the array script"
+grep -q '^#SBATCH --nodes=1$' "$ranked/slurm/run.sbatch" || fail "no --nodes=1 in the array script"
+array3=$("$py" -c 'import json, sys; print(json.load(open(sys.argv[1]))["array_job"])' "$ranked/slurm/submitted.json")
+collect3=$("$py" -c 'import json, sys; print(json.load(open(sys.argv[1]))["collect_job"])' "$ranked/slurm/submitted.json")
+wait_for 300 gone "$array3,$collect3" || fail "the ranked cell's jobs did not end within 300 s: $(squeue 2>&1)"
+cat "$ranked"/slurm/logs/*.out "$ranked"/slurm/logs/*.err 2>/dev/null | tail -30
+"$py" - "$ranked" <<'PY' || fail "the ranked cell's result"
+import glob, json, sys
+cells = [json.load(open(f)) for f in glob.glob(sys.argv[1] + "/*.json") if not f.endswith("index.json")]
+cells = [c for c in cells if "cell" in c]
+assert len(cells) == 1 and cells[0]["status"] == "ok", [c.get("status") for c in cells]
+d = cells[0]["distribution"]
+assert d["ranks"] == 2 and len(d["owned_vertices"]) == 2, d
+print("the ranked cell ran on %d ranks in its Slurm job: owned %s" % (d["ranks"], d["owned_vertices"]))
+PY
+echo "ranked cell done after $((SECONDS - t)) s"
 echo "slurm live test passed in $((SECONDS - start)) s"
