@@ -189,8 +189,13 @@ if submit >"$work/early.txt" 2>&1; then fail "a submission while the first one's
 grep -q "still queued or running" "$work/early.txt" || fail "the early second submission says: $(cat "$work/early.txt")"
 [ "$(field array_job)" = "$array1" ] || fail "the refused submission changed $out/slurm/submitted.json"
 # Shard 1 holds the longest cells of the quick matrix: seconds of work left when it is cancelled.
+# Cancelled once its run has published its plan (before its first cell), not as soon as squeue
+# says RUNNING: a cancel that reaches slurmd while it is still launching the batch script can
+# leave the script running to its end (every cell written, the task listed as CANCELLED).
 task_running() { [ "$(state "${array1}_1")" = RUNNING ]; }
+task_planned() { compgen -G "$out/plans/*.shard-1-of-3.json" >/dev/null; }
 wait_for 120 task_running || fail "task ${array1}_1 did not start within 120 s: $(squeue --states=all 2>&1)"
+wait_for 60 task_planned || fail "task ${array1}_1 wrote no run plan within 60 s of starting: $(ls -R "$out" 2>&1)"
 scancel "${array1}_1" || fail "scancel ${array1}_1"
 wait_for 420 gone "$array1,$collect1" || fail "the first submission's jobs did not end within 420 s: $(squeue 2>&1)"
 echo "first submission ended after $((SECONDS - t)) s"
