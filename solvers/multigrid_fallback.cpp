@@ -137,11 +137,19 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
     // Contracting cycles that ended above the bound: r_{k+m} = r_k · c^m predicts m. A few more
     // cycles are cheaper than handing the step to CG (which copies the finest matrix); many are
     // not, since CG by the same cycle removes the slow modes that would make them many.
+    //
+    // The extra cycles are V-cycles with at most two sweeps each way, whatever the configured
+    // cycle: what is left is typically a factor of a few to the bound, which a V(2,2)-cycle
+    // covers at about a third of a W(5,5)-cycle's work, where another W(5,5)-cycle (contraction
+    // ~0.01 on the hat hierarchy) would overshoot by two orders of magnitude.
     const int k = multigrid_.options().cycles;
     const double needed = std::ceil(std::log(bound / cycles.relative_residual) / std::log(c));
     if (needed <= std::max(2, k)) {
       const MultigridOptions kept = multigrid_.options();
       MultigridOptions more = kept;
+      more.cycle = MultigridCycle::V;
+      more.pre_smooth = std::min(kept.pre_smooth, kExtraCycleSweeps);
+      more.post_smooth = std::min(kept.post_smooth, kExtraCycleSweeps);
       more.cycles = std::max(2, k);
       more.tolerance = bound;
       // A cycle that does not halve the residual: CG by the cycle does better from there.

@@ -5,8 +5,8 @@
 // - Where the step ends: a step is `converged` only at or below `residual_bound`, a relative
 //   residual ||b - A x|| / ||b||. Contracting cycles can still end far from the solution when the
 //   step starts far from it (the integrator's prediction misses near a fold, or one cycle from a
-//   poor start), so a step that ends above the bound continues: more cycles with the bound as
-//   their tolerance, where the measured contraction predicts that a few reach it; otherwise CG
+//   poor start), so a step that ends above the bound continues: a few cheap V(2,2)-cycles with
+//   the bound as their tolerance, where the measured contraction predicts that they reach it; then
 //   preconditioned by the same cycle to the bound; then the factorization (below).
 // - How fast the cycles contract: k cycles promise to reduce the step's initial residual r_0 by
 //   at least stall_ratio^k. When they stall — their mean reduction per cycle is worse, as on the
@@ -53,6 +53,10 @@ namespace mcf {
 /// measurements behind it).
 inline constexpr double kDefaultResidualBound = 1e-4;
 
+/// Gauss-Seidel sweeps each way of the V-cycles that continue a contracting step that ended
+/// above the bound (fewer where the configured cycle has fewer).
+inline constexpr int kExtraCycleSweeps = 2;
+
 struct StallFallbackOptions {
   /// Fall back when the cycles' mean contraction (SolveReport::contraction) exceeds this; CG then
   /// stops at r_0 · stall_ratio^k (or at residual_bound, if lower). 0 = no stall test.
@@ -83,7 +87,8 @@ class FallbackMultigridSolver final : public LinearSolver {
 
  protected:
   /// The cycles; then, if they ended above the bound while contracting, up to max(2, k) more
-  /// cycles when the contraction predicts they reach it (stopping at a cycle that does not halve
+  /// V-cycles of at most kExtraCycleSweeps sweeps each way when the contraction predicts they
+  /// reach it (stopping at a cycle that does not halve
   /// the residual); then, if the step is still above the bound or the cycles stalled, CG; then,
   /// if CG broke down, did not reach its target in `direct_after` iterations or is on course not
   /// to (PcgOptions::give_up_off_course), the factorization. The report lists the residuals of the
