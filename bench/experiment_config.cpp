@@ -392,12 +392,21 @@ void expand_cells(const std::vector<Dimension>& dims, const MatrixSpec& m,
     json raw = m.defaults, assignment = json::object();
     for (size_t d = 0; d < dims.size(); ++d)
       for (size_t k = 0; k < dims[d].keys.size(); ++k) {
-        set_json_path(raw, dims[d].keys[k], dims[d].rows[pos[d]][k]);
-        assignment[dims[d].keys[k]] = dims[d].rows[pos[d]][k];
+        // null: this row leaves the key as the defaults have it (a zip's column that the row's
+        // components do not read, e.g. the multigrid's stall_ratio on a CHOLMOD row).
+        const json& value = dims[d].rows[pos[d]][k];
+        if (value.is_null()) continue;
+        set_json_path(raw, dims[d].keys[k], value);
+        assignment[dims[d].keys[k]] = value;
       }
     if (!excluded(raw, m.exclude, exclude_used)) {
       const std::string where = assignment.empty() ? source + " (defaults)"
                                                    : source + " (cell " + assignment.dump() + ")";
+      // A default applies to the cells whose components read it (defaults {"solver.cycles": 2}
+      // beside an axis of solvers sets the multigrid's cycles, not CHOLMOD's); a value the
+      // cell's own assignment gives is checked strictly.
+      for (const std::string& key : inapplicable_keys(flow_config_from_json_unchecked(raw, where)))
+        if (!assignment.contains(key)) erase_json_path(raw, key);
       const FlowConfig flow = flow_config_from_json(raw, where);
       for (int r = 0; r < e.repetitions; ++r) {
         Cell c;

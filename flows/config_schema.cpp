@@ -154,6 +154,9 @@ std::vector<OptionSpec> gather() {
       o.owner_text = "solver \"" + row.name + "\"";
       o.selected = [name = row.name](const FlowConfig& c) { return c.solver.name == name; };
       o.recorded = Recorded::when_selected;
+      // Not recorded where its solver does not run, so a value set there would be dropped
+      // without a word.
+      o.refused_elsewhere = true;
       all.push_back(std::move(o));
     }
   const std::vector<OptionSpec> tail = tail_options();

@@ -10,8 +10,22 @@
 #include <optional>
 
 namespace mcf {
+namespace {
+
+/// Set to a value other than its default where no component of `c` reads it.
+bool inapplicable(const OptionSpec& o, const FlowConfig& c) {
+  return o.refused_elsewhere && !o.selected(c) && o.get(c) != o.fallback;
+}
+
+}  // namespace
 
 FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& source) {
+  FlowConfig c = flow_config_from_json_unchecked(j, source);
+  validate_flow_config(c, source);
+  return c;
+}
+
+FlowConfig flow_config_from_json_unchecked(const nlohmann::json& j, const std::string& source) {
   ConfigReader top(j, source);
   FlowConfig c;
   // One option after the other in the schema's order; an object's reader is finished (its
@@ -32,8 +46,14 @@ FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& sou
   top.finish();
   if (c.solver.tolerance < 0) c.solver.tolerance = solver_row(c.solver.name).default_tolerance;
   resolve_stabilization_weight(c);
-  validate_flow_config(c, source);
   return c;
+}
+
+std::vector<std::string> inapplicable_keys(const FlowConfig& c) {
+  std::vector<std::string> keys;
+  for (const OptionSpec& o : flow_config_schema())
+    if (inapplicable(o, c)) keys.push_back(o.key);
+  return keys;
 }
 
 nlohmann::json to_json(const FlowConfig& c) {
@@ -56,12 +76,15 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   };
   const BasisRow& basis = basis_row(c.basis);
   const bool fixed = !basis.fixed_functions || basis.fixed_functions(c);
-  // Options no solver reads would be recorded as if they had shaped the run.
+  // Options no solver reads would be recorded as if they had shaped the run (or dropped
+  // without a word).
+  std::string in_use = "\"" + c.solver.name + "\"";
+  if (solver_row(c.solver.name).uses_preconditioner)
+    in_use += " with preconditioner \"" + c.solver.preconditioner + "\"";
   for (const OptionSpec& o : flow_config_schema())
-    if (o.refused_elsewhere && !o.selected(c) && o.get(c) != o.fallback)
+    if (inapplicable(o, c))
       fail(o.key, (o.type == OptionType::string ? "\"" + o.get(c).get<std::string>() + "\" " : "") +
-                      "applies to " + o.owner_text + " only, the solver is \"" + c.solver.name +
-                      "\"");
+                      "applies to " + o.owner_text + " only, the solver is " + in_use);
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
   if (!basis.takes_mass && c.mass != "consistent")
     fail("mass", "\"" + c.mass +

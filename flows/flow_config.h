@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace mcf {
 
@@ -92,6 +93,13 @@ struct FlowConfig {
 /// Reads a flow config strictly (unknown keys, wrong types, out-of-range values are errors that
 /// name `source` and the key path) and fills defaults. Throws ConfigError.
 FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& source);
+/// The same without the cross-option checks (validate_flow_config): what a config asks for, to
+/// be checked or amended (bench/experiment_config.cpp drops the defaults a cell's components do
+/// not read).
+FlowConfig flow_config_from_json_unchecked(const nlohmann::json& j, const std::string& source);
+/// The dotted keys set to a value other than their default although no component of `c` reads
+/// them (`--solver cholmod --cycles 7`), in the schema's order: what validate_flow_config refuses.
+std::vector<std::string> inapplicable_keys(const FlowConfig& c);
 /// The config as JSON with every default filled in (what result.json records).
 nlohmann::json to_json(const FlowConfig& c);
 /// Cross-option checks (e.g. cMCF and two-step integrators need a fixed basis).

@@ -27,4 +27,14 @@ void set_json_path(nlohmann::json& j, const std::string& dotted, const nlohmann:
   (*node)[dotted.substr(start)] = value;
 }
 
+void erase_json_path(nlohmann::json& j, const std::string& dotted) {
+  const std::size_t dot = dotted.rfind('.');
+  nlohmann::json* parent =
+      dot == std::string::npos
+          ? &j
+          : const_cast<nlohmann::json*>(json_at_path(j, dotted.substr(0, dot)));
+  if (parent && parent->is_object())
+    parent->erase(dotted.substr(dot == std::string::npos ? 0 : dot + 1));
+}
+
 }  // namespace mcf

@@ -12,5 +12,7 @@ namespace mcf {
 const nlohmann::json* json_at_path(const nlohmann::json& j, const std::string& dotted);
 /// Sets a value at a dotted path, creating objects on the way.
 void set_json_path(nlohmann::json& j, const std::string& dotted, const nlohmann::json& value);
+/// Removes the value at a dotted path, if there is one (objects on the way stay, even if empty).
+void erase_json_path(nlohmann::json& j, const std::string& dotted);
 
 }  // namespace mcf

@@ -31,7 +31,7 @@ NamedTable<PreconditionerRow> built_in() {
       "multigrid", "one cycle of the basis's geometric multigrid",
       [](const SolverConfig& c, PcgOptions o) -> std::unique_ptr<LinearSolver> {
         MultigridOptions cycle = multigrid_options(c);
-        cycle.cycles = 1;
+        cycle.cycles = 1;  // solver.cycles is refused here unless 1 (its default)
         cycle.tolerance = 0;
         return std::make_unique<MultigridPcgSolver>(cycle, o);
       },

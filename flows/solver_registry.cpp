@@ -161,22 +161,41 @@ std::vector<OptionSpec> shared_options() {
              "PCG preconditioner"),
       [](auto& c) -> auto& { return c.solver.preconditioner; });
   preconditioner.choices = [] { return preconditioner_table().choices(); };
+  preconditioner.refused_elsewhere = true;
+  preconditioner.owner_text = "solver \"pcg\"";
+  preconditioner.selected = [](const FlowConfig& c) {
+    return solver_row(c.solver.name).uses_preconditioner;
+  };
+  // The multigrid's cycle wherever it runs (as the solver or as PCG's preconditioner); recorded
+  // always (the cells of every earlier run record them), refused where no multigrid runs.
+  const auto cycle_option = [](OptionSpec o) {
+    o.refused_elsewhere = true;
+    o.owner_text =
+        "a multigrid (solver \"multigrid\", or \"pcg\" with preconditioner \"multigrid\")";
+    o.selected = [](const FlowConfig& c) { return needs_hierarchy(c.solver); };
+    return o;
+  };
   OptionSpec cycle = bind(
       option("solver.cycle", OptionType::string, "W", "--cycle",
              "Multigrid cycle (solver and preconditioner)"),
       [](auto& c) -> auto& { return c.solver.cycle; });
   cycle.choices = [] { return std::vector<Choice>{{"V", ""}, {"W", ""}}; };
+  cycle = cycle_option(cycle);
   OptionSpec cycles = ranged(
       bind(
           option("solver.cycles", OptionType::integer, 1, "--cycles", "Multigrid cycles per solve"),
           [](auto& c) -> auto& { return c.solver.cycles; }),
       1, 10000);
+  // CG preconditioned by the multigrid applies one cycle an iteration, whatever this says.
+  cycles.refused_elsewhere = true;
+  cycles.owner_text = "solver \"multigrid\" (CG's multigrid preconditioner is one cycle)";
+  cycles.selected = [](const FlowConfig& c) { return solver_row(c.solver.name).needs_hierarchy; };
   OptionSpec smooth =
-      ranged(bind(
-                 option("solver.smooth", OptionType::integer, 5, "--smooth",
-                        "Gauss-Seidel sweeps before and after each coarse correction"),
-                 [](auto& c) -> auto& { return c.solver.smooth; }),
-             0, 1000);
+      cycle_option(ranged(bind(
+                              option("solver.smooth", OptionType::integer, 5, "--smooth",
+                                     "Gauss-Seidel sweeps before and after each coarse correction"),
+                              [](auto& c) -> auto& { return c.solver.smooth; }),
+                          0, 1000));
   // Options of the geometric multigrid wherever it runs: as the solver or as PCG's
   // preconditioner. Recorded only when set, refused where no multigrid runs.
   const auto multigrid_option = [](OptionSpec o) {

@@ -65,6 +65,51 @@ TEST(ExperimentConfig, ZipGroupsVaryTogether) {
   EXPECT_EQ(e.cells[0].assignment.size(), 3u);
 }
 
+// A default applies to the cells whose components read it; a row's null leaves a zip's column
+// to the defaults; a value a cell's own assignment gives where nothing reads it is refused.
+TEST(ExperimentConfig, DefaultsApplyWhereTheyAreReadAndAxisValuesStrictly) {
+  json defaults = base;
+  defaults["solver.cycles"] = 2;
+  defaults["solver.stall_ratio"] = 0;
+  defaults["solver.preconditioner"] = "ichol";
+  const auto e = expand(
+      {{"defaults", defaults}, {"axes", {{"solver.name", {"cholmod", "multigrid", "pcg"}}}}});
+  ASSERT_EQ(e.cells.size(), 3u);
+  const json& cholmod = e.cells[0].config["solver"];
+  const json& multigrid = e.cells[1].config["solver"];
+  const json& pcg = e.cells[2].config["solver"];
+  EXPECT_EQ(cholmod["cycles"], 1);
+  EXPECT_EQ(cholmod["preconditioner"], "jacobi");
+  EXPECT_FALSE(cholmod.contains("stall_ratio"));
+  EXPECT_EQ(multigrid["cycles"], 2);
+  EXPECT_EQ(multigrid["stall_ratio"], 0);
+  EXPECT_EQ(multigrid["preconditioner"], "jacobi");
+  EXPECT_EQ(pcg["preconditioner"], "ichol");
+  EXPECT_EQ(pcg["cycles"], 1);
+  EXPECT_EQ(e.cells[1].flow.solver.cycles, 2);
+  EXPECT_EQ(e.cells[0].flow.solver.cycles, 1);
+
+  // null in a zip row: the defaults' value, applied where it is read.
+  const auto z = expand(
+      {{"defaults", defaults}, {"zip", json::parse(R"([{"solver.name": ["cholmod", "multigrid"],
+                                                  "solver.stall_ratio": [null, 0.5]}])")}});
+  ASSERT_EQ(z.cells.size(), 2u);
+  EXPECT_EQ(z.cells[0].assignment, (json{{"solver.name", "cholmod"}}));
+  EXPECT_FALSE(z.cells[0].config["solver"].contains("stall_ratio"));
+  EXPECT_EQ(z.cells[1].config["solver"]["stall_ratio"], 0.5);
+
+  // The cell's own value: refused, naming the cell and the key.
+  try {
+    expand({{"defaults", base}, {"zip", json::parse(R"([{"solver.name": ["cholmod", "multigrid"],
+                                     "solver.cycles": [7, 2]}])")}});
+    ADD_FAILURE() << "a cell's solver.cycles with CHOLMOD was taken";
+  } catch (const ConfigError& err) {
+    const std::string m = err.what();
+    EXPECT_NE(m.find("study.json (cell"), std::string::npos) << m;
+    EXPECT_NE(m.find("solver.cycles: applies to solver \"multigrid\""), std::string::npos) << m;
+  }
+}
+
 TEST(ExperimentConfig, ExcludeDropsMatchingCellsIncludingDefaults) {
   const auto e =
       expand({{"defaults", base},

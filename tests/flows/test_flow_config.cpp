@@ -1,6 +1,7 @@
 #include "core/parallel.h"
 #include "datasets/mesh_spec.h"
 #include "flows/config_reader.h"
+#include "flows/config_schema.h"
 #include "flows/flow.h"
 #include "flows/flow_config.h"
 #include "solvers/blas_threads.h"
@@ -64,6 +65,58 @@ TEST(FlowConfig, StabilizationWeightIsTheSolversUnlessSet) {
   EXPECT_NE(error_of(octree(json::object(), {{"stabilization_weight", -1}}))
                 .find("cfg.json: octree.stabilization_weight"),
             std::string::npos);
+}
+
+// One default per key: the struct's member initializers (what the reader starts from) and the
+// schema's fallback (what --help, docs/flow.md, to_json's when_set and the refusals compare with)
+// agree for every option.
+TEST(FlowConfig, TheStructsDefaultsAreTheSchemasDefaults) {
+  const FlowConfig c{};
+  for (const OptionSpec& o : flow_config_schema()) EXPECT_EQ(o.get(c), o.fallback) << o.key;
+}
+
+// A key of a component not in use is refused, naming the key, the component that reads it and
+// the one in use; nothing rewrites another component's option without a word.
+TEST(FlowConfig, KeysOfComponentsNotInUseAreRefused) {
+  const auto with = [](const json& solver) { return json{{"mesh", "a"}, {"solver", solver}}; };
+  const auto refused = [&](const json& solver, const std::string& what) {
+    const std::string e = error_of(with(solver));
+    EXPECT_NE(e.find(what), std::string::npos) << solver.dump() << ": " << e;
+  };
+  refused({{"name", "cholmod"}, {"cycles", 7}},
+          "cfg.json: solver.cycles: applies to solver \"multigrid\"");
+  refused({{"name", "cholmod"}, {"cycles", 7}}, "the solver is \"cholmod\"");
+  refused({{"name", "cholmod"}, {"cycle", "V"}}, "solver.cycle: \"V\" applies to a multigrid");
+  refused({{"name", "pcg"}, {"smooth", 3}}, "solver.smooth: applies to a multigrid");
+  refused({{"name", "pcg"}, {"smooth", 3}}, "the solver is \"pcg\" with preconditioner \"jacobi\"");
+  // CG's multigrid preconditioner is one cycle an iteration, whatever cycles says.
+  refused({{"name", "pcg"}, {"preconditioner", "multigrid"}, {"cycles", 2}},
+          "solver.cycles: applies to solver \"multigrid\"");
+  refused({{"name", "multigrid"}, {"preconditioner", "ichol"}},
+          "solver.preconditioner: \"ichol\" applies to solver \"pcg\" only");
+  // A solver row's own options (recorded only where it runs) are refused elsewhere too.
+  refused({{"name", "cholmod"}, {"stall_ratio", 0.5}},
+          "solver.stall_ratio: applies to solver \"multigrid\" only");
+  refused({{"name", "petsc"}, {"residual_bound", 1e-3}}, "solver.residual_bound");
+  refused({{"name", "pcg"}, {"direct_after", 3}}, "solver.direct_after");
+  // Taken where they are read, and at their defaults anywhere.
+  for (const json& solver :
+       {json{{"name", "multigrid"}, {"cycle", "V"}, {"cycles", 3}, {"smooth", 2}},
+        json{{"name", "pcg"}, {"preconditioner", "multigrid"}, {"cycle", "V"}, {"smooth", 2}},
+        json{{"name", "pcg"}, {"preconditioner", "ichol"}},
+        json{{"name", "multigrid"}, {"stall_ratio", 0.5}, {"direct_after", 3}},
+        json{{"name", "cholmod"},
+             {"cycle", "W"},
+             {"cycles", 1},
+             {"smooth", 5},
+             {"preconditioner", "jacobi"},
+             {"stall_ratio", 0.2}}})
+    EXPECT_EQ(error_of(with(solver)), "") << solver.dump();
+  // What the refusal checks, as a list.
+  const FlowConfig asked = flow_config_from_json_unchecked(
+      with({{"name", "cholmod"}, {"cycles", 7}, {"stall_ratio", 0}}), "cfg.json");
+  EXPECT_EQ(inapplicable_keys(asked),
+            (std::vector<std::string>{"solver.cycles", "solver.stall_ratio"}));
 }
 
 TEST(FlowConfig, ErrorsNameFileAndKey) {

@@ -38,8 +38,10 @@ json octree(const std::string& mesh, const std::string& tracking, int depth, con
 json paper(const std::string& mesh, const std::string& tracking, int depth, const json& solver) {
   json j = octree(mesh, tracking, depth, solver);
   j["octree"]["stabilization"] = "none";
-  j["solver"]["stall_ratio"] = 0;
-  j["solver"]["residual_bound"] = 0;
+  if (j["solver"].value("name", "") == "multigrid") {
+    j["solver"]["stall_ratio"] = 0;
+    j["solver"]["residual_bound"] = 0;
+  }
   return j;
 }
 
