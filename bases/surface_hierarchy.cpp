@@ -229,11 +229,11 @@ std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
 
 namespace {
 
-/// One coarsening step (header, steps 1-4): the coarse level and the prolongation (fine x coarse).
-std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
+/// Step 1: a maximal independent set, greedily in index order: per fine vertex its coarse index
+/// (-1 off the set); returns the set's size.
+int independent_set(const LevelMesh& fine, std::vector<int>& coarse_index) {
   const int n = fine.size();
-  // 1. A maximal independent set, greedily in index order.
-  std::vector<int> coarse_index(std::size_t(n), -1);
+  coarse_index.assign(std::size_t(n), -1);
   std::vector<char> blocked(std::size_t(n), 0);
   int nc = 0;
   for (int v = 0; v < n; ++v) {
@@ -243,17 +243,14 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
     for (int k = fine.start[std::size_t(v)]; k < fine.start[std::size_t(v) + 1]; ++k)
       blocked[std::size_t(fine.neighbour[std::size_t(k)])] = 1;
   }
-  // 2. Graph Voronoi cells.
-  const std::vector<int> label =
-      graph_voronoi_cells(fine.start, fine.neighbour, fine.points, coarse_index);
-  // 3. The coarse level.
-  LevelMesh coarse;
-  coarse.points.resize(nc, 3);
-  for (int v = 0; v < n; ++v)
-    if (coarse_index[std::size_t(v)] >= 0)
-      coarse.points.row(coarse_index[std::size_t(v)]) = fine.points.row(v);
-  // Its graph: cells joined by a fine edge. Each cell's fine vertices (in index order), then per
-  // cell the other cells its vertices' neighbours lie in.
+  return nc;
+}
+
+/// The coarse level's graph: cells (fine vertices by their `label`) joined by a fine edge.
+void coarse_graph(const LevelMesh& fine, const std::vector<int>& label, int nc, LevelMesh& coarse) {
+  const int n = fine.size();
+  // Each cell's fine vertices (in index order), then per cell the other cells its vertices'
+  // neighbours lie in.
   std::vector<int> cell_start(std::size_t(nc) + 1, 0), cell_vertex(static_cast<std::size_t>(n));
   for (int v = 0; v < n; ++v) ++cell_start[std::size_t(label[std::size_t(v)]) + 1];
   for (int c = 0; c < nc; ++c) cell_start[std::size_t(c) + 1] += cell_start[std::size_t(c)];
@@ -287,6 +284,11 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
       },
       coarse.start, coarse.neighbour);
   sort_symmetric_sets(coarse.start, coarse.neighbour);
+}
+
+/// The coarse level's triangles: the fine ones with corners in three distinct cells.
+void coarse_triangles(const LevelMesh& fine, const std::vector<int>& label, int nc,
+                      LevelMesh& coarse) {
   // Triangles with three distinct cells, rotated to start at their smallest index (orientation
   // kept), in the order of their sorted corners; the first of several fine triangles that map to
   // one coarse triangle is kept. They are bucketed by their first corner in fine order, and each
@@ -336,6 +338,13 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
                 kept[std::size_t(c) + 1] - kept[std::size_t(c)],
                 coarse.triangles.begin() + kept[std::size_t(c)]);
   });
+}
+
+/// Step 4: the prolongation (fine x coarse): each fine vertex of the set takes its coarse vertex,
+/// each other one the barycentric weights of the coarse triangle it lies in best.
+SparseMatrix prolongation(const LevelMesh& fine, const LevelMesh& coarse,
+                          const std::vector<int>& coarse_index, const std::vector<int>& label) {
+  const int n = fine.size(), nc = coarse.size();
   // Triangles around each coarse vertex.
   std::vector<int> tri_start(std::size_t(nc) + 1, 0), tri_of;
   for (const auto& t : coarse.triangles)
@@ -415,6 +424,26 @@ std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
         P.valuePtr()[e] = row_weight[std::size_t(v)][std::size_t(k)];
       }
   }
+  return P;
+}
+
+/// One coarsening step (header, steps 1-4): the coarse level and the prolongation (fine x coarse).
+std::pair<LevelMesh, SparseMatrix> coarsen(const LevelMesh& fine) {
+  const int n = fine.size();
+  std::vector<int> coarse_index(std::size_t(n), -1);
+  const int nc = independent_set(fine, coarse_index);
+  // 2. Graph Voronoi cells.
+  const std::vector<int> label =
+      graph_voronoi_cells(fine.start, fine.neighbour, fine.points, coarse_index);
+  // 3. The coarse level: the set's points, the cells' graph and triangles.
+  LevelMesh coarse;
+  coarse.points.resize(nc, 3);
+  for (int v = 0; v < n; ++v)
+    if (coarse_index[std::size_t(v)] >= 0)
+      coarse.points.row(coarse_index[std::size_t(v)]) = fine.points.row(v);
+  coarse_graph(fine, label, nc, coarse);
+  coarse_triangles(fine, label, nc, coarse);
+  SparseMatrix P = prolongation(fine, coarse, coarse_index, label);
   return {std::move(coarse), std::move(P)};
 }
 

@@ -225,9 +225,10 @@ void check_submit_request(const SubmitRequest& r) {
   for (const std::string& a : r.sbatch_args) check_sbatch_argument(a);
 }
 
-int submit_study(const SubmitRequest& r) {
-  check_submit_request(r);
-  const ExperimentConfig e = load_experiment_config(r.config, r.quick);
+namespace {
+
+/// What the batch scripts say, as far as the request and the config tell it.
+BatchScriptInput script_input(const SubmitRequest& r, const ExperimentConfig& e) {
   BatchScriptInput in;
   in.study = e.name;
   in.quick = r.quick;
@@ -244,11 +245,13 @@ int submit_study(const SubmitRequest& r) {
                  "mcfbench submit: %s is not there (was the source tree moved?): the collect job "
                  "will write no report\n",
                  report_script.c_str());
-  const SlurmPaths paths = slurm_paths(in.out_dir);
+  return in;
+}
 
-  // The cells' thread count is part of their keys: a folder filled with another count would get
-  // every cell a second time under other names.
-  const std::optional<json> previous = read_record(paths.record);
+/// The cells' thread count is part of their keys: a folder filled with another count would get
+/// every cell a second time under other names.
+void check_thread_count(const std::optional<json>& previous, const ExperimentConfig& e,
+                        const SubmitRequest& r, const BatchScriptInput& in) {
   if (previous && previous->value("study", "") == e.name &&
       previous->value("quick", false) == r.quick &&
       previous->value("cpus_per_task", r.cpus_per_task) != r.cpus_per_task)
@@ -257,10 +260,12 @@ int submit_study(const SubmitRequest& r) {
         std::to_string(previous->value("cpus_per_task", 0)) +
         ", which is every cell's thread count and so part of its key: submit again with the "
         "same, or into another folder");
+}
 
-  // Which cells are still to run: as `mcfbench run` decides, by their result files.
-  MeshCache meshes;
-  const std::vector<CellPlan> plans = plan_cells(e, in.out_dir, meshes, r.cpus_per_task);
+/// The array: tasks, each job's MPI tasks and nodes, and the shards that still have cells to
+/// run (as `mcfbench run` decides, by their result files); returns how many cells are to run.
+int plan_array(const SubmitRequest& r, const ExperimentConfig& e,
+               const std::vector<CellPlan>& plans, BatchScriptInput& in) {
   const int cells = int(plans.size());
   in.cells = cells;
   // Every array job gets the ranks of the cell that asks for the most (its shard may hold it).
@@ -287,34 +292,41 @@ int submit_study(const SubmitRequest& r) {
   in.resubmit = resubmit_command(r, in);
   if (r.tasks > cells)
     std::printf("%s: %d tasks for %d cells: using %d\n", e.name.c_str(), r.tasks, cells, in.tasks);
+  return to_run;
+}
 
-  // One submission at a time into a folder: a second array would run the cells the first one is
-  // still running, both writing the same files.
-  if (!r.dry_run && previous) {
-    const std::vector<std::string> ids = recorded_jobs(*previous);
-    if (!ids.empty()) {
-      const auto queued = still_queued(ids);
-      if (!queued) {
-        std::fprintf(stderr,
-                     "mcfbench submit: cannot tell whether job(s) %s of the previous submission "
-                     "into %s are still queued; nothing was submitted\n",
-                     joined(ids, ", ").c_str(), in.out_dir.c_str());
-        return 1;
-      }
-      if (!queued->empty()) {
-        std::fprintf(stderr,
-                     "mcfbench submit: job(s) %s of the previous submission into %s are still "
-                     "queued or running (squeue --jobs=%s); nothing was submitted. Submit again "
-                     "once they have ended, or cancel them first (scancel %s). (%s names them.)\n",
-                     joined(*queued, ", ").c_str(), in.out_dir.c_str(),
-                     joined(*queued, ",").c_str(), joined(*queued, " ").c_str(),
-                     paths.record.c_str());
-        return 1;
-      }
-    }
+/// One submission at a time into a folder: a second array would run the cells the first one is
+/// still running, both writing the same files. False (having said why) while the previous
+/// submission's jobs are queued, or when squeue cannot tell.
+bool previous_jobs_ended(const std::optional<json>& previous, const BatchScriptInput& in,
+                         const SlurmPaths& paths) {
+  if (!previous) return true;
+  const std::vector<std::string> ids = recorded_jobs(*previous);
+  if (ids.empty()) return true;
+  const auto queued = still_queued(ids);
+  if (!queued) {
+    std::fprintf(stderr,
+                 "mcfbench submit: cannot tell whether job(s) %s of the previous submission "
+                 "into %s are still queued; nothing was submitted\n",
+                 joined(ids, ", ").c_str(), in.out_dir.c_str());
+    return false;
   }
+  if (!queued->empty()) {
+    std::fprintf(stderr,
+                 "mcfbench submit: job(s) %s of the previous submission into %s are still "
+                 "queued or running (squeue --jobs=%s); nothing was submitted. Submit again "
+                 "once they have ended, or cancel them first (scancel %s). (%s names them.)\n",
+                 joined(*queued, ", ").c_str(), in.out_dir.c_str(), joined(*queued, ",").c_str(),
+                 joined(*queued, " ").c_str(), paths.record.c_str());
+    return false;
+  }
+  return true;
+}
 
-  // The scripts before anything is written: a folder they cannot name is refused here.
+/// The scripts, written before anything is submitted (a folder they cannot name is refused
+/// here), and what they will run.
+void write_scripts(const BatchScriptInput& in, const SlurmPaths& paths, int to_run,
+                   const std::string& what) {
   const bool run_cells = !in.array.empty();
   const std::string run_text = run_cells ? run_array_script(in) : "";
   const std::string collect_text = collect_script(in);
@@ -323,85 +335,106 @@ int submit_study(const SubmitRequest& r) {
   if (ec) throw std::runtime_error(paths.logs + ": cannot create the folder: " + ec.message());
   if (run_cells) write_file_atomic(paths.run_script, run_text);
   write_file_atomic(paths.collect_script, collect_text);
-
-  const std::string what = e.name + (r.quick ? " (quick variant)" : "");
   if (run_cells)
     std::printf(
         "%s: %d cells, %d finished, %d to run in %zu of %d tasks (task i runs the cells "
         "whose index %% %d == i)\n",
-        what.c_str(), cells, cells - to_run, to_run, in.array.size(), in.tasks, in.tasks);
+        what.c_str(), in.cells, in.cells - to_run, to_run, in.array.size(), in.tasks, in.tasks);
   else
     std::printf("%s: all %d cells are finished; only the collect-and-report job is needed\n",
-                what.c_str(), cells);
+                what.c_str(), in.cells);
   std::printf("scripts: %s%s%s\n", run_cells ? paths.run_script.c_str() : "",
               run_cells ? " and " : "", paths.collect_script.c_str());
+}
 
-  if (r.dry_run) {
-    std::printf("dry run: nothing submitted. To submit them by hand:\n");
-    if (run_cells) {
-      std::printf("  array=$(sbatch --parsable %s)\n", shell_quote(paths.run_script).c_str());
-      std::printf("  sbatch --dependency=afterany:${array%%%%;*} %s\n",
-                  shell_quote(paths.collect_script).c_str());
-    } else {
-      std::printf("  sbatch %s\n", shell_quote(paths.collect_script).c_str());
-    }
-    return 0;
+void print_by_hand(const SlurmPaths& paths, bool run_cells) {
+  std::printf("dry run: nothing submitted. To submit them by hand:\n");
+  if (run_cells) {
+    std::printf("  array=$(sbatch --parsable %s)\n", shell_quote(paths.run_script).c_str());
+    std::printf("  sbatch --dependency=afterany:${array%%%%;*} %s\n",
+                shell_quote(paths.collect_script).c_str());
+  } else {
+    std::printf("  sbatch %s\n", shell_quote(paths.collect_script).c_str());
   }
+}
 
-  std::string array_job;
+struct SubmittedJobs {
+  std::string array_job;  ///< empty where no cell was left to run
+  std::string collect_job;
+};
+
+/// The array, then the collect job depending on it; nothing (having said why, and cancelled the
+/// array) where sbatch refused either.
+std::optional<SubmittedJobs> submit_jobs(const SubmitRequest& r, const SlurmPaths& paths,
+                                         bool run_cells) {
+  SubmittedJobs jobs;
   if (run_cells) {
     const auto id = sbatch({}, r.sbatch_args, paths.run_script, "job array");
     if (!id) {
       std::fprintf(stderr, "mcfbench submit: nothing was submitted\n");
-      return 1;
+      return std::nullopt;
     }
-    array_job = *id;
+    jobs.array_job = *id;
   }
   std::vector<std::string> collect_options;
-  if (run_cells) collect_options.push_back("--dependency=afterany:" + array_job);
+  if (run_cells) collect_options.push_back("--dependency=afterany:" + jobs.array_job);
   const auto collect_job =
       sbatch(collect_options, r.sbatch_args, paths.collect_script, "collect-and-report job");
   if (!collect_job) {
     if (run_cells)
-      cancel({array_job});
+      cancel({jobs.array_job});
     else
       std::fprintf(stderr, "mcfbench submit: nothing was submitted\n");
-    return 1;
+    return std::nullopt;
   }
+  jobs.collect_job = *collect_job;
+  return jobs;
+}
 
+/// submitted.json: what the next submission into the folder checks; the jobs are cancelled if
+/// it cannot be written.
+void record_submission(const SubmitRequest& r, const ExperimentConfig& e,
+                       const BatchScriptInput& in, const SlurmPaths& paths, int to_run,
+                       const SubmittedJobs& jobs) {
+  const bool run_cells = !in.array.empty();
   const json record = {{"schema", 1},
                        {"study", e.name},
                        {"quick", r.quick},
                        {"config", in.config},
                        {"out", in.out_dir},
-                       {"cells", cells},
+                       {"cells", in.cells},
                        {"cells_to_run", to_run},
                        {"tasks", in.tasks},
                        {"array", run_cells ? json(array_spec(in.array)) : json(nullptr)},
                        {"cpus_per_task", r.cpus_per_task},
-                       {"array_job", array_job},
-                       {"collect_job", *collect_job},
+                       {"array_job", jobs.array_job},
+                       {"collect_job", jobs.collect_job},
                        {"command", in.resubmit}};
   try {
     write_file_atomic(paths.record, record.dump(1) + "\n");
   } catch (const std::exception&) {
-    std::vector<std::string> ids = {*collect_job};
-    if (run_cells) ids.insert(ids.begin(), array_job);
+    std::vector<std::string> ids = {jobs.collect_job};
+    if (run_cells) ids.insert(ids.begin(), jobs.array_job);
     cancel(ids);
     throw;
   }
+}
 
+void print_submitted(const BatchScriptInput& in, const SlurmPaths& paths,
+                     const SubmittedJobs& jobs) {
+  const bool run_cells = !in.array.empty();
   const std::string logs = paths.logs;
   std::vector<std::string> ids;
   if (run_cells) {
-    ids.push_back(array_job);
+    ids.push_back(jobs.array_job);
     std::printf("submitted job array %s (task(s) %s): logs %s/run-%s_<task>.out\n",
-                array_job.c_str(), array_spec(in.array).c_str(), logs.c_str(), array_job.c_str());
+                jobs.array_job.c_str(), array_spec(in.array).c_str(), logs.c_str(),
+                jobs.array_job.c_str());
   }
-  ids.push_back(*collect_job);
+  ids.push_back(jobs.collect_job);
   std::printf("submitted job %s, collect and report%s: log %s/collect-%s.out\n",
-              collect_job->c_str(), run_cells ? " once the array has ended" : "", logs.c_str(),
-              collect_job->c_str());
+              jobs.collect_job.c_str(), run_cells ? " once the array has ended" : "", logs.c_str(),
+              jobs.collect_job.c_str());
   std::printf("follow them:     squeue --jobs=%s\n", joined(ids, ",").c_str());
   std::printf("once they ended: sacct --jobs=%s --format=JobID,JobName,State,Elapsed,ExitCode\n",
               joined(ids, ",").c_str());
@@ -411,6 +444,30 @@ int submit_study(const SubmitRequest& r) {
   std::printf(
       "Tasks lost to a time limit, a node failure or scancel: once these jobs have ended, submit "
       "again\n(the same command); it runs only the cells still missing or errored.\n");
+}
+
+}  // namespace
+
+int submit_study(const SubmitRequest& r) {
+  check_submit_request(r);
+  const ExperimentConfig e = load_experiment_config(r.config, r.quick);
+  BatchScriptInput in = script_input(r, e);
+  const SlurmPaths paths = slurm_paths(in.out_dir);
+  const std::optional<json> previous = read_record(paths.record);
+  check_thread_count(previous, e, r, in);
+  MeshCache meshes;
+  const int to_run = plan_array(r, e, plan_cells(e, in.out_dir, meshes, r.cpus_per_task), in);
+  if (!r.dry_run && !previous_jobs_ended(previous, in, paths)) return 1;
+  write_scripts(in, paths, to_run, e.name + (r.quick ? " (quick variant)" : ""));
+  const bool run_cells = !in.array.empty();
+  if (r.dry_run) {
+    print_by_hand(paths, run_cells);
+    return 0;
+  }
+  const std::optional<SubmittedJobs> jobs = submit_jobs(r, paths, run_cells);
+  if (!jobs) return 1;
+  record_submission(r, e, in, paths, to_run, *jobs);
+  print_submitted(in, paths, *jobs);
   return 0;
 }
 
