@@ -106,10 +106,6 @@ int OctreeLevel::find_cell(int i, int j, int k) const {
 int OctreeLevel::find_function(int i, int j, int k) const {
   return find_key(functions, function_row_start, i, j, k, 1 << depth);
 }
-void OctreeLevel::index_rows() {
-  fill_rows(cells, 1 << depth, cell_row_start);
-  fill_rows(functions, (1 << depth) + 1, function_row_start);
-}
 
 Eigen::Matrix<double, Eigen::Dynamic, 3> Octree::function_positions(int level) const {
   const OctreeLevel& L = levels.at(static_cast<std::size_t>(level));

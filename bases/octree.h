@@ -68,8 +68,6 @@ struct OctreeLevel {
   int find_function(int i, int j, int k) const;
   Eigen::Index num_functions() const { return static_cast<Eigen::Index>(functions.size()); }
   Eigen::Index num_cells() const { return static_cast<Eigen::Index>(cells.size()); }
-  /// Fills the row directories from `cells` / `functions` (build_octree does this).
-  void index_rows();
 };
 
 struct Octree {

@@ -1,9 +1,9 @@
 #include "bench/compare.h"
 
 #include "bench/history_tool.h"
+#include "bench/json_path.h"
 #include "bench/subprocess.h"
 #include "bench/timing_summary.h"
-#include "flows/json_path.h"
 
 #include <algorithm>
 #include <cmath>

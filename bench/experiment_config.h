@@ -17,8 +17,8 @@
 // one more dimension; repetitions innermost), so a cell's index — and hence `--shard i/n` —
 // means the same thing in every process that reads the same file.
 
+#include "bench/json_path.h"
 #include "flows/flow_config.h"
-#include "flows/json_path.h"
 
 #include <nlohmann/json.hpp>
 

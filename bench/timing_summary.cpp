@@ -1,6 +1,6 @@
 #include "bench/timing_summary.h"
 
-#include "flows/json_path.h"
+#include "bench/json_path.h"
 
 #include <algorithm>
 #include <cmath>

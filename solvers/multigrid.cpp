@@ -894,6 +894,11 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
     rep.message = "right-hand side has the wrong number of rows";
     return rep;
   }
+  if (options_.cycles < 1) {
+    rep.status = SolveStatus::failed;
+    rep.message = "MultigridOptions::cycles must be at least 1";
+    return rep;
+  }
   const int k = int(B.cols());
   if (k == 0) return rep;
   m.ensure_buffers(k);
@@ -949,10 +954,6 @@ SolveReport MultigridSolver::solve_in_place(const ConstMatrixRef& B, MatrixRef X
   // solvers/multigrid_fallback.h), except on a single level, where the cycle is the direct solve.
   if (tol <= 0.0 && top == 0 && rep.iterations > 0 && std::isfinite(rel))
     rep.status = SolveStatus::converged;
-  if (rep.iterations == 0 && tol <= 0.0) {  // cycles == 0: report the warm start's residual
-    rel = m.relative_residual(bnorm);
-    if (!std::isfinite(rel)) rep.status = SolveStatus::numerical_issue;
-  }
   rep.relative_residual = rel;
   if (measure_start && rep.iterations > 0 && std::isfinite(rel) && std::isfinite(start) &&
       start > 0.0)

@@ -99,7 +99,7 @@ struct MultigridLevelWork {
 
 struct MultigridOptions {
   MultigridCycle cycle = MultigridCycle::W;
-  int cycles = 1;       ///< number of cycles per solve (the cap when tolerance > 0)
+  int cycles = 1;       ///< cycles per solve, at least 1 (the cap when tolerance > 0)
   int pre_smooth = 5;   ///< Gauss-Seidel sweeps before the coarse correction, per level
   int post_smooth = 5;  ///< Gauss-Seidel sweeps after the coarse correction, per level
   /// 0: run exactly `cycles` cycles (status max_iterations: nothing checked where they ended);

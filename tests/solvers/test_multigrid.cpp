@@ -233,6 +233,21 @@ TEST(Multigrid, GalerkinMatchesBruteForceAndUpdatesNumerically) {
   }
 }
 
+// Zero cycles would return the warm start unchanged as a solve: refused, the iterate untouched.
+TEST(Multigrid, ZeroCyclesIsAFailedSolve) {
+  Problem pr = make_problem(3, 1, 0.05);
+  MultigridOptions o;
+  o.cycles = 0;
+  MultigridSolver mg(o);
+  ASSERT_TRUE(mg.set_matrix(pr.A, pr.view()).ok());
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 5);
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  const mcf::SolveReport r = mg.solve(B, X);
+  EXPECT_EQ(r.status, SolveStatus::failed);
+  EXPECT_NE(r.message.find("cycles must be at least 1"), std::string::npos) << r.message;
+  EXPECT_EQ(X, Eigen::MatrixXd::Zero(pr.A.rows(), 3));
+}
+
 TEST(Multigrid, HierarchyChangeTriggersSymbolicBuild) {
   Problem a = make_problem(3, 1, 0.05);
   Problem b = make_problem(3, 1, 0.05, Drop::random);

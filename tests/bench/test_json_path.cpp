@@ -1,4 +1,4 @@
-#include "flows/json_path.h"
+#include "bench/json_path.h"
 
 #include <gtest/gtest.h>
 
