@@ -14,8 +14,14 @@ namespace mcf::examples {
 
 class DampedJacobiSolver final : public LinearSolver {
  public:
-  DampedJacobiSolver(double tolerance, int max_iterations)
-      : tolerance_(tolerance), max_iterations_(max_iterations) {}
+  /// omega: the damping in x <- x + omega D^-1 (b - A x); check_every: sweeps between two
+  /// residual norms (the stopping test), each a pass over the residual's three columns.
+  DampedJacobiSolver(double tolerance, int max_iterations, double omega = 2.0 / 3.0,
+                     int check_every = 1)
+      : tolerance_(tolerance),
+        max_iterations_(max_iterations),
+        omega_(omega),
+        check_every_(check_every) {}
   std::string name() const override { return "damped-jacobi"; }
   SolveReport set_matrix(const SparseMatrix& A, HierarchyView hierarchy = {}) override;
 
@@ -25,6 +31,8 @@ class DampedJacobiSolver final : public LinearSolver {
  private:
   double tolerance_;
   int max_iterations_;
+  double omega_;
+  int check_every_;
   SparseMatrix A_;
   Eigen::VectorXd inverse_diagonal_;
 };

@@ -66,6 +66,10 @@ struct SolverConfig {
   /// solvers/blas_threads.h), else this many, at most the flow's `threads`. Config key
   /// "blas_threads" (top level, as before it belonged to the solver).
   int blas_threads = 0;
+  /// The values of solver rows' own options that have no field above (solver_param,
+  /// flows/option_spec.h: a solver added outside flows/, as examples/damped_jacobi.cpp), by key
+  /// ("omega"); the config reader fills every registered row's, each with its one default.
+  nlohmann::json params = nlohmann::json::object();
 };
 
 struct FlowConfig {

@@ -21,6 +21,17 @@ OptionSpec ranged(OptionSpec o, double min, double max) {
   return o;
 }
 
+OptionSpec solver_param(OptionSpec o) {
+  const std::string key = o.key;
+  const nlohmann::json fallback = o.fallback;
+  o.get = [key, fallback](const FlowConfig& c) {
+    const auto it = c.solver.params.find(key);
+    return it != c.solver.params.end() ? *it : fallback;
+  };
+  o.set = [key](FlowConfig& c, const nlohmann::json& v) { c.solver.params[key] = v; };
+  return o;
+}
+
 std::pair<std::string, std::string> split_key(const std::string& key) {
   const std::size_t dot = key.rfind('.');
   if (dot == std::string::npos) return {"", key};

@@ -93,6 +93,12 @@ OptionSpec bind(OptionSpec o, Ref ref) {
   return o;
 }
 
+/// A solver row's own option `o` (its key the row-local leaf, "omega") kept in
+/// SolverConfig::params instead of a field of its own, so that a solver with options is its file
+/// pair alone. The row's factory reads it as `c.params.at("omega")`, set by the reader to the
+/// config's value or `o.fallback`.
+OptionSpec solver_param(OptionSpec o);
+
 /// The object ("solver", or "" at the top) and the key within it of a dotted key.
 std::pair<std::string, std::string> split_key(const std::string& key);
 

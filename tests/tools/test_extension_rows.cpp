@@ -67,6 +67,49 @@ TEST(ExampleSolver, DampedJacobiFlowMatchesCholmod) {
   EXPECT_GT(result["steps"].back()["solver"]["iterations"].get<int>(), 1);
 }
 
+// The example's own options (examples/damped_jacobi.cpp: solver.omega, solver.check_every), kept
+// in SolverConfig::params with nothing in flows/ naming them: taken, recorded where the solver
+// runs, at their one default otherwise, and refused under another solver.
+TEST(ExampleSolver, OwnOptionsAreTakenRecordedAndRefusedElsewhere) {
+  const std::string flow =
+      "flow --mesh icosphere:level=2 --dt 1e-4 --steps 3 --tolerance 1e-13 "
+      "--max-iterations 20000 --solver ";
+  const fs::path tuned = temp_dir() / "tuned", plain = temp_dir() / "plain",
+                 cholmod = temp_dir() / "cholmod_only";
+  ASSERT_EQ(mcfbench(flow + "damped-jacobi --omega 0.5 --check-every 4 --out " + tuned.string(),
+                     temp_dir() / "o1"),
+            0)
+      << text_of(temp_dir() / "stderr.txt");
+  ASSERT_EQ(mcfbench(flow + "damped-jacobi --out " + plain.string(), temp_dir() / "o2"), 0);
+  ASSERT_EQ(mcfbench(flow + "cholmod --out " + cholmod.string(), temp_dir() / "o3"), 0);
+  const nlohmann::json t = nlohmann::json::parse(text_of(tuned / "result.json"));
+  const nlohmann::json p = nlohmann::json::parse(text_of(plain / "result.json"));
+  const nlohmann::json c = nlohmann::json::parse(text_of(cholmod / "result.json"));
+  EXPECT_EQ(t["config"]["solver"]["omega"], 0.5);
+  EXPECT_EQ(t["config"]["solver"]["check_every"], 4);
+  EXPECT_EQ(p["config"]["solver"]["omega"], 2.0 / 3.0);
+  EXPECT_EQ(p["config"]["solver"]["check_every"], 1);
+  EXPECT_FALSE(c["config"]["solver"].contains("omega"));
+  // Both solve the same systems (to 1e-13): the same flow as CHOLMOD's; checked every 4th
+  // sweep, every step's sweeps are a multiple of 4.
+  const TriangleMesh a = read_mesh((tuned / "final.ply").string());
+  const TriangleMesh b = read_mesh((cholmod / "final.ply").string());
+  EXPECT_LT((a.vertices - b.vertices).cwiseAbs().maxCoeff(), 1e-9);
+  for (const auto& step : t["steps"]) EXPECT_EQ(step["solver"]["iterations"].get<int>() % 4, 0);
+  // Another damping takes another number of sweeps.
+  EXPECT_NE(t["steps"][0]["solver"]["iterations"], p["steps"][0]["solver"]["iterations"]);
+  // Under another solver: refused, naming the key, its solver and the one in use.
+  EXPECT_NE(mcfbench(flow + "cholmod --omega 0.5 --out " + (temp_dir() / "no").string(),
+                     temp_dir() / "o4"),
+            0);
+  EXPECT_NE(text_of(temp_dir() / "stderr.txt")
+                .find("solver.omega: applies to solver \"damped-jacobi\" only, the solver is "
+                      "\"cholmod\""),
+            std::string::npos)
+      << text_of(temp_dir() / "stderr.txt");
+  EXPECT_FALSE(fs::exists(temp_dir() / "no" / "result.json"));
+}
+
 TEST(ExampleSolver, RunsThroughExpandAndRun) {
   const fs::path config = temp_dir() / "matrix.json";
   std::ofstream(config) << R"({"name": "rows", "defaults": {"mesh": "icosphere:level=1",
