@@ -405,9 +405,15 @@ void expand_cells(const std::vector<Dimension>& dims, const MatrixSpec& m,
       // A default applies to the cells whose components read it (defaults {"solver.cycles": 2}
       // beside an axis of solvers sets the multigrid's cycles, not CHOLMOD's); a value the
       // cell's own assignment gives is checked strictly.
-      for (const std::string& key : inapplicable_keys(flow_config_from_json_unchecked(raw, where)))
-        if (!assignment.contains(key)) erase_json_path(raw, key);
-      const FlowConfig flow = flow_config_from_json(raw, where);
+      FlowConfig flow = flow_config_from_json_unchecked(raw, where);
+      bool dropped = false;
+      for (const std::string& key : inapplicable_keys(flow))
+        if (!assignment.contains(key)) {
+          erase_json_path(raw, key);
+          dropped = true;
+        }
+      if (dropped) flow = flow_config_from_json_unchecked(raw, where);
+      validate_flow_config(flow, where);
       for (int r = 0; r < e.repetitions; ++r) {
         Cell c;
         c.index = index++;

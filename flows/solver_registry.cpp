@@ -196,14 +196,11 @@ std::vector<OptionSpec> shared_options() {
                                      "Gauss-Seidel sweeps before and after each coarse correction"),
                               [](auto& c) -> auto& { return c.solver.smooth; }),
                           0, 1000));
-  // Options of the geometric multigrid wherever it runs: as the solver or as PCG's
-  // preconditioner. Recorded only when set, refused where no multigrid runs.
-  const auto multigrid_option = [](OptionSpec o) {
+  // The multigrid's options added later, recorded only when set (cells of earlier runs lack
+  // them), refused where no multigrid runs as the cycle's are.
+  const auto multigrid_option = [&](OptionSpec o) {
+    o = cycle_option(std::move(o));
     o.recorded = Recorded::when_set;
-    o.refused_elsewhere = true;
-    o.owner_text =
-        "a multigrid (solver \"multigrid\", or \"pcg\" with preconditioner \"multigrid\")";
-    o.selected = [](const FlowConfig& c) { return needs_hierarchy(c.solver); };
     return o;
   };
   OptionSpec by_term = multigrid_option(bind(

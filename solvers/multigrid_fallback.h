@@ -6,8 +6,9 @@
 //   residual ||b - A x|| / ||b||. Contracting cycles can still end far from the solution when the
 //   step starts far from it (the integrator's prediction misses near a fold, or one cycle from a
 //   poor start), so a step that ends above the bound continues: a few cheap V(2,2)-cycles with
-//   the bound as their tolerance, where the measured contraction predicts that they reach it; then
-//   preconditioned by the same cycle to the bound; then the factorization (below).
+//   the bound as their tolerance, where the measured contraction predicts that they reach it;
+//   otherwise CG preconditioned by the configured cycle to the bound; then the factorization
+//   (below).
 // - How fast the cycles contract: k cycles promise to reduce the step's initial residual r_0 by
 //   at least stall_ratio^k. When they stall — their mean reduction per cycle is worse, as on the
 //   paper's octree system or a surface whose triangles degenerate during the flow — the solve goes
@@ -88,8 +89,8 @@ class FallbackMultigridSolver final : public LinearSolver {
  protected:
   /// The cycles; then, if they ended above the bound while contracting, up to max(2, k) more
   /// V-cycles of at most kExtraCycleSweeps sweeps each way when the contraction predicts they
-  /// reach it (stopping at a cycle that does not halve
-  /// the residual); then, if the step is still above the bound or the cycles stalled, CG; then,
+  /// reach it (stopping at a cycle that does not halve the residual); then, if the step is still
+  /// above the bound or the cycles stalled, CG; then,
   /// if CG broke down, did not reach its target in `direct_after` iterations or is on course not
   /// to (PcgOptions::give_up_off_course), the factorization. The report lists the residuals of the
   /// cycles, the extra cycles and CG in order (the factorization's last), `iterations` counts all
