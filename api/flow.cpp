@@ -1,17 +1,17 @@
-// flow(): what `mcfbench flow` does (bench/flow_folder.h) with the result kept in memory: the
+// flow(): what `mcfbench flow` does (harness/flow_folder.h) with the result kept in memory: the
 // config through the flow config's schema, the memory check before and after the mesh is loaded,
 // the flow itself (flows/flow.h) with the same observer hooks, and the same result record
-// (bench/result_record.h).
+// (harness/result_record.h).
 
 #include "mcfbench/flow.h"
 
 #include "api/detail.h"
 
-#include "bench/memory_budget.h"
-#include "bench/progress.h"
-#include "bench/result_record.h"
 #include "flows/flow.h"
 #include "flows/memory_estimate.h"
+#include "harness/memory_budget.h"
+#include "harness/progress.h"
+#include "harness/result_record.h"
 #include "solvers/petsc_runtime.h"
 
 #include <cstdio>

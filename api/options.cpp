@@ -5,9 +5,9 @@
 #include "api/detail.h"
 #include "mcfbench/flow.h"
 
-#include "bench/json_path.h"
 #include "flows/config_reader.h"
 #include "flows/config_schema.h"
+#include "harness/json_path.h"
 
 #include <nlohmann/json.hpp>
 

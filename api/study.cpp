@@ -1,12 +1,12 @@
-// run() is `mcfbench run` (bench/run_with_progress.h) called in this process; results() reads a
+// run() is `mcfbench run` (harness/run_with_progress.h) called in this process; results() reads a
 // results folder's cell files into one table.
 
 #include "mcfbench/study.h"
 
 #include "api/detail.h"
 
-#include "bench/run_with_progress.h"
 #include "flows/config_reader.h"
+#include "harness/run_with_progress.h"
 
 #include <nlohmann/json.hpp>
 

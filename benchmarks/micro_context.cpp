@@ -1,9 +1,9 @@
 // The machine and commit of a mcfbench_micro run, in Google Benchmark's JSON context as
-// "mcfbench_environment" (the environment object of a result.json, bench/environment.h), so that
+// "mcfbench_environment" (the environment object of a result.json, harness/environment.h), so that
 // `mcfbench history add` (benchmarks/run_micro.sh) files micro-benchmark results under the same
 // machine identity and commit as the study results.
 
-#include "bench/environment.h"
+#include "harness/environment.h"
 
 #include <benchmark/benchmark.h>
 

@@ -16,7 +16,7 @@ namespace {
 
 // octree.stabilization_weight recorded where the system carries no such term (the hat basis, the
 // paper's system): the value every config recorded before the weight became the solver's, so
-// that those cells keep their config keys (bench/cell_hash.h). It changes nothing there.
+// that those cells keep their config keys (harness/cell_hash.h). It changes nothing there.
 constexpr double kInertStabilizationWeight = 0.5;
 
 // Bytes per input vertex and per octree function, least-squares fits (relative error) to the peak

@@ -60,7 +60,7 @@ nlohmann::json to_json(const FlowConfig& c) {
   nlohmann::json j = nlohmann::json::object();
   for (const OptionSpec& o : flow_config_schema()) {
     // when_set and when_selected: a key present where it changes nothing would change the config
-    // key of every cell (bench/cell_hash.h), and `compare` would find no cell of an earlier run
+    // key of every cell (harness/cell_hash.h), and `compare` would find no cell of an earlier run
     // to compare with.
     if (o.recorded == Recorded::when_set && o.get(c) == o.fallback) continue;
     if (o.recorded == Recorded::when_selected && !o.selected(c)) continue;

@@ -98,7 +98,7 @@ struct FlowConfig {
 /// name `source` and the key path) and fills defaults. Throws ConfigError.
 FlowConfig flow_config_from_json(const nlohmann::json& j, const std::string& source);
 /// The same without the cross-option checks (validate_flow_config): what a config asks for, to
-/// be checked or amended (bench/experiment_config.cpp drops the defaults a cell's components do
+/// be checked or amended (harness/experiment_config.cpp drops the defaults a cell's components do
 /// not read).
 FlowConfig flow_config_from_json_unchecked(const nlohmann::json& j, const std::string& source);
 /// The dotted keys set to a value other than their default although no component of `c` reads

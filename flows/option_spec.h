@@ -26,7 +26,7 @@ enum class Recorded {
   /// Only where the row that owns it is selected (a solver's own options), and
   when_selected,
   /// only with a value other than its default: a key present with its default would change the
-  /// config key of every cell (bench/cell_hash.h), and `compare` would find no cell of an earlier
+  /// config key of every cell (harness/cell_hash.h), and `compare` would find no cell of an earlier
   /// run to compare with.
   when_set,
 };

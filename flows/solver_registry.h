@@ -32,7 +32,7 @@ struct SolverRow {
   /// The options only this solver reads, keyed within "solver" ("stall_ratio"), read after the
   /// shared ones (solver_options()). Every config reads them; result.json records them only
   /// where this solver runs, so that the other solvers' cells keep the config keys
-  /// (bench/cell_hash.h) they had before the option existed.
+  /// (harness/cell_hash.h) they had before the option existed.
   std::vector<OptionSpec> options{};
   /// Starts from the warm start (the integrator's prediction) instead of solving exactly.
   bool iterative = false;

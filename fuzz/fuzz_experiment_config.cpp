@@ -3,9 +3,9 @@
 // refusal allowed; any other exception, a crash, a sanitizer report, a hang or unbounded memory
 // is a finding. Nothing is run: a cell's mesh spec is a string here.
 
-#include "bench/experiment_config.h"
 #include "flows/config_reader.h"
 #include "fuzz/fuzz_file.h"
+#include "harness/experiment_config.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -20,7 +20,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 DPI = 120
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-DEFAULT_REFERENCES = os.path.join(REPO_ROOT, "bench", "configs")
+DEFAULT_REFERENCES = os.path.join(REPO_ROOT, "harness", "configs")
 
 plt.rcParams.update({
     "figure.dpi": DPI,
@@ -91,7 +91,7 @@ def load_results(folder):
     return results
 
 
-PLAN_FOLDER = "plans"  # bench/runner.h kPlanFolder
+PLAN_FOLDER = "plans"  # harness/runner.h kPlanFolder
 
 
 def load_plans(folder):
@@ -263,7 +263,7 @@ def commit_of(result):
 
 
 def config_identity(result):
-    """Which configuration a result ran, repetitions aside: cell.config_key (bench/cell_hash.cpp:
+    """Which configuration a result ran, repetitions aside: cell.config_key (harness/cell_hash.cpp:
     the full config and the mesh's fingerprint, without the repetition, as `mcfbench compare`
     pools repetitions), else (results without it) the cell's study, quick flag and assignment,
     else the file itself (a plain `mcfbench flow` run)."""
@@ -328,7 +328,7 @@ def commits_note(study, info):
 
 def contended(result):
     """Whether the cell shared its cores with other work while it ran (`contention.contended`,
-    bench/contention.h): its times are not a measurement of its method."""
+    harness/contention.h): its times are not a measurement of its method."""
     return bool(get(result, "contention.contended", False))
 
 
@@ -399,7 +399,7 @@ def is_singular(result):
 
 
 def load_reference(study, references_dir):
-    """bench/configs/<study>.reference.json as a dict, or None when absent or unreadable."""
+    """harness/configs/<study>.reference.json as a dict, or None when absent or unreadable."""
     if not references_dir:
         return None
     p = os.path.join(references_dir, study + ".reference.json")

@@ -2,7 +2,7 @@
 """Regenerate the studies' figures and tables from result folders.
 
 usage: /usr/bin/python3 reports/make_report.py RESULTS_DIR [RESULTS_DIR ...] OUT_DIR
-                                               [--references bench/configs] [--require-complete]
+                                               [--references harness/configs] [--require-complete]
 
 Each results folder holds one study's result JSON files (index.json ignored); results are
 grouped by cell.study and handed to the study's module; frames strips are drawn for any study
@@ -37,7 +37,7 @@ import study_manifest  # noqa: E402
 # report left it.
 STAGING_FOLDER = ".report-staging"
 
-# The studies with a report module of their name, in the report's order (bench/configs/studies.json).
+# The studies with a report module of their name, in the report's order (harness/configs/studies.json).
 STUDIES = study_manifest.names()
 
 
@@ -45,7 +45,7 @@ def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("paths", nargs="+", metavar="DIR", help="results folder(s), then the output folder")
     p.add_argument("--references", default=common.DEFAULT_REFERENCES,
-                   help="folder of <study>.reference.json paper values (default: bench/configs)")
+                   help="folder of <study>.reference.json paper values (default: harness/configs)")
     p.add_argument("--require-complete", action="store_true",
                    help="write nothing and exit 1 if a planned cell has no result, a cell errored, a "
                         "plan is unreadable or a results folder is missing or empty")

@@ -69,7 +69,7 @@ def median(v):
 
 def mann_whitney_p(a, b):
     """Two-sided p of the U test (normal approximation, tie and continuity corrected), as
-    bench/compare.cpp computes it; 1 when either side is empty or everything ties."""
+    harness/compare.cpp computes it; 1 when either side is empty or everything ties."""
     n1, n2 = len(a), len(b)
     if n1 == 0 or n2 == 0:
         return 1.0

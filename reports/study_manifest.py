@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The list of studies, read from its one source, bench/configs/studies.json.
+"""The list of studies, read from its one source, harness/configs/studies.json.
 
 usage: /usr/bin/python3 reports/study_manifest.py [--default] [--manifest FILE]
 
@@ -14,7 +14,7 @@ import os
 import sys
 
 MANIFEST = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
-                        "bench", "configs", "studies.json")
+                        "harness", "configs", "studies.json")
 
 
 class ManifestError(Exception):
@@ -46,7 +46,7 @@ def names(path=MANIFEST, default_only=False):
 def main(argv):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--default", action="store_true", help="only the studies run when none is named")
-    p.add_argument("--manifest", default=MANIFEST, help="the manifest (default: bench/configs/studies.json)")
+    p.add_argument("--manifest", default=MANIFEST, help="the manifest (default: harness/configs/studies.json)")
     args = p.parse_args(argv)
     try:
         print("\n".join(names(args.manifest, args.default)))

@@ -3,7 +3,7 @@
 dimension, set-up time, per-step system update + solve for tracked and rebuilt octrees, and the
 tracked-vs-rebuilt speed-up, with the paper's row beside ours when the reference file has one.
 
-Reference format (bench/configs/table1.reference.json), read if present:
+Reference format (harness/configs/table1.reference.json), read if present:
   {"rows": [{"model": "Bimba", "mesh": "<our stand-in spec, optional>", "depth": 8,
              "input_vertices": 3.0e5, "split_triangles": 2.7e6, "dimension": 3.4e5,
              "setup_seconds": 4, "system_seconds": 3, "update_seconds": 0.9, "solve_seconds": 0.14}]}

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job on a small default: set-up, build, then the quick variant of the studies
-# bench/configs/studies.json marks run_by_default (scripts/run_studies.sh's default; minutes on 2
+# harness/configs/studies.json marks run_by_default (scripts/run_studies.sh's default; minutes on 2
 # cores) and the report with every figure and table:
 #   out/demo/results/<study>/*.json   out/demo/report/index.md (+ PNG, Markdown)
 set -euo pipefail

@@ -7,7 +7,7 @@
 #                                               run, so a finding is reproducible (CI: fuzz_smoke)
 #   scripts/fuzz.sh --build-only [TARGET...]    configure and build only (scripts/test.sh)
 # A timed run starts each target from its seeds (fuzz/corpus/TARGET/; the experiment config's
-# from bench/configs/) and keeps what it learns in BUILD/corpus/TARGET/, so a second run goes on
+# from harness/configs/) and keeps what it learns in BUILD/corpus/TARGET/, so a second run goes on
 # from there. A crash, hang (-timeout=10), leak or out-of-memory (-rss_limit_mb=2048) input is
 # written to BUILD/findings/TARGET/. Prints executions and findings per target; exits 1 if any
 # target found something, 2 on a usage or build error. Build jobs: $MCFBENCH_JOBS (default: all
@@ -50,7 +50,7 @@ cmake --build "$build" --parallel "${MCFBENCH_JOBS:-$(nproc)}" --target "${targe
 # The seeds of a target, copied into the folder $2 (existing files are kept).
 seed() {
   if [ -d "$root/fuzz/corpus/$1" ]; then cp -n "$root/fuzz/corpus/$1"/* "$2"/; fi
-  if [ "$1" = fuzz_experiment_config ]; then cp -n "$root"/bench/configs/*.json "$2"/; fi
+  if [ "$1" = fuzz_experiment_config ]; then cp -n "$root"/harness/configs/*.json "$2"/; fi
 }
 
 scratch=""

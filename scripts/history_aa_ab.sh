@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # How often the performance gate (scripts/perf_gate.sh) cries wolf, and whether it catches a
 # known slowdown, on this machine: `history_aa_ab.sh [CONFIG [COMMIT]]` (default
-# bench/configs/table1.json, its quick variant, at HEAD).
+# harness/configs/table1.json, its quick variant, at HEAD).
 #   A/A: $AA_TRIALS gate runs (default 20) of COMMIT against itself; a "regression" is a false
 #        alarm (the target: none in at least 19 of 20).
 #   A/B: $AB_TRIALS gate runs (default 5) of COMMIT against itself with a slowdown of
@@ -19,7 +19,7 @@
 # MCFBENCH_GATE_THRESHOLD, MCFBENCH_HISTORY_BUILDS, ...) pass through.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-config=$(realpath "${1:-$root/bench/configs/table1.json}")
+config=$(realpath "${1:-$root/harness/configs/table1.json}")
 repo=${MCFBENCH_GATE_REPO:-$(git rev-parse --show-toplevel 2>/dev/null || echo "$root")}
 commit=$(git -C "$repo" rev-parse "${2:-HEAD}^{commit}")
 aa=${AA_TRIALS:-20}

@@ -30,7 +30,7 @@ class PetscRuntime {
  public:
   /// The session, started on the first call: PetscInitialize (which starts MPI unless the
   /// process already did) with PETSc's signal handler off (the harness handles SIGINT/SIGTERM
-  /// itself: bench/stop_signals.h) and its errors returned as codes instead of printed
+  /// itself: harness/stop_signals.h) and its errors returned as codes instead of printed
   /// tracebacks, so a failed call becomes a PetscFailure with PETSc's message. Throws
   /// PetscUnavailable without PETSc, PetscFailure when the initialization fails.
   static PetscRuntime& instance();

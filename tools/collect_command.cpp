@@ -1,7 +1,7 @@
 // `mcfbench collect DIR...`: the flags of merging result folders into one index file and
-// checking that every cell is there once (bench/collect.h).
+// checking that every cell is there once (harness/collect.h).
 
-#include "bench/collect.h"
+#include "harness/collect.h"
 #include "tools/commands.h"
 
 #include <memory>

@@ -1,7 +1,7 @@
 #pragma once
 // The mcfbench subcommands; each registers its options on the CLI11 app and returns the
 // callback's exit status through run(). A command only parses its flags and calls one function
-// of a lower layer (bench/, datasets/), which holds the logic and is tested there.
+// of a lower layer (harness/, datasets/), which holds the logic and is tested there.
 
 #include <CLI/CLI.hpp>
 

@@ -1,9 +1,9 @@
 // `mcfbench compare OLD NEW`: the flags of the regression check between two result sets
-// (bench/compare.h: exit 1 when a cell got significantly slower or less accurate; sets of
+// (harness/compare.h: exit 1 when a cell got significantly slower or less accurate; sets of
 // different machines refused unless --allow-cross-machine), NEW optionally stored in the
 // performance history (`mcfbench history`).
 
-#include "bench/compare.h"
+#include "harness/compare.h"
 #include "tools/commands.h"
 
 #include <memory>

@@ -1,8 +1,8 @@
 // `mcfbench distance A B`: the flags of the Metro-style distance between two surfaces
-// (bench/surface_distance.h).
+// (harness/surface_distance.h).
 
-#include "bench/surface_distance.h"
 #include "datasets/mesh_spec.h"
+#include "harness/surface_distance.h"
 #include "tools/commands.h"
 
 #include <cstdio>

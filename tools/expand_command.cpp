@@ -1,7 +1,7 @@
 // `mcfbench expand CONFIG.json`: the flags of listing the cells of an experiment matrix without
-// running them (bench/cell_listing.h).
+// running them (harness/cell_listing.h).
 
-#include "bench/cell_listing.h"
+#include "harness/cell_listing.h"
 #include "tools/commands.h"
 
 #include <cstdio>

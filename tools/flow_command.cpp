@@ -1,10 +1,10 @@
 // `mcfbench flow`: the flags of one flow, written to OUT/result.json and OUT/final.ply (+ frames)
-// by bench/flow_folder.h. Every flag but --config, --max-memory and --out is an option of the
+// by harness/flow_folder.h. Every flag but --config, --max-memory and --out is an option of the
 // flow config's schema (flows/config_schema.h), made from it with its help.
 
-#include "bench/flow_folder.h"
 #include "datasets/mesh_spec.h"
 #include "flows/config_schema.h"
+#include "harness/flow_folder.h"
 #include "tools/commands.h"
 
 #include <deque>

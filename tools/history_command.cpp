@@ -1,7 +1,7 @@
 // `mcfbench history COMMAND ...`: every argument after `history` goes to the history tool
-// (bench/history_tool.h, reports/perf_history.py), which parses it.
+// (harness/history_tool.h, reports/perf_history.py), which parses it.
 
-#include "bench/history_tool.h"
+#include "harness/history_tool.h"
 #include "tools/commands.h"
 
 namespace mcf {

@@ -1,8 +1,8 @@
 // `mcfbench run CONFIG.json`: the flags of running an experiment matrix (or one shard of it),
-// one result file per cell (bench/run_with_progress.h); rerunning skips finished cells and
+// one result file per cell (harness/run_with_progress.h); rerunning skips finished cells and
 // retries errored ones, so a killed or failed run is resumed by running it again.
 
-#include "bench/run_with_progress.h"
+#include "harness/run_with_progress.h"
 #include "tools/commands.h"
 
 #include <memory>
@@ -27,7 +27,7 @@ void add_run_command(CLI::App& app, std::function<int()>& run) {
       "reference\n"
       "cells that other shards computed, and `mcfbench collect results/NAME` checks that every "
       "cell is there.\n"
-      "Config format: see bench/experiment_config.h and bench/configs/.");
+      "Config format: see harness/experiment_config.h and harness/configs/.");
   cmd->add_option("config", a->config, "Experiment config (JSON)")->required();
   cmd->add_option("--out", a->out,
                   "Results folder (default results/NAME, or results/NAME-quick with --quick)");

@@ -1,8 +1,8 @@
 // `mcfbench submit CONFIG.json --out DIR`: the flags of running an experiment matrix on a Slurm
 // cluster, a job array over its shards and a job that collects and reports once the array has
-// ended (bench/slurm_submit.h).
+// ended (harness/slurm_submit.h).
 
-#include "bench/slurm_submit.h"
+#include "harness/slurm_submit.h"
 #include "tools/commands.h"
 
 #include <memory>

@@ -4,7 +4,7 @@
 
 usage: check_lists.py --root REPO
 
-- The studies, bench/configs/studies.json: each has its config bench/configs/<name>.json and its
+- The studies, harness/configs/studies.json: each has its config harness/configs/<name>.json and its
   report module reports/<name>.py; every experiment config of the folder is a study or an example;
   docs/studies.md's table lists them in the manifest's order; README.md's count of the studies
   demo.sh runs is the number marked run_by_default.
@@ -67,20 +67,20 @@ def check_layers(root, errors):
 
 
 def check_studies(root, errors):
-    path = "bench/configs/studies.json"
+    path = "harness/configs/studies.json"
     manifest = json.loads(read(root, path))
     studies = [s["name"] for s in manifest["studies"]]
     default = [s["name"] for s in manifest["studies"] if s.get("run_by_default")]
     examples = manifest.get("examples", [])
     for name in studies:
-        for need in ("bench/configs/%s.json" % name, "reports/%s.py" % name):
+        for need in ("harness/configs/%s.json" % name, "reports/%s.py" % name):
             if not os.path.isfile(os.path.join(root, need)):
                 errors.append("%s: study %s has no %s" % (path, name, need))
-    configs = sorted(f[:-5] for f in os.listdir(os.path.join(root, "bench", "configs"))
+    configs = sorted(f[:-5] for f in os.listdir(os.path.join(root, "harness", "configs"))
                      if f.endswith(".json") and ".reference." not in f and f != "studies.json")
     for name in configs:
         if name not in studies and name not in examples:
-            errors.append("%s: bench/configs/%s.json is neither a study nor an example" % (path, name))
+            errors.append("%s: harness/configs/%s.json is neither a study nor an example" % (path, name))
     table = re.findall(r"^\| \[`([a-z_0-9]+)`\]\(#", read(root, "docs/studies.md"), re.M)
     if table != studies:
         errors.append("docs/studies.md: the table lists %s; %s has %s" % (table, path, studies))

@@ -55,7 +55,7 @@ def step(n, dt, errscale=1e-4, extra=None, slow=1.0, residual=1e-2):
 
 def result(study, index, assignment, config, steps, status="ok", reason="completed", repetition=0, commit="fake",
            quick=False, **more):
-    """A result file's dict; cell.key names the repetition, cell.config_key does not (bench/cell_hash.cpp)."""
+    """A result file's dict; cell.key names the repetition, cell.config_key does not (harness/cell_hash.cpp)."""
     r = {"schema": 1, "status": status, "stop": {"step": len(steps), "reason": reason},
          "config": config, "steps": steps,
          "environment": {"commit": commit, "cpu": "fake", "cores": 2, "threads": 2, "libraries": {}},
@@ -118,7 +118,7 @@ def write_plan(folder, study, shard=(0, 1), cells=None, commit="fake", quick=Fal
     os.makedirs(os.path.dirname(path), exist_ok=True)
     with open(path, "w") as f:
         json.dump({"schema": 1, "plan": "mcfbench run", "study": study, "quick": quick, "commit": commit,
-                   "source": "bench/configs/%s.json" % study, "shard": "%d/%d" % (i, n),
+                   "source": "harness/configs/%s.json" % study, "shard": "%d/%d" % (i, n),
                    "cells_total": len(listed), "cells": listed, "study_config": {"name": study}}, f, indent=1)
     return path
 
@@ -341,7 +341,7 @@ def main(root):
         f.write('{"config": {')
     with open(os.path.join(root, "cubature", "notes.json"), "w") as f:
         json.dump([1, 2, 3], f)
-    # The plans `mcfbench run` writes before its first cell (RESULTS_DIR/plans/, bench/runner.cpp
+    # The plans `mcfbench run` writes before its first cell (RESULTS_DIR/plans/, harness/runner.cpp
     # run_plan): every cell is planned and has its result, so the report is complete. depth_cycles
     # ran as two shards, whose plans list every cell and name the hashes of their own.
     for s in ("table1", "sphere_error", "model_error", "cubature", "cmcf", "time_order"):

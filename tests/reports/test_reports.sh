@@ -221,7 +221,7 @@ done
 "$py" "$root/reports/make_report.py" $solo "$work/solo_out" >"$work/solo_log" 2>&1 \
   || { cat "$work/solo_log"; echo "FAIL: make_report.py on one-cell studies"; fail=1; }
 [ -s "$work/solo_out/index.md" ] || { echo "FAIL: no index for one-cell studies"; fail=1; }
-# Repetitions: a study run with "repetitions": 2 draws repetition 0 of each cell once (bench/cell_hash.cpp's
+# Repetitions: a study run with "repetitions": 2 draws repetition 0 of each cell once (harness/cell_hash.cpp's
 # cell.key names the repetition; cell.config_key does not), so its figures and tables are those of the
 # same study run once: cubature's three curves, time_order's fits (each δ once, the counts of stable runs).
 "$py" "$root/reports/make_report.py" "$work/results/cubature" "$work/results/time_order" "$work/once" \

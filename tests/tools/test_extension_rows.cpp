@@ -1,5 +1,5 @@
 // The extension rows from the outside: the example solver of examples/ runs through `flow`, `run`
-// and `expand` without an edit to flows/, bench/ or tools/, and the option table of docs/flow.md,
+// and `expand` without an edit to flows/, harness/ or tools/, and the option table of docs/flow.md,
 // `mcfbench flow --help` and the config reader agree with the schema they are made from.
 
 #include "datasets/mesh_io.h"

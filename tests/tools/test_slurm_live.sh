@@ -25,7 +25,7 @@ set -u
 mcfbench=${1:?usage: test_slurm_live.sh MCFBENCH}
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
-config=$root/bench/configs/model_error.json
+config=$root/harness/configs/model_error.json
 py=/usr/bin/python3
 
 if [ "$(id -u)" != 0 ]; then
