@@ -1,11 +1,13 @@
 #include "distributed/rank_system.h"
 
 #include "distributed/comm.h"
-#include "distributed/rank_hierarchy.h"
+#include "distributed/rank_block_cg.h"
+#include "distributed/rank_multigrid.h"
 #include "solvers/petsc_runtime.h"
 #include "solvers/petsc_solver.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -122,21 +124,20 @@ struct RankSystem::Impl {
 
   Mat A = nullptr;
   Vec b = nullptr, x = nullptr, r = nullptr, shift = nullptr;
-  Vec ghosted = nullptr;  // block size 3: the owned rows' xyz, then the ghosts'
-  KSP ksp = nullptr, cg = nullptr, direct = nullptr;
-  std::vector<Mat> interpolations;
-  bool guarded = false;        // fixed multigrid cycles with a residual bound
-  bool prefer_direct = false;  // an earlier step needed the factorization
+  Vec ghosted = nullptr;                     // block size 3: the owned rows' xyz, then the ghosts'
+  KSP ksp = nullptr, direct = nullptr;       // solver "petsc"; MUMPS, the guard's last step
+  std::unique_ptr<RankMultigrid> multigrid;  // solvers "multigrid" and "pcg"
+  bool guarded = false;                      // fixed multigrid cycles with a residual bound
+  bool prefer_direct = false;                // an earlier step needed the factorization
   int level_count = 1;
 
   Impl(const RankMesh& m, MassKind mass, RankSolverOptions o)
       : mesh(m), options(std::move(o)), basis(TriangleMesh{m.vertices, m.faces}, mass) {}
 
   ~Impl() {
+    multigrid.reset();
     if (ksp) KSPDestroy(&ksp);
-    if (cg) KSPDestroy(&cg);
     if (direct) KSPDestroy(&direct);
-    for (Mat& p : interpolations) MatDestroy(&p);
     if (A) MatDestroy(&A);
     for (Vec* v : {&b, &x, &r, &shift, &ghosted})
       if (*v) VecDestroy(v);
@@ -203,73 +204,6 @@ struct RankSystem::Impl {
     return k;
   }
 
-  /// The surface multigrid as PETSc's PCMG on `pc`: the per-partition hierarchy's
-  /// prolongations, Galerkin coarse operators, `smooth` forward SOR sweeps down and as many
-  /// backward sweeps up (a symmetric cycle, as CG needs), the coarsest level solved redundantly.
-  void set_multigrid(PC pc) {
-    const RankHierarchy h = build_rank_hierarchy(mesh, std::max(100, 1000 / mesh.ranks));
-    level_count = h.levels();
-    petsc_check(PCSetType(pc, PCMG), "PCSetType");
-    petsc_check(PCMGSetLevels(pc, level_count, nullptr), "PCMGSetLevels");
-    if (interpolations.empty()) {
-      // Level sizes on this rank, finest last; global offsets by a scan over the ranks.
-      std::vector<PetscInt> local(static_cast<std::size_t>(level_count));
-      local.back() = mesh.owned;
-      for (int l = 0; l + 1 < level_count; ++l)
-        local[std::size_t(l)] = PetscInt(h.prolongations[std::size_t(l)].cols());
-      std::vector<PetscInt> offset(local.size()), total(local.size());
-      for (std::size_t l = 0; l < local.size(); ++l) {
-        PetscInt end = 0;
-        petsc_check(MPI_Scan(&local[l], &end, 1, MPIU_INT, MPI_SUM, comm), "MPI_Scan");
-        offset[l] = end - local[l];
-        petsc_check(MPI_Allreduce(&local[l], &total[l], 1, MPIU_INT, MPI_SUM, comm),
-                    "MPI_Allreduce");
-      }
-      for (int l = 0; l + 1 < level_count; ++l) {
-        const SparseMatrix& P = h.prolongations[std::size_t(l)];  // fine x coarse, CSC
-        const SparseMatrix rows = P.transpose();                  // coarse x fine: CSC of rows
-        std::vector<PetscInt> pia(std::size_t(rows.cols()) + 1), pja;
-        std::vector<PetscScalar> pv;
-        for (Eigen::Index i = 0; i < rows.cols(); ++i) {
-          for (auto p = rows.outerIndexPtr()[i]; p < rows.outerIndexPtr()[i + 1]; ++p) {
-            pja.push_back(offset[std::size_t(l)] + rows.innerIndexPtr()[p]);
-            pv.push_back(rows.valuePtr()[p]);
-          }
-          pia[std::size_t(i) + 1] = PetscInt(pja.size());
-        }
-        Mat Pm = nullptr;
-        petsc_check(
-            MatCreateMPIAIJWithArrays(comm, local[std::size_t(l) + 1], local[std::size_t(l)],
-                                      total[std::size_t(l) + 1], total[std::size_t(l)], pia.data(),
-                                      pja.data(), pv.data(), &Pm),
-            "MatCreateMPIAIJWithArrays");
-        interpolations.push_back(Pm);
-      }
-    }
-    for (int l = 1; l < level_count; ++l)
-      petsc_check(PCMGSetInterpolation(pc, l, interpolations[std::size_t(l) - 1]),
-                  "PCMGSetInterpolation");
-    petsc_check(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH), "PCMGSetGalerkin");
-  }
-
-  /// Options of the surface multigrid's PC under the prefix (the cycle, the smoothers, the
-  /// coarse solve); `pc` is "mg_" for the PCs of the solver and of the guard's CG alike.
-  std::string multigrid_options() const {
-    char text[512];
-    std::snprintf(text, sizeof text,
-                  "-pc_mg_cycle_type %s -pc_mg_distinct_smoothup "
-                  "-mg_levels_ksp_type richardson -mg_levels_ksp_max_it %d "
-                  "-mg_levels_ksp_norm_type none -mg_levels_pc_type sor "
-                  "-mg_levels_pc_sor_local_forward "
-                  "-mg_levels_up_ksp_type richardson -mg_levels_up_ksp_max_it %d "
-                  "-mg_levels_up_ksp_norm_type none -mg_levels_up_pc_type sor "
-                  "-mg_levels_up_pc_sor_local_backward "
-                  "-mg_coarse_ksp_type preonly -mg_coarse_pc_type redundant "
-                  "-mg_coarse_redundant_pc_type cholesky",
-                  options.cycle == "V" ? "v" : "w", options.smooth, options.smooth);
-    return text;
-  }
-
   void make_solver() {
     prefix = PetscRuntime::instance().new_prefix();
     char numbers[160];
@@ -287,41 +221,18 @@ struct RankSystem::Impl {
         petsc_check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
       return;
     }
-    const bool cycles_only = options.solver == "multigrid" && options.tolerance <= 0;
-    if (options.solver == "multigrid") {
-      // Fixed cycles: Richardson on the cycle, `cycles` of them, no test in between; with a
-      // tolerance, cycles until it, at most `cycles` (as the one-process multigrid counts).
-      std::snprintf(numbers, sizeof numbers,
-                    "-ksp_type richardson -ksp_richardson_scale 1 -ksp_max_it %d -ksp_rtol %.17g "
-                    "-ksp_norm_type %s -ksp_initial_guess_nonzero true ",
-                    options.cycles, cycles_only ? 0.0 : options.tolerance,
-                    cycles_only ? "none" : "unpreconditioned");
-    } else {
-      std::snprintf(numbers, sizeof numbers,
-                    "-ksp_type cg -ksp_max_it %d -ksp_rtol %.17g -ksp_norm_type unpreconditioned "
-                    "-ksp_initial_guess_nonzero true ",
-                    options.max_iterations, options.tolerance);
-    }
-    inserted = std::string(numbers) + multigrid_options();
-    ksp = make_ksp(inserted);
-    PC pc = nullptr;
-    petsc_check(KSPGetPC(ksp, &pc), "KSPGetPC");
-    set_multigrid(pc);
-    petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
-    guarded = cycles_only && options.residual_bound > 0;
-    if (guarded) {
-      // The guard: CG preconditioned by the same cycle (the same PC object) to the bound, and a
-      // distributed Cholesky factorization (MUMPS) after `direct_after` iterations.
-      petsc_check(KSPCreate(comm, &cg), "KSPCreate");
-      petsc_check(KSPSetOperators(cg, A, A), "KSPSetOperators");
-      petsc_check(KSPSetType(cg, KSPCG), "KSPSetType");
-      petsc_check(KSPSetPC(cg, pc), "KSPSetPC");
-      petsc_check(KSPSetNormType(cg, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
-      petsc_check(KSPSetInitialGuessNonzero(cg, PETSC_TRUE), "KSPSetInitialGuessNonzero");
-      petsc_check(KSPSetTolerances(cg, options.residual_bound, PETSC_DEFAULT, PETSC_DEFAULT,
-                                   std::max(options.direct_after, 1)),
-                  "KSPSetTolerances");
-    }
+    // The surface multigrid across ranks, three columns at a time (rank_multigrid.h): fixed
+    // cycles (tolerance 0) converged only at the residual bound, where CG by the cycle and then
+    // MUMPS take over; cycles to a tolerance; or CG preconditioned by one cycle.
+    multigrid =
+        std::make_unique<RankMultigrid>(mesh, RankCycle{options.cycle != "V", options.smooth});
+    level_count = multigrid->levels();
+    guarded = options.solver == "multigrid" && options.tolerance <= 0 && options.residual_bound > 0;
+    std::snprintf(numbers, sizeof numbers, "%s(%d,%d) %s, %d levels, coarsest %lld vertices",
+                  options.cycle == "V" ? "V" : "W", options.smooth, options.smooth,
+                  options.solver == "multigrid" ? "cycles" : "preconditioning CG", level_count,
+                  multigrid->coarsest_size());
+    inserted = numbers;
   }
 
   void make_direct() {
@@ -342,6 +253,170 @@ struct RankSystem::Impl {
     petsc_check(VecNorm(r, NORM_2, &rn), "VecNorm");
     petsc_check(VecNorm(b, NORM_2, &bn), "VecNorm");
     return bn > 0 ? rn / bn : rn;
+  }
+
+  void load_column(Vec v, const Coefficients& X, int c) {
+    PetscScalar* w = nullptr;
+    petsc_check(VecGetArray(v, &w), "VecGetArray");
+    for (int i = 0; i < mesh.owned; ++i) w[i] = X(i, c);
+    petsc_check(VecRestoreArray(v, &w), "VecRestoreArray");
+  }
+  void store_column(Vec v, Coefficients& X, int c) {
+    const PetscScalar* w = nullptr;
+    petsc_check(VecGetArrayRead(v, &w), "VecGetArrayRead");
+    for (int i = 0; i < mesh.owned; ++i) X(i, c) = w[i];
+    petsc_check(VecRestoreArrayRead(v, &w), "VecRestoreArrayRead");
+  }
+
+  /// Solver "petsc": PETSc's KSP on each coordinate in turn.
+  void solve_columns(const Coefficients& rhs, const Coefficients& start, Coefficients& Y,
+                     SolveReport& report) {
+    for (int c = 0; c < 3; ++c) {
+      load_column(b, rhs, c);
+      load_column(x, start, c);
+      petsc_check(KSPSolve(ksp, b, x), "KSPSolve");
+      KSPConvergedReason reason;
+      PetscInt its = 0;
+      petsc_check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+      petsc_check(KSPGetIterationNumber(ksp, &its), "KSPGetIterationNumber");
+      ColumnReport column;
+      column.iterations = int(its);
+      column.reason = reason_name(reason);
+      column.relative_residual = relative_residual();
+      const SolveStatus status = status_of(reason);
+      if (severity(status) > severity(report.status)) report.status = status;
+      report.iterations += column.iterations;
+      report.relative_residual = std::max(report.relative_residual, column.relative_residual);
+      report.residuals.push_back(column.relative_residual);
+      report.columns.push_back(column);
+      store_column(x, Y, c);
+    }
+  }
+
+  /// Solvers "multigrid" and "pcg": the three coordinates together (rank_multigrid.h,
+  /// rank_block_cg.h); a guarded step above its bound goes on with CG by the cycle, then MUMPS
+  /// on each coordinate still above it.
+  void solve_blocks(const Coefficients& rhs, const Coefficients& start, Coefficients& Y,
+                    SolveReport& report) {
+    const int n = mesh.owned;
+    multigrid->set_operator(A);
+    std::vector<double> B(4 * std::size_t(n), 0.0), X(4 * std::size_t(n), 0.0);
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        B[4 * std::size_t(i) + std::size_t(c)] = rhs(i, c);
+        X[4 * std::size_t(i) + std::size_t(c)] = start(i, c);
+      }
+    std::array<int, 3> iterations{0, 0, 0};
+    std::array<std::string, 3> reasons;
+    std::array<SolveStatus, 3> status{SolveStatus::converged, SolveStatus::converged,
+                                      SolveStatus::converged};
+    std::array<double, 3> rel{};
+    if (options.solver == "pcg") {
+      const BlockCgReport cg = block_cg(*multigrid, B.data(), X.data(), {true, true, true},
+                                        options.tolerance, options.max_iterations);
+      rel = relative_residuals(*multigrid, B.data(), X.data());
+      for (std::size_t c = 0; c < 3; ++c) {
+        iterations[c] = cg.iterations[c];
+        status[c] = cg.converged[c]   ? SolveStatus::converged
+                    : cg.breakdown[c] ? SolveStatus::numerical_issue
+                                      : SolveStatus::max_iterations;
+        reasons[c] = cg.converged[c]   ? "CG converged to the tolerance"
+                     : cg.breakdown[c] ? "CG broke down (p'Ap <= 0)"
+                                       : "CG reached its iteration limit";
+      }
+    } else if (options.tolerance > 0) {
+      // Cycles until every coordinate is at the tolerance, at most `cycles`.
+      rel = relative_residuals(*multigrid, B.data(), X.data());
+      const double first = *std::max_element(rel.begin(), rel.end());
+      int k = 0;
+      const auto above = [&]() {
+        return *std::max_element(rel.begin(), rel.end()) > options.tolerance;
+      };
+      while (k < options.cycles && above()) {
+        multigrid->cycle(B.data(), X.data());
+        ++k;
+        rel = relative_residuals(*multigrid, B.data(), X.data());
+        for (std::size_t c = 0; c < 3; ++c)
+          if (iterations[c] == 0 && rel[c] <= options.tolerance) iterations[c] = k;
+      }
+      const double last = *std::max_element(rel.begin(), rel.end());
+      if (k > 0 && first > 0 && last > 0) report.contraction = std::pow(last / first, 1.0 / k);
+      for (std::size_t c = 0; c < 3; ++c) {
+        const bool met = rel[c] <= options.tolerance;
+        if (!met) iterations[c] = k;
+        status[c] = met ? SolveStatus::converged : SolveStatus::max_iterations;
+        reasons[c] = met ? "cycles to the tolerance" : "cycles reached their limit";
+      }
+    } else {
+      for (int k = 0; k < options.cycles; ++k) multigrid->cycle(B.data(), X.data());
+      rel = relative_residuals(*multigrid, B.data(), X.data());
+      iterations.fill(options.cycles);
+      reasons.fill(guarded ? "cycles under the bound" : "fixed cycles");
+      if (guarded) guard(B, X, rel, iterations, reasons, status, report);
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      if (!std::isfinite(rel[c])) status[c] = SolveStatus::numerical_issue;
+      ColumnReport column;
+      column.iterations = iterations[c];
+      column.relative_residual = rel[c];
+      column.reason = reasons[c];
+      if (severity(status[c]) > severity(report.status)) report.status = status[c];
+      report.iterations = std::max(report.iterations, iterations[c]);
+      report.relative_residual = std::max(report.relative_residual, rel[c]);
+      report.residuals.push_back(rel[c]);
+      report.columns.push_back(column);
+    }
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) Y(i, c) = X[4 * std::size_t(i) + std::size_t(c)];
+  }
+
+  /// Fixed cycles ended above the residual bound in some coordinates: CG preconditioned by the
+  /// cycle to the bound (at most `direct_after` iterations; skipped once a step needed more),
+  /// then MUMPS on the coordinates still above it.
+  void guard(std::vector<double>& B, std::vector<double>& X, std::array<double, 3>& rel,
+             std::array<int, 3>& iterations, std::array<std::string, 3>& reasons,
+             std::array<SolveStatus, 3>& status, SolveReport& report) {
+    const double bound = options.residual_bound;
+    const auto above = [&](std::size_t c) { return std::isfinite(rel[c]) && rel[c] > bound; };
+    std::array<bool, 3> active{above(0), above(1), above(2)};
+    if (!active[0] && !active[1] && !active[2]) return;
+    if (!prefer_direct) {
+      const BlockCgReport cg = block_cg(*multigrid, B.data(), X.data(), active, bound,
+                                        std::max(options.direct_after, 1));
+      rel = relative_residuals(*multigrid, B.data(), X.data());
+      for (std::size_t c = 0; c < 3; ++c)
+        if (active[c]) {
+          iterations[c] += cg.iterations[c];
+          report.fallback_iterations += cg.iterations[c];
+          reasons[c] = "CG preconditioned by the cycle took over";
+        }
+      report.message = joined_messages(report.message, "CG preconditioned by the cycle took over");
+    }
+    active = {above(0), above(1), above(2)};
+    if (options.direct_after > 0 && (active[0] || active[1] || active[2])) {
+      if (!direct) make_direct();
+      Coefficients Xc(mesh.owned, 3);
+      for (int c = 0; c < 3; ++c) {
+        if (!active[std::size_t(c)]) continue;
+        for (int i = 0; i < mesh.owned; ++i) {
+          Xc(i, 0) = B[4 * std::size_t(i) + std::size_t(c)];
+          Xc(i, 1) = X[4 * std::size_t(i) + std::size_t(c)];
+        }
+        load_column(b, Xc, 0);
+        load_column(x, Xc, 1);
+        petsc_check(KSPSolve(direct, b, x), "KSPSolve");
+        store_column(x, Xc, 1);
+        for (int i = 0; i < mesh.owned; ++i) X[4 * std::size_t(i) + std::size_t(c)] = Xc(i, 1);
+        reasons[std::size_t(c)] = "a distributed Cholesky factorization (MUMPS) solved it";
+      }
+      prefer_direct = true;
+      report.direct_fallback = true;
+      rel = relative_residuals(*multigrid, B.data(), X.data());
+      report.message =
+          joined_messages(report.message, "a distributed Cholesky factorization (MUMPS) solved it");
+    }
+    for (std::size_t c = 0; c < 3; ++c)
+      if (above(c)) status[c] = SolveStatus::max_iterations;
   }
 };
 
@@ -431,9 +506,7 @@ SolveReport RankSystem::solve(double a, double b, const Coefficients& R, const C
                                           s.ja.data(), s.values.data()),
                 "MatUpdateMPIAIJWithArrays");
     // Right-hand sides with the held values moved over (before the held rows and columns go).
-    std::vector<std::vector<PetscScalar>> rhs(3, std::vector<PetscScalar>(std::size_t(n)));
-    for (int c = 0; c < 3; ++c)
-      for (int i = 0; i < n; ++i) rhs[std::size_t(c)][std::size_t(i)] = R(i, c);
+    Coefficients rhs = R;
     if (held_global_ > 0) {
       for (int c = 0; c < 3; ++c) {
         petsc_check(VecSet(s.shift, 0.0), "VecSet");
@@ -444,80 +517,26 @@ SolveReport RankSystem::solve(double a, double b, const Coefficients& R, const C
         petsc_check(MatMult(s.A, s.shift, s.r), "MatMult");
         const PetscScalar* w = nullptr;
         petsc_check(VecGetArrayRead(s.r, &w), "VecGetArrayRead");
-        for (int i = 0; i < n; ++i) rhs[std::size_t(c)][std::size_t(i)] -= w[i];
+        for (int i = 0; i < n; ++i) rhs(i, c) -= w[i];
         petsc_check(VecRestoreArrayRead(s.r, &w), "VecRestoreArrayRead");
-        for (const int i : held_) rhs[std::size_t(c)][std::size_t(i)] = held(i, c);
+        for (const int i : held_) rhs(i, c) = held(i, c);
       }
       petsc_check(MatZeroRowsColumns(s.A, PetscInt(s.held_rows.size()), s.held_rows.data(), 1.0,
                                      nullptr, nullptr),
                   "MatZeroRowsColumns");
     }
-    for (int c = 0; c < 3; ++c) {
-      PetscScalar* v = nullptr;
-      petsc_check(VecGetArray(s.b, &v), "VecGetArray");
-      std::copy(rhs[std::size_t(c)].begin(), rhs[std::size_t(c)].end(), v);
-      petsc_check(VecRestoreArray(s.b, &v), "VecRestoreArray");
-      petsc_check(VecGetArray(s.x, &v), "VecGetArray");
-      for (int i = 0; i < n; ++i) v[i] = warm(i, c);
-      for (const int i : held_) v[i] = held(i, c);
-      petsc_check(VecRestoreArray(s.x, &v), "VecRestoreArray");
-
-      ColumnReport column;
-      SolveStatus status = SolveStatus::converged;
-      std::string note;
-      petsc_check(KSPSolve(s.ksp, s.b, s.x), "KSPSolve");
-      KSPConvergedReason reason;
-      PetscInt its = 0;
-      petsc_check(KSPGetConvergedReason(s.ksp, &reason), "KSPGetConvergedReason");
-      petsc_check(KSPGetIterationNumber(s.ksp, &its), "KSPGetIterationNumber");
-      column.iterations = int(its);
-      column.reason = reason_name(reason);
-      double rel = s.relative_residual();
-      if (s.guarded) {
-        // Fixed cycles: converged only at the bound; above it CG by the cycle, then MUMPS.
-        status = std::isfinite(rel) ? SolveStatus::converged : SolveStatus::numerical_issue;
-        if (status == SolveStatus::converged && rel > s.options.residual_bound) {
-          bool solved = false;
-          if (!s.prefer_direct) {
-            petsc_check(KSPSolve(s.cg, s.b, s.x), "KSPSolve");
-            PetscInt more = 0;
-            petsc_check(KSPGetIterationNumber(s.cg, &more), "KSPGetIterationNumber");
-            report.fallback_iterations += int(more);
-            column.iterations += int(more);
-            rel = s.relative_residual();
-            solved = rel <= s.options.residual_bound;
-            note = "CG preconditioned by the cycle took over";
-          }
-          if (!solved && s.options.direct_after > 0) {
-            if (!s.direct) s.make_direct();
-            petsc_check(KSPSolve(s.direct, s.b, s.x), "KSPSolve");
-            s.prefer_direct = true;
-            report.direct_fallback = true;
-            rel = s.relative_residual();
-            note = "a distributed Cholesky factorization (MUMPS) solved it";
-            solved = rel <= s.options.residual_bound;
-          }
-          if (!solved) status = SolveStatus::max_iterations;
-        }
-        column.reason = note.empty() ? "cycles under the bound" : note;
-      } else {
-        status = status_of(reason);
-      }
-      column.relative_residual = rel;
-      if (severity(status) > severity(report.status)) report.status = status;
-      report.iterations += column.iterations;
-      report.relative_residual = std::max(report.relative_residual, rel);
-      report.residuals.push_back(rel);
-      report.columns.push_back(column);
-      const PetscScalar* w = nullptr;
-      petsc_check(VecGetArrayRead(s.x, &w), "VecGetArrayRead");
-      for (int i = 0; i < n; ++i) Y(i, c) = w[i];
-      petsc_check(VecRestoreArrayRead(s.x, &w), "VecRestoreArrayRead");
-      if (!note.empty()) report.message = joined_messages(report.message, note);
-    }
+    Coefficients start = warm;
+    for (const int i : held_) start.row(i) = held.row(i);
+    if (s.multigrid)
+      s.solve_blocks(rhs, start, Y, report);
+    else
+      s.solve_columns(rhs, start, Y, report);
     if (report.status != SolveStatus::converged && report.message.empty())
       report.message = report.columns.empty() ? "" : report.columns.back().reason;
   } catch (const PetscFailure& e) {
+    report.status = SolveStatus::failed;
+    report.message = e.what();
+  } catch (const std::runtime_error& e) {
     report.status = SolveStatus::failed;
     report.message = e.what();
   }
@@ -527,30 +546,43 @@ SolveReport RankSystem::solve(double a, double b, const Coefficients& R, const C
 std::vector<std::pair<std::string, std::string>> RankSystem::settings() const {
   const Impl& s = *impl_;
   std::vector<std::pair<std::string, std::string>> out;
-  KSPType kt = nullptr;
-  PC pc = nullptr;
-  PCType pt = nullptr;
-  KSPGetType(s.ksp, &kt);
-  KSPGetPC(s.ksp, &pc);
-  PCGetType(pc, &pt);
-  out.emplace_back("ksp_type", kt ? kt : "");
-  out.emplace_back("pc_type", pt ? pt : "");
-  out.emplace_back("options_prefix", s.prefix);
-  out.emplace_back("inserted_options", s.inserted);
-  out.emplace_back("petsc_options", s.options.petsc_options);
+  if (s.multigrid) {
+    out.emplace_back("method", s.options.solver == "pcg"
+                                   ? "CG on the three coordinates together, preconditioned by "
+                                     "one cycle of the surface multigrid across ranks"
+                                   : "the surface multigrid across ranks, the three coordinates "
+                                     "together");
+    out.emplace_back("cycle", s.inserted);
+    out.emplace_back("coarsest_solve",
+                     "Cholesky (LDLT) of the gathered coarsest level on every rank");
+    out.emplace_back("direct_fallback", "PETSc's Cholesky with MUMPS");
+  } else {
+    KSPType kt = nullptr;
+    PC pc = nullptr;
+    PCType pt = nullptr;
+    KSPGetType(s.ksp, &kt);
+    KSPGetPC(s.ksp, &pc);
+    PCGetType(pc, &pt);
+    out.emplace_back("ksp_type", kt ? kt : "");
+    out.emplace_back("pc_type", pt ? pt : "");
+    out.emplace_back("options_prefix", s.prefix);
+    out.emplace_back("inserted_options", s.inserted);
+    out.emplace_back("petsc_options", s.options.petsc_options);
+  }
   out.emplace_back("version", PetscRuntime::instance().version());
   return out;
 }
 
 std::string RankSystem::name() const {
   const Impl& s = *impl_;
+  if (s.options.solver == "multigrid") return "distributed-multigrid";
+  if (s.options.solver == "pcg") return "distributed-pcg-multigrid";
   KSPType kt = nullptr;
   PC pc = nullptr;
   PCType pt = nullptr;
   KSPGetType(s.ksp, &kt);
   KSPGetPC(s.ksp, &pc);
   PCGetType(pc, &pt);
-  if (s.options.solver == "multigrid") return "distributed-multigrid";
   return std::string("petsc-") + (kt ? kt : "?") + "-" + (pt ? pt : "?");
 }
 
@@ -564,6 +596,7 @@ double RankSystem::matrix_bytes() const {
 
 double RankSystem::preconditioner_bytes() const {
   const Impl& s = *impl_;
+  if (s.multigrid) return s.multigrid->bytes();
   PC pc = nullptr;
   KSPGetPC(s.ksp, &pc);
   PetscBool multigrid = PETSC_FALSE;

@@ -144,6 +144,42 @@ print("fixed cycles on 2 ranks, bound %g: %s, %d levels" % (bound, steps, r["sys
 sys.exit(0 if r["system"]["levels"] > 1 and all(s == "converged" and x <= bound for s, x in steps) else 1)
 PY
 
+# The guard's two stages across ranks: one V(1,1)-cycle ends far above a bound of 1e-10, so CG by
+# the cycle finishes each step; with one CG iteration allowed and a bound of 1e-12, MUMPS does.
+# Both end at the bound and within 1e-8 of the one-process CHOLMOD flow.
+"$mcfbench" flow --mesh sphere:vertices=3000 --solver cholmod --threads 1 --dt 1e-3 --steps 3 \
+  --out "$work/guard-exact" >"$work/guard.log" 2>&1 || { cat "$work/guard.log"; fail "the guard's reference"; }
+for stage in "cg:--residual-bound 1e-10" "direct:--residual-bound 1e-12 --direct-after 1"; do
+  name=${stage%%:*}
+  mpirun -n 2 "$mcfbench" flow --mesh sphere:vertices=3000 --solver multigrid --cycle V --smooth 1 \
+    --cycles 1 ${stage#*:} --threads 1 --dt 1e-3 --steps 3 --out "$work/guard-$name" \
+    >"$work/guard.log" 2>&1 || { cat "$work/guard.log"; fail "the guard ($name)"; }
+  "$py" - "$work/guard-exact" "$work/guard-$name" "$name" <<'PY' || fail "the guard ($name)"
+import json, sys
+import numpy as np
+def read(p):
+    d = open(p, "rb").read()
+    h = d.index(b"end_header\n") + len(b"end_header\n")
+    n = int([l for l in d[:h].decode().split("\n") if l.startswith("element vertex")][0].split()[-1])
+    return np.frombuffer(d[h:h + 24 * n], dtype="<f8").reshape(n, 3)
+exact, guarded, stage = sys.argv[1:4]
+a = read(exact + "/final.ply")
+dev = np.abs(a - read(guarded + "/final.ply")).max() / np.linalg.norm(a.max(0) - a.min(0))
+r = json.load(open(guarded + "/result.json"))
+bound = r["config"]["solver"]["residual_bound"]
+steps = r["steps"]
+ok = all(s["solver"]["status"] == "converged" and s["solver"]["relative_residual"] <= bound
+         for s in steps)
+fb = [s["solver"].get("fallback", {}) for s in steps]
+if stage == "cg":
+    ok = ok and all(f.get("iterations", 0) > 0 and f.get("direct_solves", 0) == 0 for f in fb)
+else:
+    ok = ok and all(f.get("direct_solves", 0) > 0 for f in fb)
+print("the guard (%s) on 2 ranks: %.3g of the diagonal, fallbacks %s" % (stage, dev, fb))
+sys.exit(0 if ok and dev < 1e-8 else 1)
+PY
+done
+
 # Bad input: one message, from rank 0, and nothing written.
 refused() {
   local what=$1 expect=$2

@@ -1,0 +1,70 @@
+#pragma once
+// The surface multigrid across ranks, relaxing the three coordinates together.
+//
+// The hierarchy is the per-partition one (distributed/rank_hierarchy.h): block-diagonal
+// prolongations, so restriction and prolongation touch only a rank's own rows; the coarse
+// operators A_l = P_lᵀ A_{l+1} P_l are PETSc's parallel Galerkin products (MatPtAP, the pattern
+// formed once and the values refreshed at every set_operator). Each level keeps its owned rows as
+// PETSc's two local blocks — the diagonal block (owned columns) and the off-diagonal block
+// (ghost columns) — and the cycle runs on them with the harness's own kernels:
+//
+// - a smoothing sweep exchanges the ghost rows of the iterate once (all columns in one message,
+//   a VecScatter of blocks of 4), then relaxes the owned rows by Gauss-Seidel with the ghosts
+//   fixed: processor-block Gauss-Seidel, the same sweep as PETSc's SOR with local sweeps
+//   (`-pc_sor_local_forward`), forward down the cycle and backward up it, so that the cycle is
+//   symmetric and serves as CG's preconditioner;
+// - the coarsest level is gathered on every rank and solved there by a sparse Cholesky factor
+//   (Eigen's LDLᵀ), refactorized at every set_operator;
+// - V- or W-cycle (γ = 1 or 2) as in the one-process multigrid (solvers/multigrid.h).
+//
+// Where PETSc's PCMG solves x, y and z one after another (every level's matrix streamed three
+// times), this cycle reads each matrix entry once for the three columns.
+//
+// Blocks: n x 4 doubles, row-major ((i, c) at 4 i + c), columns 0..2 the coordinates and column 3
+// padding that stays zero. Every call is collective. Built only with PETSc (the header names
+// PETSc's matrix as an opaque pointer; rank_system.cpp is its one user).
+
+#include "distributed/rank_mesh.h"
+
+#include <memory>
+#include <string>
+
+struct _p_Mat;  // PETSc's Mat is a pointer to it
+
+namespace mcf::dist {
+
+struct RankCycle {
+  bool w_cycle = true;  ///< W (γ = 2) or V (γ = 1)
+  int smooth = 5;       ///< forward sweeps down, as many backward sweeps up
+};
+
+class RankMultigrid {
+ public:
+  /// Builds the per-partition hierarchy and its interpolation matrices.
+  RankMultigrid(const RankMesh& mesh, RankCycle cycle);
+  ~RankMultigrid();
+  RankMultigrid(const RankMultigrid&) = delete;
+  RankMultigrid& operator=(const RankMultigrid&) = delete;
+
+  /// Takes A (MPIAIJ over the owned rows, symmetric, the same pattern at every call; held by the
+  /// caller) as the finest operator: Galerkin coarse operators, local blocks, coarsest factor.
+  void set_operator(_p_Mat* A);
+
+  /// One cycle on A X = B, X (the owned rows' block) improved in place.
+  void cycle(const double* B, double* X);
+  /// Y = A X on the owned rows (X's ghost rows exchanged first).
+  void apply(const double* X, double* Y);
+
+  int owned() const;
+  int levels() const;
+  /// Vertices of the coarsest level, over all ranks.
+  long long coarsest_size() const;
+  /// Bytes this rank holds: coarse operators, interpolations, the coarsest factor, buffers.
+  double bytes() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mcf::dist
