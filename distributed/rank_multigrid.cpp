@@ -49,39 +49,42 @@ Csr csr_of(Mat m) {
   return c;
 }
 
-double storage_bytes(Mat m) {
-  MatInfo info;
-  petsc_check(MatGetInfo(m, MAT_LOCAL, &info), "MatGetInfo");
-  PetscInt rows = 0, cols = 0;
-  petsc_check(MatGetLocalSize(m, &rows, &cols), "MatGetLocalSize");
-  return info.nz_used * double(sizeof(PetscScalar) + sizeof(PetscInt)) +
-         double(rows + 1) * double(sizeof(PetscInt));
-}
-
 }  // namespace
 
 struct RankMultigrid::Impl {
   struct Level {
     PetscInt n = 0, offset = 0, total = 0;  // owned rows, the first's global number, all rows
-    Mat A = nullptr;                        // coarse levels: P^T A P, held here
-    Mat P = nullptr;                        // interpolation from the level below (l >= 1)
-    RowMajor prolongation;                  // its owned rows: n x (level l - 1's n)
-    Csr diagonal, off;                      // A's local blocks: owned and ghost columns
-    std::vector<PetscInt> ghost_columns;    // global numbers of `off`'s columns
+    RowMajor prolongation;                  // from the level below (l >= 1): n x its n
+    // The owned rows: the diagonal block (owned columns, local numbers) and the off-diagonal
+    // block (column m is the ghost of global number ghost_columns[m], increasing). The finest
+    // level's are views of PETSc's matrix; the coarse levels' are held in own_*.
+    Csr diagonal, off;
+    std::vector<PetscInt> ghost_columns;
+    std::vector<PetscInt> own_diagonal_ia, own_diagonal_ja, own_off_ia, own_off_ja;
+    std::vector<double> own_diagonal_v, own_off_v;
     std::vector<int> diag_pos;
     std::vector<double> inv_diag;
     Vec global = nullptr, ghosts = nullptr;  // an iterate's layout, the ghost rows' buffer
     VecScatter scatter = nullptr;
     std::vector<double> ghost, b, x, r;  // blocks of 4 per row
+    // The Galerkin product onto the level below (l >= 1), on its pattern: Pᵀ by coarse rows
+    // (the owned fine rows and weights of each owned coarse row), and P's rows over the owned
+    // then the ghost fine rows (the ghosts' exchanged from their owners) with local coarse
+    // columns; the dense accumulator of one coarse row.
+    std::vector<int> pt_start, pt_fine, pe_start, pe_col;
+    std::vector<double> pt_weight, pe_weight, accumulator;
   };
 
   MPI_Comm comm = PETSC_COMM_WORLD;
   int ranks = 1;
   RankCycle shape;
   std::vector<Level> levels;  // coarsest first
-  // The coarsest level, gathered on every rank.
-  Mat* gathered = nullptr;  // one matrix: MatCreateSubMatrices' array
-  IS all_rows = nullptr;
+  bool symbolic_done = false;
+  // The coarsest level, gathered on every rank: its entries' global rows and columns, in the
+  // gathered order, and their values; the factor's pattern is analysed once.
+  std::vector<int> gather_counts, gather_displs;  // per rank, entries
+  std::vector<PetscInt> gathered_rows, gathered_cols;
+  std::vector<double> gathered_values, local_values;
   SparseMatrix coarse_matrix;
   Eigen::SimplicialLDLT<SparseMatrix> coarse_factor;
   bool analyzed = false;
@@ -91,14 +94,10 @@ struct RankMultigrid::Impl {
 
   ~Impl() {
     for (Level& L : levels) {
-      if (L.P) MatDestroy(&L.P);
-      if (L.A && &L != &levels.back()) MatDestroy(&L.A);
       if (L.scatter) VecScatterDestroy(&L.scatter);
       if (L.global) VecDestroy(&L.global);
       if (L.ghosts) VecDestroy(&L.ghosts);
     }
-    if (gathered) MatDestroySubMatrices(1, &gathered);
-    if (all_rows) ISDestroy(&all_rows);
   }
 
   void build(const RankMesh& mesh) {
@@ -119,24 +118,8 @@ struct RankMultigrid::Impl {
       petsc_check(VecCreateMPIWithArray(comm, 4, 4 * L.n, PETSC_DECIDE, nullptr, &L.global),
                   "VecCreateMPIWithArray");
     }
-    for (std::size_t l = 1; l < levels.size(); ++l) {
-      Level &F = levels[l], &C = levels[l - 1];
-      F.prolongation = RowMajor(h.prolongations[l - 1]);
-      // The interpolation as PETSc's matrix, for the Galerkin products.
-      const RowMajor& P = F.prolongation;
-      std::vector<PetscInt> ia(std::size_t(P.rows()) + 1, 0), ja;
-      std::vector<PetscScalar> v;
-      for (int i = 0; i < P.rows(); ++i) {
-        for (RowMajor::InnerIterator it(P, i); it; ++it) {
-          ja.push_back(C.offset + it.col());
-          v.push_back(it.value());
-        }
-        ia[std::size_t(i) + 1] = PetscInt(ja.size());
-      }
-      petsc_check(MatCreateMPIAIJWithArrays(comm, F.n, C.n, F.total, C.total, ia.data(), ja.data(),
-                                            v.data(), &F.P),
-                  "MatCreateMPIAIJWithArrays");
-    }
+    for (std::size_t l = 1; l < levels.size(); ++l)
+      levels[l].prolongation = RowMajor(h.prolongations[l - 1]);
     // The coarsest level's rows on each rank, for the gather before its solve.
     const Level& K = levels.front();
     const std::vector<double> sizes = all_values(double(K.n));
@@ -149,67 +132,273 @@ struct RankMultigrid::Impl {
       at += counts[k];
     }
     coarse_rhs.assign(std::size_t(at), 0.0);
-    petsc_check(ISCreateStride(PETSC_COMM_SELF, K.total, 0, 1, &all_rows), "ISCreateStride");
+    coarse_b.resize(K.total, 3);
   }
 
-  /// A level's local blocks, diagonal and ghost exchange, from its current matrix.
-  void read_blocks(Level& L) {
+  /// The ghost exchange of a level, from its ghost columns.
+  void make_scatter(Level& L) {
+    const auto count = PetscInt(L.ghost_columns.size());
+    if (L.scatter) VecScatterDestroy(&L.scatter);
+    if (L.ghosts) VecDestroy(&L.ghosts);
+    L.ghost.assign(std::size_t(4 * count), 0.0);
+    petsc_check(VecCreateSeqWithArray(PETSC_COMM_SELF, 4, 4 * count, L.ghost.data(), &L.ghosts),
+                "VecCreateSeqWithArray");
+    IS from = nullptr, to = nullptr;
+    petsc_check(
+        ISCreateBlock(PETSC_COMM_SELF, 4, count, L.ghost_columns.data(), PETSC_COPY_VALUES, &from),
+        "ISCreateBlock");
+    petsc_check(ISCreateStride(PETSC_COMM_SELF, 4 * count, 0, 1, &to), "ISCreateStride");
+    petsc_check(VecScatterCreate(L.global, from, L.ghosts, to, &L.scatter), "VecScatterCreate");
+    ISDestroy(&from);
+    ISDestroy(&to);
+  }
+
+  /// The finest level's blocks from PETSc's matrix; false if its ghost columns changed (the
+  /// products' patterns are then made again).
+  bool read_finest(Mat A) {
+    Level& L = levels.back();
     Mat Ad = nullptr, Ao = nullptr;
     const PetscInt* garray = nullptr;
-    petsc_check(MatMPIAIJGetSeqAIJ(L.A, &Ad, &Ao, &garray), "MatMPIAIJGetSeqAIJ");
+    petsc_check(MatMPIAIJGetSeqAIJ(A, &Ad, &Ao, &garray), "MatMPIAIJGetSeqAIJ");
     L.diagonal = csr_of(Ad);
     L.off = csr_of(Ao);
     PetscInt ghost_count = 0;
     petsc_check(MatGetSize(Ao, nullptr, &ghost_count), "MatGetSize");
     if (L.diagonal.rows != L.n || L.off.rows != L.n)
-      throw std::runtime_error("distributed multigrid: a level's local rows do not match");
+      throw std::runtime_error("distributed multigrid: the local rows do not match the mesh's");
     const std::vector<PetscInt> columns(garray, garray + ghost_count);
-    if (columns != L.ghost_columns || !L.scatter) {
-      L.ghost_columns = columns;
-      if (L.scatter) VecScatterDestroy(&L.scatter);
-      if (L.ghosts) VecDestroy(&L.ghosts);
-      L.ghost.assign(std::size_t(4 * ghost_count), 0.0);
-      petsc_check(
-          VecCreateSeqWithArray(PETSC_COMM_SELF, 4, 4 * ghost_count, L.ghost.data(), &L.ghosts),
-          "VecCreateSeqWithArray");
-      IS from = nullptr, to = nullptr;
-      petsc_check(ISCreateBlock(PETSC_COMM_SELF, 4, ghost_count, L.ghost_columns.data(),
-                                PETSC_COPY_VALUES, &from),
-                  "ISCreateBlock");
-      petsc_check(ISCreateStride(PETSC_COMM_SELF, 4 * ghost_count, 0, 1, &to), "ISCreateStride");
-      petsc_check(VecScatterCreate(L.global, from, L.ghosts, to, &L.scatter), "VecScatterCreate");
-      ISDestroy(&from);
-      ISDestroy(&to);
+    if (columns == L.ghost_columns && L.scatter) return true;
+    L.ghost_columns = columns;
+    make_scatter(L);
+    return false;
+  }
+
+  static Csr view(const std::vector<PetscInt>& ia, const std::vector<PetscInt>& ja,
+                  const std::vector<double>& v) {
+    return Csr{ia.data(), ja.data(), v.data(), PetscInt(ia.size()) - 1};
+  }
+
+  /// Calls f(fine local column, value) for each entry of the fine level's row k (ghost columns
+  /// numbered after the owned ones).
+  template <class F>
+  static void for_row(const Level& L, PetscInt k, F&& f) {
+    for (PetscInt p = L.diagonal.ia[k]; p < L.diagonal.ia[k + 1]; ++p)
+      f(L.diagonal.ja[p], L.diagonal.v[p]);
+    for (PetscInt p = L.off.ia[k]; p < L.off.ia[k + 1]; ++p) f(L.n + L.off.ja[p], L.off.v[p]);
+  }
+
+  /// The pattern of the level below l, Pᵀ A P restricted to its owned rows, and what the
+  /// numeric product needs: P's ghost rows (exchanged once), the coarse ghost columns and their
+  /// exchange.
+  void galerkin_symbolic(std::size_t l) {
+    Level &F = levels[l], &C = levels[l - 1];
+    const RowMajor& P = F.prolongation;
+    const auto nf = std::size_t(F.n), gf = F.ghost_columns.size();
+    // Each owned fine row's P row as blocks of 4 (global coarse numbers, -1 past its end; the
+    // weights), exchanged as an iterate is.
+    std::vector<double> index(4 * nf, -1.0), weight(4 * nf, 0.0);
+    for (int i = 0; i < P.rows(); ++i) {
+      int k = 0;
+      for (RowMajor::InnerIterator it(P, i); it; ++it, ++k) {
+        if (k == 4)
+          throw std::runtime_error("distributed multigrid: a prolongation row has over 4 entries");
+        index[4 * std::size_t(i) + std::size_t(k)] = double(C.offset + it.col());
+        weight[4 * std::size_t(i) + std::size_t(k)] = it.value();
+      }
     }
+    exchange(F, index.data());
+    const std::vector<double> ghost_index = F.ghost;
+    exchange(F, weight.data());
+    const std::vector<double> ghost_weight = F.ghost;
+    std::vector<PetscInt>& G = C.ghost_columns;
+    G.clear();
+    for (const double g : ghost_index)
+      if (g >= 0 && !(g >= double(C.offset) && g < double(C.offset + C.n)))
+        G.push_back(PetscInt(g));
+    std::sort(G.begin(), G.end());
+    G.erase(std::unique(G.begin(), G.end()), G.end());
+    const auto nc = std::size_t(C.n);
+    const auto local = [&](PetscInt g) {
+      if (g >= C.offset && g < C.offset + C.n) return int(g - C.offset);
+      return int(nc) + int(std::lower_bound(G.begin(), G.end(), g) - G.begin());
+    };
+    // P's rows, owned fine rows then ghost ones, on local coarse columns.
+    F.pe_start.assign(1, 0);
+    F.pe_col.clear();
+    F.pe_weight.clear();
+    for (int i = 0; i < P.rows(); ++i) {
+      for (RowMajor::InnerIterator it(P, i); it; ++it) {
+        F.pe_col.push_back(int(it.col()));
+        F.pe_weight.push_back(it.value());
+      }
+      F.pe_start.push_back(int(F.pe_col.size()));
+    }
+    for (std::size_t m = 0; m < gf; ++m) {
+      for (std::size_t k = 0; k < 4; ++k)
+        if (ghost_index[4 * m + k] >= 0) {
+          F.pe_col.push_back(local(PetscInt(ghost_index[4 * m + k])));
+          F.pe_weight.push_back(ghost_weight[4 * m + k]);
+        }
+      F.pe_start.push_back(int(F.pe_col.size()));
+    }
+    // Pᵀ by coarse rows.
+    F.pt_start.assign(nc + 1, 0);
+    for (int i = 0; i < P.rows(); ++i)
+      for (RowMajor::InnerIterator it(P, i); it; ++it) ++F.pt_start[std::size_t(it.col()) + 1];
+    for (std::size_t c = 0; c < nc; ++c) F.pt_start[c + 1] += F.pt_start[c];
+    F.pt_fine.assign(std::size_t(F.pt_start[nc]), 0);
+    F.pt_weight.assign(F.pt_fine.size(), 0.0);
+    std::vector<int> next(F.pt_start.begin(), F.pt_start.end() - 1);
+    for (int i = 0; i < P.rows(); ++i)
+      for (RowMajor::InnerIterator it(P, i); it; ++it) {
+        const int at = next[std::size_t(it.col())]++;
+        F.pt_fine[std::size_t(at)] = i;
+        F.pt_weight[std::size_t(at)] = it.value();
+      }
+    // The coarse rows' patterns, sorted, split into the owned and the ghost columns.
+    const std::size_t width = nc + G.size();
+    std::vector<int> mark(width, -1), cols;
+    C.own_diagonal_ia.assign(1, 0);
+    C.own_off_ia.assign(1, 0);
+    C.own_diagonal_ja.clear();
+    C.own_off_ja.clear();
+    for (std::size_t i = 0; i < nc; ++i) {
+      cols.clear();
+      for (int t = F.pt_start[i]; t < F.pt_start[i + 1]; ++t)
+        for_row(F, F.pt_fine[std::size_t(t)], [&](PetscInt f, double) {
+          for (int q = F.pe_start[std::size_t(f)]; q < F.pe_start[std::size_t(f) + 1]; ++q) {
+            const int c = F.pe_col[std::size_t(q)];
+            if (mark[std::size_t(c)] != int(i)) {
+              mark[std::size_t(c)] = int(i);
+              cols.push_back(c);
+            }
+          }
+        });
+      std::sort(cols.begin(), cols.end());
+      for (const int c : cols) {
+        if (c < int(nc))
+          C.own_diagonal_ja.push_back(c);
+        else
+          C.own_off_ja.push_back(c - int(nc));
+      }
+      C.own_diagonal_ia.push_back(PetscInt(C.own_diagonal_ja.size()));
+      C.own_off_ia.push_back(PetscInt(C.own_off_ja.size()));
+    }
+    C.own_diagonal_v.assign(C.own_diagonal_ja.size(), 0.0);
+    C.own_off_v.assign(C.own_off_ja.size(), 0.0);
+    C.diagonal = view(C.own_diagonal_ia, C.own_diagonal_ja, C.own_diagonal_v);
+    C.off = view(C.own_off_ia, C.own_off_ja, C.own_off_v);
+    F.accumulator.assign(width, 0.0);
+    make_scatter(C);
+  }
+
+  /// The values of the level below l on its pattern: per owned coarse row i, Σ over the fine
+  /// rows k of Pᵀ's row i, over A's row k and over P's row of each entry's column, accumulated
+  /// in a dense row and read out in the pattern's order (a fixed order: the same bits on
+  /// every rerun).
+  void galerkin_numeric(std::size_t l) {
+    Level &F = levels[l], &C = levels[l - 1];
+    double* acc = F.accumulator.data();
+    const auto nc = std::size_t(C.n);
+    for (std::size_t i = 0; i < nc; ++i) {
+      for (int t = F.pt_start[i]; t < F.pt_start[i + 1]; ++t) {
+        const double w = F.pt_weight[std::size_t(t)];
+        for_row(F, F.pt_fine[std::size_t(t)], [&](PetscInt f, double a) {
+          const double wa = w * a;
+          for (int q = F.pe_start[std::size_t(f)]; q < F.pe_start[std::size_t(f) + 1]; ++q)
+            acc[F.pe_col[std::size_t(q)]] += wa * F.pe_weight[std::size_t(q)];
+        });
+      }
+      for (PetscInt p = C.own_diagonal_ia[i]; p < C.own_diagonal_ia[i + 1]; ++p) {
+        double& v = acc[C.own_diagonal_ja[std::size_t(p)]];
+        C.own_diagonal_v[std::size_t(p)] = v;
+        v = 0.0;
+      }
+      for (PetscInt p = C.own_off_ia[i]; p < C.own_off_ia[i + 1]; ++p) {
+        double& v = acc[nc + std::size_t(C.own_off_ja[std::size_t(p)])];
+        C.own_off_v[std::size_t(p)] = v;
+        v = 0.0;
+      }
+    }
+  }
+
+  void find_diagonals(Level& L) {
     L.diag_pos.assign(std::size_t(L.n), -1);
-    L.inv_diag.assign(std::size_t(L.n), 0.0);
     const Csr& d = L.diagonal;
     for (PetscInt i = 0; i < L.n; ++i)
       for (PetscInt p = d.ia[i]; p < d.ia[i + 1]; ++p)
         if (d.ja[p] == i) {
           L.diag_pos[std::size_t(i)] = int(p);
-          L.inv_diag[std::size_t(i)] = 1.0 / d.v[p];
           break;
         }
-    for (PetscInt i = 0; i < L.n; ++i)
-      if (L.diag_pos[std::size_t(i)] < 0 || !(d.v[L.diag_pos[std::size_t(i)]] > 0))
+  }
+
+  void invert_diagonals(Level& L) {
+    L.inv_diag.resize(std::size_t(L.n));
+    for (PetscInt i = 0; i < L.n; ++i) {
+      const int p = L.diag_pos[std::size_t(i)];
+      if (p < 0 || !(L.diagonal.v[p] > 0))
         throw std::runtime_error(
             "distributed multigrid: a level's diagonal entry is missing or not positive");
+      L.inv_diag[std::size_t(i)] = 1.0 / L.diagonal.v[p];
+    }
+  }
+
+  /// The coarsest level's entries with global rows and columns, gathered on every rank once.
+  void gather_symbolic() {
+    const Level& K = levels.front();
+    std::vector<PetscInt> rows, cols;
+    for (PetscInt i = 0; i < K.n; ++i) {
+      for (PetscInt p = K.diagonal.ia[i]; p < K.diagonal.ia[i + 1]; ++p) {
+        rows.push_back(K.offset + i);
+        cols.push_back(K.offset + K.diagonal.ja[p]);
+      }
+      for (PetscInt p = K.off.ia[i]; p < K.off.ia[i + 1]; ++p) {
+        rows.push_back(K.offset + i);
+        cols.push_back(K.ghost_columns[std::size_t(K.off.ja[p])]);
+      }
+    }
+    const std::vector<double> sizes = all_values(double(rows.size()));
+    gather_counts.resize(sizes.size());
+    gather_displs.resize(sizes.size());
+    int at = 0;
+    for (std::size_t k = 0; k < sizes.size(); ++k) {
+      gather_counts[k] = int(sizes[k]);
+      gather_displs[k] = at;
+      at += gather_counts[k];
+    }
+    gathered_rows.resize(std::size_t(at));
+    gathered_cols.resize(std::size_t(at));
+    gathered_values.resize(std::size_t(at));
+    petsc_check(MPI_Allgatherv(rows.data(), int(rows.size()), MPIU_INT, gathered_rows.data(),
+                               gather_counts.data(), gather_displs.data(), MPIU_INT, comm),
+                "MPI_Allgatherv");
+    petsc_check(MPI_Allgatherv(cols.data(), int(cols.size()), MPIU_INT, gathered_cols.data(),
+                               gather_counts.data(), gather_displs.data(), MPIU_INT, comm),
+                "MPI_Allgatherv");
+    local_values.resize(rows.size());
+    analyzed = false;
   }
 
   void factor_coarsest() {
-    Level& K = levels.front();
-    petsc_check(MatCreateSubMatrices(K.A, 1, &all_rows, &all_rows,
-                                     gathered ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &gathered),
-                "MatCreateSubMatrices");
-    const Csr c = csr_of(gathered[0]);
-    const int n = int(K.total);
-    std::vector<int> outer(std::size_t(n) + 1), inner(std::size_t(c.ia[n]));
-    for (int i = 0; i <= n; ++i) outer[std::size_t(i)] = int(c.ia[i]);
-    for (std::size_t p = 0; p < inner.size(); ++p) inner[p] = int(c.ja[p]);
-    // Symmetric: its rows are its columns.
-    coarse_matrix =
-        Eigen::Map<const SparseMatrix>(n, n, int(inner.size()), outer.data(), inner.data(), c.v);
+    const Level& K = levels.front();
+    std::size_t e = 0;
+    for (PetscInt i = 0; i < K.n; ++i) {
+      for (PetscInt p = K.diagonal.ia[i]; p < K.diagonal.ia[i + 1]; ++p)
+        local_values[e++] = K.diagonal.v[p];
+      for (PetscInt p = K.off.ia[i]; p < K.off.ia[i + 1]; ++p) local_values[e++] = K.off.v[p];
+    }
+    petsc_check(MPI_Allgatherv(local_values.data(), int(local_values.size()), MPI_DOUBLE,
+                               gathered_values.data(), gather_counts.data(), gather_displs.data(),
+                               MPI_DOUBLE, comm),
+                "MPI_Allgatherv");
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(gathered_values.size());
+    for (std::size_t k = 0; k < gathered_values.size(); ++k)
+      entries.emplace_back(int(gathered_rows[k]), int(gathered_cols[k]), gathered_values[k]);
+    const auto n = Eigen::Index(K.total);
+    coarse_matrix.resize(n, n);
+    coarse_matrix.setFromTriplets(entries.begin(), entries.end());
     if (!analyzed) {
       coarse_factor.analyzePattern(coarse_matrix);
       analyzed = true;
@@ -217,7 +406,6 @@ struct RankMultigrid::Impl {
     coarse_factor.factorize(coarse_matrix);
     if (coarse_factor.info() != Eigen::Success)
       throw std::runtime_error("distributed multigrid: the coarsest level's factorization failed");
-    coarse_b.resize(n, 3);
   }
 
   void exchange(Level& L, const double* x) {
@@ -327,14 +515,16 @@ RankMultigrid::~RankMultigrid() = default;
 
 void RankMultigrid::set_operator(Mat A) {
   Impl& s = *impl_;
-  s.levels.back().A = A;
-  for (std::size_t l = s.levels.size() - 1; l > 0; --l) {
-    Mat& coarse = s.levels[l - 1].A;
-    petsc_check(MatPtAP(s.levels[l].A, s.levels[l].P,
-                        coarse ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, PETSC_DEFAULT, &coarse),
-                "MatPtAP");
+  if (!s.read_finest(A) || !s.symbolic_done) {
+    for (std::size_t l = s.levels.size() - 1; l > 0; --l) s.galerkin_symbolic(l);
+    for (auto& L : s.levels) s.find_diagonals(L);
+    s.gather_symbolic();
+    s.symbolic_done = true;
+  } else {
+    s.find_diagonals(s.levels.back());  // PETSc's arrays may have moved
   }
-  for (auto& L : s.levels) s.read_blocks(L);
+  for (std::size_t l = s.levels.size() - 1; l > 0; --l) s.galerkin_numeric(l);
+  for (auto& L : s.levels) s.invert_diagonals(L);
   s.factor_coarsest();
 }
 
@@ -370,15 +560,43 @@ double RankMultigrid::bytes() const {
   double bytes = 0;
   for (std::size_t l = 0; l < s.levels.size(); ++l) {
     const Impl::Level& L = s.levels[l];
-    if (l + 1 < s.levels.size() && L.A) bytes += storage_bytes(L.A);
-    if (L.P) bytes += storage_bytes(L.P);
-    bytes += double(L.prolongation.nonZeros()) * 12.0;
+    bytes += double(L.own_diagonal_ja.size() + L.own_off_ja.size()) * 12.0 +
+             double(L.own_diagonal_ia.size() + L.own_off_ia.size()) * 4.0;
+    bytes += double(L.prolongation.nonZeros()) * 12.0 + double(L.pt_fine.size()) * 12.0 +
+             double(L.pe_col.size()) * 12.0 + 8.0 * double(L.accumulator.size());
     bytes +=
-        8.0 * double(L.b.size() + L.x.size() + L.r.size() + L.ghost.size() + L.inv_diag.size());
+        8.0 * double(L.b.size() + L.x.size() + L.r.size() + L.ghost.size() + L.inv_diag.size()) +
+        4.0 * double(L.diag_pos.size());
   }
-  if (s.gathered) bytes += storage_bytes(s.gathered[0]);
+  bytes += double(s.gathered_values.size()) * (8.0 + 2 * sizeof(PetscInt));
   bytes += double(s.coarse_matrix.nonZeros()) * 12.0 * 3.0;  // the matrix and its factor
   return bytes;
+}
+
+std::vector<RankMultigrid::Entry> RankMultigrid::operator_entries(int l) const {
+  const Impl::Level& L = impl_->levels[std::size_t(l)];
+  std::vector<Entry> out;
+  for (PetscInt i = 0; i < L.n; ++i) {
+    for (PetscInt p = L.diagonal.ia[i]; p < L.diagonal.ia[i + 1]; ++p)
+      out.push_back({L.offset + i, L.offset + L.diagonal.ja[p], L.diagonal.v[p]});
+    for (PetscInt p = L.off.ia[i]; p < L.off.ia[i + 1]; ++p)
+      out.push_back({L.offset + i, L.ghost_columns[std::size_t(L.off.ja[p])], L.off.v[p]});
+  }
+  return out;
+}
+
+std::vector<RankMultigrid::Entry> RankMultigrid::prolongation_entries(int l) const {
+  const Impl::Level &F = impl_->levels[std::size_t(l)], &C = impl_->levels[std::size_t(l) - 1];
+  std::vector<Entry> out;
+  for (int i = 0; i < F.prolongation.rows(); ++i)
+    for (RowMajor::InnerIterator it(F.prolongation, i); it; ++it)
+      out.push_back({F.offset + i, C.offset + it.col(), it.value()});
+  return out;
+}
+
+std::pair<long long, int> RankMultigrid::level_rows(int l) const {
+  const Impl::Level& L = impl_->levels[std::size_t(l)];
+  return {L.offset, int(L.n)};
 }
 
 }  // namespace mcf::dist

@@ -28,6 +28,8 @@
 
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 struct _p_Mat;  // PETSc's Mat is a pointer to it
 
@@ -61,6 +63,17 @@ class RankMultigrid {
   long long coarsest_size() const;
   /// Bytes this rank holds: coarse operators, interpolations, the coarsest factor, buffers.
   double bytes() const;
+
+  /// For checks against PETSc's products: level l's (0 the coarsest) owned rows and the
+  /// prolongation onto level l from level l - 1 (l >= 1), as global (row, column, value); the
+  /// first global row of level l on this rank and its count.
+  struct Entry {
+    long long row, column;
+    double value;
+  };
+  std::vector<Entry> operator_entries(int l) const;
+  std::vector<Entry> prolongation_entries(int l) const;
+  std::pair<long long, int> level_rows(int l) const;
 
  private:
   struct Impl;
