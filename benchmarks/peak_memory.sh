@@ -2,12 +2,12 @@
 # Peak resident memory against its estimate (flows/memory_estimate.h) over the bases, solvers,
 # depths and mesh sizes the estimate was fitted on: one one-step flow per row, written as CSV
 # (spec, basis, tracking, solver, depth, vertices, unknowns, estimate and peak in MiB, ratio).
-# Usage: benchmarks/peak_memory.sh [OUT.csv]   (default benchmarks/results/peak-memory.csv)
+# Usage: benchmarks/peak_memory.sh [OUT.csv]   (default out/peak-memory.csv)
 # Environment: MCFBENCH_BUILD (default build/). About 10 minutes on 2 cores; needs ~4 GiB.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${MCFBENCH_BUILD:-$root/build}/mcfbench
-out=${1:-$root/benchmarks/results/peak-memory.csv}
+out=${1:-$root/out/peak-memory.csv}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 rows=$work/rows.csv

@@ -10,7 +10,7 @@
 # Usage: benchmarks/run_micro.sh [extra benchmark flags, e.g. --benchmark_filter=Cholmod]
 # Environment: MCFBENCH_BUILD (the build folder, as for scripts/build.sh; default build/),
 #              MCFBENCH_MICRO_OUT (default results/micro),
-#              MCFBENCH_HISTORY_STORE (default benchmarks/history; "none": do not store),
+#              MCFBENCH_HISTORY_STORE (default data/history; "none": do not store),
 #              MCFBENCH_MICRO_CONFIG (the series' config name, default micro),
 #              MCFBENCH_BENCH_MESH (mesh of the benchmarks, see benchmarks/micro_hat.cpp).
 set -euo pipefail
@@ -18,7 +18,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${MCFBENCH_BUILD:-$root/build}
 bin=$build/mcfbench_micro
 out_dir=${MCFBENCH_MICRO_OUT:-results/micro}
-store=${MCFBENCH_HISTORY_STORE:-benchmarks/history}
+store=${MCFBENCH_HISTORY_STORE:-data/history}
 [ -x "$bin" ] || { echo "run_micro.sh: $bin not built (cmake --build $build --target mcfbench_micro)" >&2; exit 1; }
 
 mkdir -p "$out_dir"

@@ -450,7 +450,7 @@ int compare_and_record(const CompareRequest& request) {
   const CompareReport r = compare_results(old_set, new_set, o);
   std::printf("%s", compare_markdown(r, old_set, new_set, o).c_str());
   if (request.store_history)
-    store_in_history(new_set, request.history.empty() ? "benchmarks/history" : request.history);
+    store_in_history(new_set, request.history.empty() ? "data/history" : request.history);
   return r.regression ? 1 : 0;
 }
 

@@ -94,7 +94,7 @@ struct CompareRequest {
   std::string old_dir, new_dir;  ///< DIR[@COMMIT] each
   CompareOptions options;
   bool store_history = false;  ///< store NEW in the history `history` (store_in_history)
-  std::string history;         ///< empty: benchmarks/history
+  std::string history;         ///< empty: data/history
 };
 
 /// compare as a whole: loads both sets, prints the Markdown comparison on stdout, stores NEW in

@@ -12,7 +12,7 @@ usage: /usr/bin/python3 reports/perf_history.py COMMAND ...   (scripts/history.s
   ab CONFIG BASE HEAD --out DIR  BASE and HEAD alternated over rounds, then `mcfbench compare`
   publish OUT                    OUT/index.html: charts, steps, regressions (offline)
 
-Every command takes --store DIR (default benchmarks/history) and --repo DIR (default: the git
+Every command takes --store DIR (default data/history) and --repo DIR (default: the git
 repository of the current folder). `COMMAND --help` lists the rest.
 
 Store layout: STORE/<machine>/machine.json (the identity: cpu, cores, threads, blas_threads,
@@ -898,12 +898,12 @@ addEventListener('load', function () {
 
 def study_reports(args):
     """The reports the page links: --report PATHs, else the repository's own (docs/studies.md,
-    which answers each study, and the reports of full runs kept under benchmarks/results/)."""
+    which answers each study, and the reports of full runs kept under data/results/)."""
     if args.report:
         return args.report
     found = [os.path.join(args.repo, "docs", "studies.md")]
     found += sorted(os.path.join(d, f)
-                    for d, _, files in os.walk(os.path.join(args.repo, "benchmarks", "results"))
+                    for d, _, files in os.walk(os.path.join(args.repo, "data", "results"))
                     for f in files if f.endswith(".md"))
     return [p for p in found if os.path.isfile(p)]
 
@@ -1000,7 +1000,7 @@ def dispatch(argv):
     sub = ap.add_subparsers(dest="command", required=True)
 
     def common(p):
-        p.add_argument("--store", default="benchmarks/history", help="history folder")
+        p.add_argument("--store", default="data/history", help="history folder")
         p.add_argument("--repo", default=".", help="git repository of the commits")
 
     def detector(p):
@@ -1076,7 +1076,7 @@ def dispatch(argv):
     p.add_argument("out")
     p.add_argument("--report", action="append", default=[],
                    help="a study report to link (repeatable; default: the repository's "
-                   "docs/studies.md and the Markdown reports under benchmarks/results/)")
+                   "docs/studies.md and the Markdown reports under data/results/)")
     common(p)
     detector(p)
     args = ap.parse_args(argv)

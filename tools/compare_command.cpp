@@ -36,7 +36,7 @@ void add_compare_command(CLI::App& app, std::function<int()>& run) {
                 "otherwise)");
   cmd->add_option("--history", a->history,
                   "Store NEW in this history store, keyed by machine, commit and study (no "
-                  "value: benchmarks/history; see `mcfbench history`)")
+                  "value: data/history; see `mcfbench history`)")
       ->expected(0, 1);
   cmd->callback([cmd, a, &run] {
     run = [cmd, a]() -> int {
