@@ -2,7 +2,7 @@
 # The performance gate: `perf_gate.sh CONFIG [BASE [HEAD]]` benchmarks BASE (default: the merge
 # base of $MCFBENCH_GATE_BRANCH, default main, and HEAD) against HEAD (default HEAD) on this
 # machine, alternating them over $MCFBENCH_GATE_ROUNDS rounds (default 5: the fewest at which the
-# U test of `compare` can reach its p < 0.05 is 4), and answers (docs/benchmarks.md "The gate"):
+# U test of `compare` can reach its p < 0.05 is 4), and answers (docs/history.md "The gate"):
 #   exit 0  pass: no cell of CONFIG's quick variant is slower beyond the threshold;
 #   exit 1  regression: a cell is slower by more than $MCFBENCH_GATE_THRESHOLD (default 0.1)
 #           with the U test over the rounds agreeing (`mcfbench compare`) in any metric of

@@ -24,7 +24,7 @@ void add_history_command(CLI::App& app, std::function<int()>& run) {
       "--force, --last, --good, --bad, --threshold, --alpha, --min-run, --json, "
       "--fail-on-regression, "
       "--benchmark,\n"
-      "--rounds, --out, --compare, --name. docs/benchmarks.md#history explains them.");
+      "--rounds, --out, --compare, --name. docs/history.md explains them.");
   // Everything after `history` (its subcommand, flags, --help) is the tool's to parse.
   cmd->prefix_command();
   cmd->callback(
