@@ -70,6 +70,7 @@ struct Tally {
   std::vector<std::vector<double>> residuals_per_solve;
   nlohmann::json columns_per_solve = nlohmann::json::array();
   SolveReport worst;
+  double contraction = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
 };
 
 /// The StepContext of a rank: the integrators of flows/integrator.h run unchanged on the owned
@@ -104,6 +105,7 @@ class RankContext final : public StepContext {
     ++t.solves;
     t.iterations += r.iterations;
     t.residuals_per_solve.push_back(r.residuals);
+    t.contraction = std::max(t.contraction, r.contraction);
     if (r.fallback_iterations > 0 || r.direct_fallback) {
       ++t.fallbacks;
       t.fallback_iterations += r.fallback_iterations;
@@ -299,6 +301,7 @@ FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* sou
                                       {"iterations", tally.fallback_iterations},
                                       {"direct_solves", tally.direct_solves}};
     if (!worst.message.empty()) record["solver"]["message"] = worst.message;
+    if (tally.contraction >= 0) record["solver"]["contraction"] = tally.contraction;
 
     std::string reason;
     if (!worst.ok()) {

@@ -6,6 +6,7 @@
 #include "core/vec4.h"
 #include "distributed/comm.h"
 #include "distributed/rank_hierarchy.h"
+#include "solvers/galerkin.h"
 #include "solvers/petsc_runtime.h"
 
 #include <Eigen/SparseCholesky>
@@ -67,12 +68,17 @@ struct RankMultigrid::Impl {
     Vec global = nullptr, ghosts = nullptr;  // an iterate's layout, the ghost rows' buffer
     VecScatter scatter = nullptr;
     std::vector<double> ghost, b, x, r;  // blocks of 4 per row
-    // The Galerkin product onto the level below (l >= 1), on its pattern: Pᵀ by coarse rows
-    // (the owned fine rows and weights of each owned coarse row), and P's rows over the owned
-    // then the ghost fine rows (the ghosts' exchanged from their owners) with local coarse
-    // columns; the dense accumulator of one coarse row.
-    std::vector<int> pt_start, pt_fine, pe_start, pe_col;
-    std::vector<double> pt_weight, pe_weight, accumulator;
+    // The Galerkin product onto the level below (l >= 1), as the one-process multigrid forms it
+    // (solvers/galerkin.h) on the rank's extended system: on the owned then the ghost vertices,
+    // Â holds the owned rows and, in the ghost columns, their mirror (the ghost rows' entries in
+    // owned columns; none between ghosts), and P̂ the owned and the ghost vertices' prolongation
+    // rows (the ghosts' exchanged from their owners), onto the owned then the ghost coarse
+    // vertices. The coarse level's owned rows are the first rows of Ĉ = P̂ᵀ Â P̂ (symmetric).
+    SparseMatrix ext_A, ext_P, ext_C;
+    std::vector<int> ext_source;  // per Â entry in a ghost column: the off-diagonal block's entry
+    std::vector<int> ext_transpose, c_source;  // c_source: per coarse owned entry, its place in Ĉ
+    multigrid_detail::GalerkinPlan plan;
+    multigrid_detail::Spa spa;
   };
 
   MPI_Comm comm = PETSC_COMM_WORLD;
@@ -112,8 +118,10 @@ struct RankMultigrid::Impl {
       petsc_check(MPI_Scan(&L.n, &end, 1, MPIU_INT, MPI_SUM, comm), "MPI_Scan");
       L.offset = end - L.n;
       petsc_check(MPI_Allreduce(&L.n, &L.total, 1, MPIU_INT, MPI_SUM, comm), "MPI_Allreduce");
-      L.b.assign(std::size_t(4 * L.n), 0.0);
-      L.x.assign(std::size_t(4 * L.n), 0.0);
+      if (&L != &levels.back()) {  // the finest level's are the caller's
+        L.b.assign(std::size_t(4 * L.n), 0.0);
+        L.x.assign(std::size_t(4 * L.n), 0.0);
+      }
       L.r.assign(std::size_t(4 * L.n), 0.0);
       petsc_check(VecCreateMPIWithArray(comm, 4, 4 * L.n, PETSC_DECIDE, nullptr, &L.global),
                   "VecCreateMPIWithArray");
@@ -178,17 +186,8 @@ struct RankMultigrid::Impl {
     return Csr{ia.data(), ja.data(), v.data(), PetscInt(ia.size()) - 1};
   }
 
-  /// Calls f(fine local column, value) for each entry of the fine level's row k (ghost columns
-  /// numbered after the owned ones).
-  template <class F>
-  static void for_row(const Level& L, PetscInt k, F&& f) {
-    for (PetscInt p = L.diagonal.ia[k]; p < L.diagonal.ia[k + 1]; ++p)
-      f(L.diagonal.ja[p], L.diagonal.v[p]);
-    for (PetscInt p = L.off.ia[k]; p < L.off.ia[k + 1]; ++p) f(L.n + L.off.ja[p], L.off.v[p]);
-  }
-
-  /// The pattern of the level below l, Pᵀ A P restricted to its owned rows, and what the
-  /// numeric product needs: P's ghost rows (exchanged once), the coarse ghost columns and their
+  /// The patterns of the level below l's product (Â, P̂, Ĉ and the Galerkin plan) and of its
+  /// owned rows, after P's ghost rows (exchanged once); the coarse ghost columns and their
   /// exchange.
   void galerkin_symbolic(std::size_t l) {
     Level &F = levels[l], &C = levels[l - 1];
@@ -222,104 +221,108 @@ struct RankMultigrid::Impl {
       if (g >= C.offset && g < C.offset + C.n) return int(g - C.offset);
       return int(nc) + int(std::lower_bound(G.begin(), G.end(), g) - G.begin());
     };
-    // P's rows, owned fine rows then ghost ones, on local coarse columns.
-    F.pe_start.assign(1, 0);
-    F.pe_col.clear();
-    F.pe_weight.clear();
-    for (int i = 0; i < P.rows(); ++i) {
-      for (RowMajor::InnerIterator it(P, i); it; ++it) {
-        F.pe_col.push_back(int(it.col()));
-        F.pe_weight.push_back(it.value());
-      }
-      F.pe_start.push_back(int(F.pe_col.size()));
-    }
-    for (std::size_t m = 0; m < gf; ++m) {
+    // P̂: the owned fine rows' P rows, then the ghosts', on local coarse columns.
+    const std::size_t width = nc + G.size(), rows = nf + gf;
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int i = 0; i < P.rows(); ++i)
+      for (RowMajor::InnerIterator it(P, i); it; ++it)
+        entries.emplace_back(i, int(it.col()), it.value());
+    for (std::size_t m = 0; m < gf; ++m)
       for (std::size_t k = 0; k < 4; ++k)
-        if (ghost_index[4 * m + k] >= 0) {
-          F.pe_col.push_back(local(PetscInt(ghost_index[4 * m + k])));
-          F.pe_weight.push_back(ghost_weight[4 * m + k]);
-        }
-      F.pe_start.push_back(int(F.pe_col.size()));
+        if (ghost_index[4 * m + k] >= 0)
+          entries.emplace_back(int(nf + m), local(PetscInt(ghost_index[4 * m + k])),
+                               ghost_weight[4 * m + k]);
+    F.ext_P = SparseMatrix(Eigen::Index(rows), Eigen::Index(width));
+    F.ext_P.setFromTriplets(entries.begin(), entries.end());
+    F.ext_P.makeCompressed();
+    // Â: column k < nf is the owned row k (owned columns, then the ghost columns shifted by nf:
+    // sorted); column nf + m holds the owned rows with an entry in ghost column m, increasing.
+    std::vector<int> outer(rows + 1, 0);
+    for (std::size_t k = 0; k < nf; ++k) {
+      outer[k + 1] =
+          int((F.diagonal.ia[k + 1] - F.diagonal.ia[k]) + (F.off.ia[k + 1] - F.off.ia[k]));
+      for (PetscInt p = F.off.ia[k]; p < F.off.ia[k + 1]; ++p)
+        ++outer[nf + std::size_t(F.off.ja[p]) + 1];
     }
-    // Pᵀ by coarse rows.
-    F.pt_start.assign(nc + 1, 0);
-    for (int i = 0; i < P.rows(); ++i)
-      for (RowMajor::InnerIterator it(P, i); it; ++it) ++F.pt_start[std::size_t(it.col()) + 1];
-    for (std::size_t c = 0; c < nc; ++c) F.pt_start[c + 1] += F.pt_start[c];
-    F.pt_fine.assign(std::size_t(F.pt_start[nc]), 0);
-    F.pt_weight.assign(F.pt_fine.size(), 0.0);
-    std::vector<int> next(F.pt_start.begin(), F.pt_start.end() - 1);
-    for (int i = 0; i < P.rows(); ++i)
-      for (RowMajor::InnerIterator it(P, i); it; ++it) {
-        const int at = next[std::size_t(it.col())]++;
-        F.pt_fine[std::size_t(at)] = i;
-        F.pt_weight[std::size_t(at)] = it.value();
+    for (std::size_t c = 0; c < rows; ++c) outer[c + 1] += outer[c];
+    std::vector<int> inner(std::size_t(outer[rows])), next(outer.begin(), outer.end() - 1);
+    F.ext_source.assign(inner.size() - std::size_t(outer[nf]), 0);
+    for (std::size_t k = 0; k < nf; ++k) {
+      for (PetscInt p = F.diagonal.ia[k]; p < F.diagonal.ia[k + 1]; ++p) {
+        const int at = next[k]++;
+        inner[std::size_t(at)] = int(F.diagonal.ja[p]);
       }
-    // The coarse rows' patterns, sorted, split into the owned and the ghost columns.
-    const std::size_t width = nc + G.size();
-    std::vector<int> mark(width, -1), cols;
+      for (PetscInt p = F.off.ia[k]; p < F.off.ia[k + 1]; ++p) {
+        int at = next[k]++;
+        inner[std::size_t(at)] = int(nf) + int(F.off.ja[p]);
+        at = next[nf + std::size_t(F.off.ja[p])]++;
+        inner[std::size_t(at)] = int(k);
+        F.ext_source[std::size_t(at - outer[nf])] = int(p);
+      }
+    }
+    F.ext_A = SparseMatrix(Eigen::Index(rows), Eigen::Index(rows));
+    F.ext_A.resizeNonZeros(Eigen::Index(inner.size()));
+    std::copy(outer.begin(), outer.end(), F.ext_A.outerIndexPtr());
+    std::copy(inner.begin(), inner.end(), F.ext_A.innerIndexPtr());
+    std::fill(F.ext_A.valuePtr(), F.ext_A.valuePtr() + inner.size(), 0.0);
+    const SparseMatrix PT = F.ext_P.transpose();
+    F.ext_C = multigrid_detail::symbolic_product(
+        PT, multigrid_detail::symbolic_product(F.ext_A, F.ext_P));
+    F.ext_transpose = multigrid_detail::transpose_positions(F.ext_C);
+    F.plan = multigrid_detail::galerkin_plan(multigrid_detail::Csc(F.ext_A), F.ext_P, F.ext_C, {});
+    // The coarse owned rows: Ĉ's first nc columns (rows by symmetry), owned rows first.
+    const SparseMatrix& Ch = F.ext_C;
     C.own_diagonal_ia.assign(1, 0);
     C.own_off_ia.assign(1, 0);
     C.own_diagonal_ja.clear();
     C.own_off_ja.clear();
+    std::vector<int> diagonal_source, off_source;
     for (std::size_t i = 0; i < nc; ++i) {
-      cols.clear();
-      for (int t = F.pt_start[i]; t < F.pt_start[i + 1]; ++t)
-        for_row(F, F.pt_fine[std::size_t(t)], [&](PetscInt f, double) {
-          for (int q = F.pe_start[std::size_t(f)]; q < F.pe_start[std::size_t(f) + 1]; ++q) {
-            const int c = F.pe_col[std::size_t(q)];
-            if (mark[std::size_t(c)] != int(i)) {
-              mark[std::size_t(c)] = int(i);
-              cols.push_back(c);
-            }
-          }
-        });
-      std::sort(cols.begin(), cols.end());
-      for (const int c : cols) {
-        if (c < int(nc))
-          C.own_diagonal_ja.push_back(c);
-        else
-          C.own_off_ja.push_back(c - int(nc));
+      for (int p = Ch.outerIndexPtr()[i]; p < Ch.outerIndexPtr()[i + 1]; ++p) {
+        const int r = Ch.innerIndexPtr()[p];
+        if (r < int(nc)) {
+          C.own_diagonal_ja.push_back(r);
+          diagonal_source.push_back(p);
+        } else {
+          C.own_off_ja.push_back(r - int(nc));
+          off_source.push_back(p);
+        }
       }
       C.own_diagonal_ia.push_back(PetscInt(C.own_diagonal_ja.size()));
       C.own_off_ia.push_back(PetscInt(C.own_off_ja.size()));
     }
+    F.c_source = diagonal_source;
+    F.c_source.insert(F.c_source.end(), off_source.begin(), off_source.end());
     C.own_diagonal_v.assign(C.own_diagonal_ja.size(), 0.0);
     C.own_off_v.assign(C.own_off_ja.size(), 0.0);
     C.diagonal = view(C.own_diagonal_ia, C.own_diagonal_ja, C.own_diagonal_v);
     C.off = view(C.own_off_ia, C.own_off_ja, C.own_off_v);
-    F.accumulator.assign(width, 0.0);
     make_scatter(C);
   }
 
-  /// The values of the level below l on its pattern: per owned coarse row i, Σ over the fine
-  /// rows k of Pᵀ's row i, over A's row k and over P's row of each entry's column, accumulated
-  /// in a dense row and read out in the pattern's order (a fixed order: the same bits on
-  /// every rerun).
+  /// The values of the level below l on its patterns: Â from the level's blocks, Ĉ by the
+  /// one-process Galerkin kernel (a fixed order: the same bits on every rerun), the coarse
+  /// owned rows read out of it.
   void galerkin_numeric(std::size_t l) {
     Level &F = levels[l], &C = levels[l - 1];
-    double* acc = F.accumulator.data();
-    const auto nc = std::size_t(C.n);
-    for (std::size_t i = 0; i < nc; ++i) {
-      for (int t = F.pt_start[i]; t < F.pt_start[i + 1]; ++t) {
-        const double w = F.pt_weight[std::size_t(t)];
-        for_row(F, F.pt_fine[std::size_t(t)], [&](PetscInt f, double a) {
-          const double wa = w * a;
-          for (int q = F.pe_start[std::size_t(f)]; q < F.pe_start[std::size_t(f) + 1]; ++q)
-            acc[F.pe_col[std::size_t(q)]] += wa * F.pe_weight[std::size_t(q)];
-        });
-      }
-      for (PetscInt p = C.own_diagonal_ia[i]; p < C.own_diagonal_ia[i + 1]; ++p) {
-        double& v = acc[C.own_diagonal_ja[std::size_t(p)]];
-        C.own_diagonal_v[std::size_t(p)] = v;
-        v = 0.0;
-      }
-      for (PetscInt p = C.own_off_ia[i]; p < C.own_off_ia[i + 1]; ++p) {
-        double& v = acc[nc + std::size_t(C.own_off_ja[std::size_t(p)])];
-        C.own_off_v[std::size_t(p)] = v;
-        v = 0.0;
-      }
+    // Â's owned columns are the owned rows (the diagonal block's run, then the off-diagonal
+    // block's), its ghost columns the off-diagonal entries mirrored.
+    double* a = F.ext_A.valuePtr();
+    const int* outer = F.ext_A.outerIndexPtr();
+    for (PetscInt k = 0; k < F.n; ++k) {
+      double* to = std::copy(F.diagonal.v + F.diagonal.ia[k], F.diagonal.v + F.diagonal.ia[k + 1],
+                             a + outer[k]);
+      std::copy(F.off.v + F.off.ia[k], F.off.v + F.off.ia[k + 1], to);
     }
+    double* ghosts = a + outer[F.n];
+    for (std::size_t e = 0; e < F.ext_source.size(); ++e) ghosts[e] = F.off.v[F.ext_source[e]];
+    multigrid_detail::galerkin_values(multigrid_detail::Csc(F.ext_A), F.ext_P, F.ext_C,
+                                      F.ext_C.valuePtr(), F.ext_transpose, {}, F.spa,
+                                      F.plan.empty() ? nullptr : &F.plan);
+    const double* c = F.ext_C.valuePtr();
+    const std::size_t nd = C.own_diagonal_v.size();
+    for (std::size_t e = 0; e < nd; ++e) C.own_diagonal_v[e] = c[F.c_source[e]];
+    for (std::size_t e = 0; e < C.own_off_v.size(); ++e) C.own_off_v[e] = c[F.c_source[nd + e]];
   }
 
   void find_diagonals(Level& L) {
@@ -562,8 +565,11 @@ double RankMultigrid::bytes() const {
     const Impl::Level& L = s.levels[l];
     bytes += double(L.own_diagonal_ja.size() + L.own_off_ja.size()) * 12.0 +
              double(L.own_diagonal_ia.size() + L.own_off_ia.size()) * 4.0;
-    bytes += double(L.prolongation.nonZeros()) * 12.0 + double(L.pt_fine.size()) * 12.0 +
-             double(L.pe_col.size()) * 12.0 + 8.0 * double(L.accumulator.size());
+    bytes += double(L.prolongation.nonZeros() + L.ext_P.nonZeros() + L.ext_A.nonZeros() +
+                    L.ext_C.nonZeros()) *
+                 12.0 +
+             4.0 * double(L.ext_source.size() + L.ext_transpose.size() + L.c_source.size()) +
+             double(L.plan.bytes());
     bytes +=
         8.0 * double(L.b.size() + L.x.size() + L.r.size() + L.ghost.size() + L.inv_diag.size()) +
         4.0 * double(L.diag_pos.size());

@@ -2,11 +2,13 @@
 // The surface multigrid across ranks, relaxing the three coordinates together.
 //
 // The hierarchy is the per-partition one (distributed/rank_hierarchy.h): block-diagonal
-// prolongations, so restriction and prolongation touch only a rank's own rows; the coarse
-// operators A_l = P_lᵀ A_{l+1} P_l are PETSc's parallel Galerkin products (MatPtAP, the pattern
-// formed once and the values refreshed at every set_operator). Each level keeps its owned rows as
-// PETSc's two local blocks — the diagonal block (owned columns) and the off-diagonal block
-// (ghost columns) — and the cycle runs on them with the harness's own kernels:
+// prolongations, so restriction and prolongation touch only a rank's own rows, and each rank forms
+// the owned rows of the coarse operators A_l = P_lᵀ A_{l+1} P_l alone once it has the prolongation
+// rows of its ghost vertices (exchanged once): the patterns are made at the first set_operator and
+// the values refreshed on them at every one, in a fixed order. Each level keeps its owned rows as
+// two blocks — the diagonal block (owned columns) and the off-diagonal block (ghost columns) —
+// the finest level's being views of PETSc's matrix, and the cycle runs on them with the harness's
+// own kernels:
 //
 // - a smoothing sweep exchanges the ghost rows of the iterate once (all columns in one message,
 //   a VecScatter of blocks of 4), then relaxes the owned rows by Gauss-Seidel with the ghosts

@@ -3,8 +3,8 @@
 // assembles the rows of M and K it owns from its own triangles — complete, since it holds every
 // triangle around an owned vertex —, writes them into PETSc's distributed matrix (the pattern
 // preallocated once, the values refreshed in place), exchanges the ghost ring of an iterate
-// after each solve (a ghosted PETSc vector, block size 3), and solves (a M + b K) Y = R with a
-// KSP across the ranks. No rank ever holds more than its own rows.
+// after each solve (a ghosted PETSc vector, block size 3), and solves (a M + b K) Y = R across
+// the ranks. No rank ever holds more than its own rows.
 //
 // Held functions (the vertices of an open boundary, docs/design.md "Conventions") are eliminated
 // symmetrically, as the one-process flow's reduced system does (flows/reduced_system.h): their
@@ -12,8 +12,9 @@
 //
 // Solvers: "petsc" — PETSc's KSP with the one-process solver's defaults (CG, GAMG, symmetric SOR
 // smoothing; solvers/petsc_solver.h) and the user's options over them; "multigrid" — the surface
-// multigrid across ranks (distributed/rank_hierarchy.h) as PETSc's PCMG; "pcg" with the multigrid
-// preconditioner — CG preconditioned by one such cycle.
+// multigrid across ranks on the three coordinates together (distributed/rank_multigrid.h); "pcg"
+// with the multigrid preconditioner — CG preconditioned by one such cycle, three columns at once
+// (distributed/rank_block_cg.h). A guarded step's last resort is PETSc's Cholesky with MUMPS.
 //
 // PETSc's headers stay in rank_system.cpp; without PETSc the constructor throws PetscUnavailable.
 

@@ -122,8 +122,9 @@ print("open cylinder: %d held functions of %d" % (held, r["system"]["dimension"]
 sys.exit(0 if held == 2 * 48 else 1)
 PY
 
-# A rerun on the same ranks gives the same bits (the surface multigrid: its hierarchy, PtAP and
-# SOR sweeps are fixed per partition, and PT-Scotch's partition is made the same every run).
+# A rerun on the same ranks gives the same bits (the surface multigrid: its hierarchy, Galerkin
+# products, sweeps and rank-ordered sums are fixed per partition, and PT-Scotch's partition is made
+# the same every run).
 for i in 1 2; do
   mpirun -n 2 "$mcfbench" flow --mesh cgal:elephant --solver pcg --preconditioner multigrid \
     --threads 1 --dt 1e-3 --steps 2 --out "$work/again-$i" >"$work/again.log" 2>&1 ||
