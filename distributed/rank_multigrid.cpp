@@ -63,7 +63,7 @@ struct RankMultigrid::Impl {
     std::vector<PetscInt> ghost_columns;
     std::vector<PetscInt> own_diagonal_ia, own_diagonal_ja, own_off_ia, own_off_ja;
     std::vector<double> own_diagonal_v, own_off_v;
-    std::vector<int> diag_pos;
+    std::vector<int> diag_pos, interface;
     std::vector<double> inv_diag;
     Vec global = nullptr, ghosts = nullptr;  // an iterate's layout, the ghost rows' buffer
     VecScatter scatter = nullptr;
@@ -326,6 +326,9 @@ struct RankMultigrid::Impl {
   }
 
   void find_diagonals(Level& L) {
+    L.interface.clear();
+    for (PetscInt i = 0; i < L.n; ++i)
+      if (L.off.ia[i + 1] > L.off.ia[i]) L.interface.push_back(int(i));
     L.diag_pos.assign(std::size_t(L.n), -1);
     const Csr& d = L.diagonal;
     for (PetscInt i = 0; i < L.n; ++i)
@@ -433,8 +436,10 @@ struct RankMultigrid::Impl {
       acc1 -= splat(d.v[p]) * load4(x + 4 * std::size_t(d.ja[p]));
   }
 
-  /// One Gauss-Seidel sweep over the owned rows with the ghost rows fixed: exchanged first, or
-  /// zero (`zero_ghosts`: the iterate is zero everywhere, the first sweep from a zero guess).
+  /// One Gauss-Seidel sweep over the owned rows with the ghost rows fixed (exchanged first, or
+  /// zero: `zero_ghosts`, the iterate zero everywhere, the first sweep from a zero guess), and
+  /// the interface rows' second pass with fresh ghosts: after the sweep going forward, before
+  /// it going backward (the adjoint).
   void sweep(Level& L, const double* b, double* x, bool forward, bool zero_ghosts) {
     if (zero_ghosts)
       std::fill(L.ghost.begin(), L.ghost.end(), 0.0);
@@ -445,10 +450,19 @@ struct RankMultigrid::Impl {
       subtract_row(L, x, i, acc0, acc1);
       store4(x + 4 * std::size_t(i), (acc0 + acc1) * splat(L.inv_diag[std::size_t(i)]));
     };
-    if (forward)
+    if (forward) {
       for (PetscInt i = 0; i < L.n; ++i) relax(i);
-    else
+      if (ranks > 1) {
+        exchange(L, x);
+        for (const int i : L.interface) relax(i);
+      }
+    } else {
+      if (ranks > 1) {
+        for (auto it = L.interface.rbegin(); it != L.interface.rend(); ++it) relax(*it);
+        exchange(L, x);
+      }
       for (PetscInt i = L.n - 1; i >= 0; --i) relax(i);
+    }
   }
 
   /// R = B - A X.

@@ -3,7 +3,7 @@
 // PETSc's parallel MatPtAP of the same prolongations, level by level, to rounding; and CG by its
 // cycle solves a system with known solution. The fine operator is a weighted graph Laplacian
 // plus a mass-like diagonal on a sphere's mesh, partitioned as the distributed flow partitions
-// it. Exit 0 when all hold, 1 otherwise (a message on rank 0).
+// it; the cycle is a symmetric operator. Exit 0 when all hold, 1 otherwise (a message on rank 0).
 
 #include "datasets/generators.h"
 #include "distributed/comm.h"
@@ -118,6 +118,32 @@ int main() {
     made.push_back(C);
     previous = C;
     (void)fine_first;
+  }
+  // The cycle (zero start) is a symmetric operator, as CG's preconditioner must be: u·B v = v·B u.
+  {
+    std::vector<double> u(4 * std::size_t(mesh.owned), 0.0), v(u.size(), 0.0), Bu(u.size(), 0.0),
+        Bv(u.size(), 0.0);
+    for (int i = 0; i < mesh.owned; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const double g = double(mesh.global(i));
+        u[4 * std::size_t(i) + std::size_t(c)] = std::cos(0.37 * g + c);
+        v[4 * std::size_t(i) + std::size_t(c)] = std::sin(1.3 * g - 2.0 * c);
+      }
+    multigrid.cycle(u.data(), Bu.data());
+    multigrid.cycle(v.data(), Bv.data());
+    double vBu = 0, uBv = 0, norm = 0;
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      vBu += v[k] * Bu[k];
+      uBv += u[k] * Bv[k];
+      norm += std::abs(v[k] * Bu[k]);
+    }
+    vBu = ordered_sum(vBu);
+    uBv = ordered_sum(uBv);
+    norm = ordered_sum(norm);
+    if (rank() == 0)
+      std::printf("the cycle's symmetry: |v.Bu - u.Bv| = %.2g of %.2g\n", std::abs(vBu - uBv),
+                  norm);
+    ok = ok && std::abs(vBu - uBv) <= 1e-12 * norm;
   }
   // CG by the cycle on A X = A X*, three columns.
   const int n = mesh.owned;
