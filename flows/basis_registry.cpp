@@ -6,7 +6,6 @@
 #include "datasets/subdivide.h"
 #include "datasets/validate.h"
 #include "flows/config_reader.h"
-#include "flows/memory_estimate.h"
 #include "flows/solver_registry.h"
 
 #include <stdexcept>

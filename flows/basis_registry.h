@@ -6,7 +6,7 @@
 #include "bases/basis.h"
 #include "bases/octree_basis.h"
 #include "datasets/mesh.h"
-#include "flows/flow_config.h"
+#include "flows/config_values.h"
 #include "flows/memory_model.h"
 #include "flows/named_table.h"
 #include "flows/option_spec.h"

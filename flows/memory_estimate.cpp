@@ -8,14 +8,6 @@
 #include <stdexcept>
 
 namespace mcf {
-namespace {
-
-/// About this many finest functions per (h^2 of surface): measured 2.84-3.02 on the armadillo,
-/// the elephant and spheres at depths 6 to 9.
-constexpr double kFunctionsPerArea = 3.0;
-
-}  // namespace
-
 std::string format_gib(double bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.2f GiB", bytes / double(1ull << 30));
@@ -59,10 +51,6 @@ FlowSizes mesh_sizes(const FlowConfig& config, const TriangleMesh& mesh, bool an
   if (const BasisRow& basis = basis_row(config.basis); basis.size)
     basis.size(config, mesh, analytic, s);
   return s;
-}
-
-double estimated_octree_dimension(double area_over_side2, int depth) {
-  return kFunctionsPerArea * area_over_side2 * std::ldexp(1.0, 2 * depth);
 }
 
 MemoryEstimate estimate_flow_memory(const FlowConfig& config, const FlowSizes& sizes,

@@ -14,7 +14,7 @@
 
 #include "datasets/mesh.h"
 #include "datasets/mesh_spec.h"
-#include "flows/flow_config.h"
+#include "flows/config_values.h"
 #include "flows/memory_model.h"
 
 #include <nlohmann/json.hpp>
@@ -51,11 +51,6 @@ FlowSizes spec_sizes(const MeshSpecRequest& request);
 /// will choose. A cube the basis would refuse (`unit` on a mesh outside it) leaves the octree
 /// unsized; the basis reports that error itself.
 FlowSizes mesh_sizes(const FlowConfig& config, const TriangleMesh& mesh, bool analytic);
-
-/// The finest octree level's function count expected for a surface: about 3 A / h^2 for area A
-/// and finest cell size h = side / 2^depth (each function's support meets the surface in about
-/// a third of the area of its 2h x 2h x 2h box, measured 2.8-3.0 on the project's models).
-double estimated_octree_dimension(double area_over_side2, int depth);
 
 /// Peak resident memory of `config`'s flow on a mesh of `sizes`, `resident_bytes` being what the
 /// process holds already.

@@ -3,6 +3,8 @@
 // row sizes the mesh's and its own share and describes its system matrix; a solver row sizes what
 // it adds to that matrix. Every figure is in bytes.
 
+#include <cmath>
+
 namespace mcf {
 
 /// The sizes an estimate needs. `area_over_side2` < 0: the octree's size is not known yet (a
@@ -31,5 +33,14 @@ struct SystemFigures {
   /// 0 where the basis's own hierarchy is counted in its share).
   double hierarchy_bytes_per_unknown = 0;
 };
+
+/// The finest octree level's function count expected for a surface: about 3 A / h^2 for area A
+/// and finest cell size h = side / 2^depth (each function's support meets the surface in about
+/// a third of the area of its 2h x 2h x 2h box: measured 2.84-3.02 on the armadillo, the
+/// elephant and spheres at depths 6 to 9).
+inline double estimated_octree_dimension(double area_over_side2, int depth) {
+  constexpr double functions_per_area = 3.0;
+  return functions_per_area * area_over_side2 * std::ldexp(1.0, 2 * depth);
+}
 
 }  // namespace mcf

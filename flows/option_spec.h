@@ -4,7 +4,7 @@
 // result.json records it. The config reader, `to_json`, the command line, its --help and the
 // option table of docs/flow.md are all made from these (flows/config_schema.h).
 
-#include "flows/flow_config.h"
+#include "flows/config_values.h"
 
 #include <nlohmann/json.hpp>
 

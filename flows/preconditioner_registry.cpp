@@ -1,6 +1,6 @@
 #include "flows/preconditioner_registry.h"
 
-#include "flows/solver_registry.h"
+#include "flows/multigrid_options.h"
 #include "solvers/multigrid_pcg.h"
 
 #include <stdexcept>

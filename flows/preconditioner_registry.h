@@ -2,7 +2,7 @@
 // The preconditioner axis: one row per `solver.preconditioner` of the solvers whose row says
 // uses_preconditioner (CG).
 
-#include "flows/flow_config.h"
+#include "flows/config_values.h"
 #include "flows/memory_model.h"
 #include "flows/named_table.h"
 #include "solvers/linear_solver.h"

@@ -3,8 +3,9 @@
 // solver"). The flow, the config reader, the memory estimate and the command line read a solver's
 // meaning from its row and nowhere else.
 
-#include "flows/flow_config.h"
+#include "flows/config_values.h"
 #include "flows/memory_model.h"
+#include "flows/multigrid_options.h"
 #include "flows/named_table.h"
 #include "flows/option_spec.h"
 #include "solvers/linear_solver.h"
@@ -70,7 +71,4 @@ bool needs_hierarchy(const SolverConfig& config);
 /// Whether the config's solver runs one flow divided across MPI ranks (distributed/): a row
 /// marked `distributed` (petsc, multigrid), or CG with the multigrid preconditioner.
 bool runs_across_ranks(const SolverConfig& config);
-/// The multigrid cycle the config describes (the multigrid solver's and preconditioner's).
-MultigridOptions multigrid_options(const SolverConfig& config);
-
 }  // namespace mcf

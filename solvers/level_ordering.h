@@ -14,7 +14,6 @@
 // interface.
 
 #include "core/sparse.h"
-#include "solvers/multigrid.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -35,7 +34,7 @@ namespace mcf::multigrid_detail {
 // 8-colour ordering and its iterates are unchanged. `perm[r]` is the caller's index of internal
 // row r, `inv` its inverse; both are empty for the identity.
 
-constexpr int kTile = MultigridSolver::tile_size;
+constexpr int kTile = 1024;        // MultigridSolver::tile_size (multigrid.cpp asserts they agree)
 constexpr int kMinBlockTiles = 8;  // tiles per relaxation block, at least (find_blocks())
 
 inline int old_index(const std::vector<int>& perm, int r) {

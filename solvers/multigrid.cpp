@@ -28,6 +28,9 @@
 
 namespace mcf {
 
+static_assert(multigrid_detail::kTile == MultigridSolver::tile_size,
+              "solvers/level_ordering.h tiles levels as the solver stores them");
+
 const char* to_string(MultigridCycle c) {
   return c == MultigridCycle::V ? "V" : "W";
 }
