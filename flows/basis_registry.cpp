@@ -104,6 +104,7 @@ std::vector<OptionSpec> octree_row_options() {
              "only its vertices are output"),
       [](auto& c) -> auto& { return c.octree.refine_input; });
   refine.flag_kind = FlagKind::set_true;
+  refine.selected = [](const FlowConfig&) { return true; };  // read by the hat basis as well
   OptionSpec stabilization = bind(
       option("octree.stabilization", OptionType::string, "normal-gradient", "--stabilization",
              "Octree system (docs/octree-multigrid.md)"),
@@ -122,6 +123,15 @@ std::vector<OptionSpec> octree_row_options() {
           [](auto& c) -> auto& { return c.octree.stabilization_weight; }),
       0, 1e6);
   weight.default_text = "the solver's (0.5; cholmod, dense 1e-6)";
+  // Elsewhere the config records the inert value (kInertStabilizationWeight), which is no
+  // request; any other value is refused.
+  weight.owner = "octree";
+  weight.owner_text = "basis \"octree\"";
+  weight.refused_elsewhere = true;
+  weight.matrix_drops = true;
+  weight.selected = [](const FlowConfig& c) {
+    return c.basis == "octree" || c.octree.stabilization_weight == kInertStabilizationWeight;
+  };
   return {tracking, depth, cubature, cube, refine, stabilization, weight};
 }
 

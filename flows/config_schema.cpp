@@ -144,7 +144,21 @@ std::vector<OptionSpec> tail_options() {
 std::vector<OptionSpec> gather() {
   std::vector<OptionSpec> all = head_options();
   for (const BasisRow& row : basis_table().rows())
-    all.insert(all.end(), row.options.begin(), row.options.end());
+    for (OptionSpec o : row.options) {
+      // A basis's own options, unless the option says which bases read it.
+      if (!o.selected) {
+        o.owner = row.name;
+        o.owner_text = "basis \"" + row.name + "\"";
+        o.selected = [name = row.name](const FlowConfig& c) { return c.basis == name; };
+        o.refused_elsewhere = true;
+      }
+      if (o.refused_elsewhere) {
+        if (!o.in_use)
+          o.in_use = [](const FlowConfig& c) { return "the basis is \"" + c.basis + "\""; };
+        o.matrix_drops = true;
+      }
+      all.push_back(std::move(o));
+    }
   const std::vector<OptionSpec>& shared = solver_options();
   all.insert(all.end(), shared.begin(), shared.end());
   for (const SolverRow& row : solver_table().rows())
@@ -176,6 +190,12 @@ const std::vector<OptionSpec>& flow_config_schema() {
   // Built on first use, after every row registered from a static initializer.
   static const std::vector<OptionSpec> schema = gather();
   return schema;
+}
+
+const OptionSpec& option_spec(const std::string& key) {
+  for (const OptionSpec& o : flow_config_schema())
+    if (o.key == key) return o;
+  throw std::out_of_range("no config key \"" + key + "\"");
 }
 
 std::string option_values(const OptionSpec& o) {
@@ -239,7 +259,9 @@ std::string flow_options_markdown() {
     if (o.choices)
       for (const Choice& c : o.choices())
         if (!c.second.empty()) meaning += "; `" + c.first + "`: " + c.second;
-    if (!o.owner.empty()) meaning += " (solver `" + o.owner + "` only)";
+    if (!o.owner.empty())
+      meaning +=
+          (o.key.rfind("solver.", 0) == 0 ? " (solver `" : " (basis `") + o.owner + "` only)";
     md += "| " + flag + " | `" + o.key + "` | " + cell(option_values(o)) + " | " +
           cell(option_default(o)) + " | " + cell(meaning) + " |\n";
   }

@@ -19,6 +19,8 @@ const std::vector<std::string>& flow_config_keys();
 /// The options in reading order: the config reader checks them in this order, so that of two bad
 /// keys the first here is the one an error names. Keys of one object ("solver") are contiguous.
 const std::vector<OptionSpec>& flow_config_schema();
+/// The schema's option with this dotted key; throws std::out_of_range for a key it lacks.
+const OptionSpec& option_spec(const std::string& key);
 
 /// The values an option takes, as --help and docs/flow.md show them ("4..10", "V | W", "flag").
 std::string option_values(const OptionSpec& o);

@@ -84,7 +84,8 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   for (const OptionSpec& o : flow_config_schema())
     if (inapplicable(o, c))
       fail(o.key, (o.type == OptionType::string ? "\"" + o.get(c).get<std::string>() + "\" " : "") +
-                      "applies to " + o.owner_text + " only, the solver is " + in_use);
+                      "applies to " + o.owner_text + " only, " +
+                      (o.in_use ? o.in_use(c) : "the solver is " + in_use));
   // Accepting it would record a lumped mass the flow never used (and duplicate an axis's cells).
   if (!basis.takes_mass && c.mass != "consistent")
     fail("mass", "\"" + c.mass +

@@ -73,6 +73,12 @@ struct OptionSpec {
   /// What a refusal names as the owner: `solver "petsc"`, "a multigrid (...)".
   std::string owner_text{};
   std::function<bool(const FlowConfig&)> selected{};
+  /// In an experiment matrix, a value set on a cell whose components do not read it is dropped
+  /// (the cell records the default, as for a default) instead of refused: a basis's options,
+  /// which a study sets per mesh or per axis across bases (harness/experiment_config.h).
+  bool matrix_drops = false;
+  /// What a refusal names as in use instead (`the basis is "hat"`); empty: the solver.
+  std::function<std::string(const FlowConfig&)> in_use{};
 };
 
 /// An option with its key, type, default, flag and help; the rest as OptionSpec's defaults.

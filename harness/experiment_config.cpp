@@ -403,13 +403,16 @@ void expand_cells(const std::vector<Dimension>& dims, const MatrixSpec& m,
       const std::string where = assignment.empty() ? source + " (defaults)"
                                                    : source + " (cell " + assignment.dump() + ")";
       // A default applies to the cells whose components read it (defaults {"solver.cycles": 2}
-      // beside an axis of solvers sets the multigrid's cycles, not CHOLMOD's); a value the
-      // cell's own assignment gives is checked strictly.
+      // beside an axis of solvers sets the multigrid's cycles, not CHOLMOD's), and so does a
+      // basis's option from any part of the matrix (octree.depth tied to the mesh sets the octree
+      // cells' depth, not the hat cells'); any other value the cell's own assignment gives is
+      // checked strictly.
       FlowConfig flow = flow_config_from_json_unchecked(raw, where);
       bool dropped = false;
       for (const std::string& key : inapplicable_keys(flow))
-        if (!assignment.contains(key)) {
+        if (!assignment.contains(key) || option_spec(key).matrix_drops) {
           erase_json_path(raw, key);
+          assignment.erase(key);
           dropped = true;
         }
       if (dropped) flow = flow_config_from_json_unchecked(raw, where);

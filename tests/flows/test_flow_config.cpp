@@ -98,6 +98,24 @@ TEST(FlowConfig, KeysOfComponentsNotInUseAreRefused) {
   refused({{"name", "cholmod"}, {"stall_ratio", 0.5}},
           "solver.stall_ratio: applies to solver \"multigrid\" only");
   refused({{"name", "petsc"}, {"residual_bound", 1e-3}}, "solver.residual_bound");
+  // The octree basis's options under the hat basis; refine_input is read by both, and the
+  // weight's inert value (what a hat config records) is no request.
+  const auto basis_refusal = [](const json& octree) {
+    return error_of(json{{"mesh", "a"}, {"basis", "hat"}, {"octree", octree}});
+  };
+  EXPECT_NE(basis_refusal({{"depth", 6}})
+                .find("cfg.json: octree.depth: applies to basis \"octree\" only, the basis is "
+                      "\"hat\""),
+            std::string::npos);
+  EXPECT_NE(basis_refusal({{"stabilization", "none"}}).find("octree.stabilization: \"none\""),
+            std::string::npos);
+  EXPECT_NE(basis_refusal({{"stabilization_weight", 2.0}}).find("octree.stabilization_weight"),
+            std::string::npos);
+  EXPECT_NE(basis_refusal({{"tracking", "rebuilt"}}).find("octree.tracking"), std::string::npos);
+  EXPECT_EQ(basis_refusal({{"refine_input", true}}), "");
+  EXPECT_EQ(basis_refusal({{"stabilization_weight", 0.5}}), "");
+  EXPECT_EQ(basis_refusal({{"depth", 8}}), "");  // the default
+  EXPECT_EQ(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"octree", {{"depth", 6}}}}), "");
   refused({{"name", "pcg"}, {"direct_after", 3}}, "solver.direct_after");
   // Taken where they are read, and at their defaults anywhere.
   for (const json& solver :

@@ -110,6 +110,31 @@ TEST(ExperimentConfig, DefaultsApplyWhereTheyAreReadAndAxisValuesStrictly) {
   }
 }
 
+// A basis's option applies to that basis's cells from any part of the matrix (octree.depth tied
+// to the mesh across bases): the hat cells record the default and lose it from their assignment;
+// where that leaves two cells alike, the matrix is refused.
+TEST(ExperimentConfig, ABasisOptionAppliesToItsBasisCellsFromAnyDimension) {
+  const auto e =
+      expand({{"defaults", base},
+              {"zip", json::parse(R"([{"mesh": ["icosphere:level=1", "icosphere:level=2"],
+                                                  "octree.depth": [6, 7]},
+                                                 {"basis": ["hat", "octree"]}])")}});
+  ASSERT_EQ(e.cells.size(), 4u);
+  EXPECT_EQ(e.cells[0].config["basis"], "hat");
+  EXPECT_EQ(e.cells[0].config["octree"]["depth"], 8);
+  EXPECT_FALSE(e.cells[0].assignment.contains("octree.depth"));
+  EXPECT_EQ(e.cells[1].config["octree"]["depth"], 6);
+  EXPECT_EQ(e.cells[1].assignment["octree.depth"], 6);
+  EXPECT_EQ(e.cells[3].config["octree"]["depth"], 7);
+  try {
+    expand(
+        {{"defaults", base}, {"axes", {{"basis", {"hat", "octree"}}, {"octree.depth", {6, 7}}}}});
+    ADD_FAILURE() << "two hat cells alike once octree.depth was dropped were taken";
+  } catch (const ConfigError& err) {
+    EXPECT_NE(std::string(err.what()).find("study.json"), std::string::npos) << err.what();
+  }
+}
+
 TEST(ExperimentConfig, ExcludeDropsMatchingCellsIncludingDefaults) {
   const auto e =
       expand({{"defaults", base},
@@ -175,6 +200,7 @@ TEST(ExperimentConfig, DottedKeysInDefaultsSetTheNestedOption) {
   const json j = {{"name", "s"},
                   {"defaults",
                    {{"mesh", "icosphere:level=1"},
+                    {"basis", "octree"},
                     {"solver", {{"name", "cholmod"}, {"tolerance", 1e-6}}},
                     {"solver.name", "pcg"},
                     {"octree.depth", 5}}},
