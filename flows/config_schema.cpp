@@ -74,6 +74,14 @@ std::vector<OptionSpec> tail_options() {
              "evaluates them at X_n instead (first order)"),
       [](auto& c) -> auto& { return c.extrapolate; });
   extrapolate.flag_kind = FlagKind::set_false;
+  extrapolate.refused_elsewhere = true;
+  extrapolate.owner_text = "the two-step integrators (crank-nicolson, bdf2)";
+  extrapolate.selected = [](const FlowConfig& c) {
+    return integrator_reads_extrapolate(c.integrator);
+  };
+  extrapolate.in_use = [](const FlowConfig& c) {
+    return "the integrator is \"" + c.integrator + "\"";
+  };
   OptionSpec dt = ranged(bind(
                              option("dt", OptionType::number, 1e-3, "--dt", "Time step"),
                              [](auto& c) -> auto& { return c.dt; }),

@@ -112,6 +112,10 @@ const std::vector<std::string>& integrator_names() {
   return names;
 }
 
+bool integrator_reads_extrapolate(const std::string& name) {
+  return name == "crank-nicolson" || name == "bdf2";
+}
+
 std::unique_ptr<Integrator> make_integrator(const std::string& name, bool extrapolate) {
   if (name == "explicit-euler") return std::make_unique<ExplicitEuler>();
   if (name == "semi-implicit") return std::make_unique<SemiImplicitEuler>();

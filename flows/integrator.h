@@ -21,6 +21,9 @@ class Integrator {
 
 /// explicit-euler, semi-implicit, crank-nicolson, bdf2, taylor2, neumann2.
 const std::vector<std::string>& integrator_names();
+/// Whether the integrator reads `extrapolate` (the two-step schemes: operators at the
+/// extrapolated X* or frozen at X_n).
+bool integrator_reads_extrapolate(const std::string& name);
 /// `extrapolate`: two-step schemes evaluate M, K at the extrapolated X* (second order on MCF);
 /// false freezes them at X_n (first order). Throws std::invalid_argument on an unknown name.
 std::unique_ptr<Integrator> make_integrator(const std::string& name, bool extrapolate);

@@ -116,6 +116,12 @@ TEST(FlowConfig, KeysOfComponentsNotInUseAreRefused) {
   EXPECT_EQ(basis_refusal({{"stabilization_weight", 0.5}}), "");
   EXPECT_EQ(basis_refusal({{"depth", 8}}), "");  // the default
   EXPECT_EQ(error_of(json{{"mesh", "a"}, {"basis", "octree"}, {"octree", {{"depth", 6}}}}), "");
+  // --frozen: the two-step integrators' operators at X_n; the others read nothing of it.
+  EXPECT_NE(error_of(json{{"mesh", "a"}, {"extrapolate", false}})
+                .find("cfg.json: extrapolate: applies to the two-step integrators (crank-nicolson, "
+                      "bdf2) only, the integrator is \"semi-implicit\""),
+            std::string::npos);
+  EXPECT_EQ(error_of(json{{"mesh", "a"}, {"integrator", "bdf2"}, {"extrapolate", false}}), "");
   refused({{"name", "pcg"}, {"direct_after", 3}}, "solver.direct_after");
   // Taken where they are read, and at their defaults anywhere.
   for (const json& solver :
