@@ -1,13 +1,19 @@
 #pragma once
 // The parallel loops every layer writes, on TBB. Each takes a body whose iterations write
-// disjoint outputs and read nothing another iteration of the same loop writes: then how the
-// range is split among threads cannot change the result, which stays bitwise the same for any
-// thread count. (Reductions, whose order of summation would depend on the split, are taken over
-// fixed chunks: parallel_for_chunks, and sum_over_chunks for a plain sum of per-chunk values.)
+// disjoint outputs and read nothing another iteration of the same loop writes, and splits the
+// range at points that depend on its length and grain only (TBB's simple_partitioner halves a
+// range until it is at most the grain; the auto partitioner splits where threads steal work).
+// Fixed split points matter even without a reduction: the compiler vectorizes the loop over a
+// block and finishes its remainder in scalar code, and the two may round a face's area or a
+// row's sum differently (a fused multiply-add in one and not the other), so a split that moved
+// with the threads' timing changed the last bits of the results from run to run. With fixed
+// splits the result is bitwise the same for any thread count. (Reductions are taken over fixed
+// chunks: parallel_for_chunks, and sum_over_chunks for a plain sum of per-chunk values.)
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -15,14 +21,16 @@
 
 namespace mcf {
 
-/// body(i) for every i in [0, n), in parallel over blocks of at least `grain` indices (TBB's
-/// blocked_range with its default partitioner).
+/// body(i) for every i in [0, n), in parallel over blocks of at most `grain` indices whose
+/// bounds depend on n and grain only (simple_partitioner).
 template <class Index, class Body>
 void parallel_for_indices(Index n, std::size_t grain, Body&& body) {
-  tbb::parallel_for(tbb::blocked_range<Index>(Index(0), n, grain),
-                    [&](const tbb::blocked_range<Index>& r) {
-                      for (Index i = r.begin(); i != r.end(); ++i) body(i);
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<Index>(Index(0), n, grain),
+      [&](const tbb::blocked_range<Index>& r) {
+        for (Index i = r.begin(); i != r.end(); ++i) body(i);
+      },
+      tbb::simple_partitioner());
 }
 
 /// body(chunk, begin, end) for the fixed chunks [c * size, min(n, (c + 1) * size)) of [0, n), in

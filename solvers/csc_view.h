@@ -11,10 +11,11 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 namespace mcf::multigrid_detail {
 
-constexpr int kGrain = 256;         // rows per TBB task
+constexpr int kGrain = 4096;        // rows per TBB task, at most (fixed blocks: simple_partitioner)
 constexpr int kSerialBelow = 2048;  // loops shorter than this run serially (same result)
 
 /// Runs f(begin, end) over [0, n), in parallel when n is large enough. Every kernel writes
@@ -25,8 +26,11 @@ void for_rows(int n, F&& f) {
     f(0, n);
     return;
   }
-  tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain),
-                    [&](const tbb::blocked_range<int>& r) { f(r.begin(), r.end()); });
+  // Split points fixed by n and the grain (core/parallel.h: a vectorized block and its scalar
+  // remainder may round differently, so where a block ends must not move with the threads).
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, n, kGrain),
+      [&](const tbb::blocked_range<int>& r) { f(r.begin(), r.end()); }, tbb::simple_partitioner());
 }
 
 /// Raw view of a compressed column-major matrix.
