@@ -245,7 +245,8 @@ struct RankMultigrid::Impl {
         ++outer[nf + std::size_t(F.off.ja[p]) + 1];
     }
     for (std::size_t c = 0; c < rows; ++c) outer[c + 1] += outer[c];
-    std::vector<int> inner(std::size_t(outer[rows])), next(outer.begin(), outer.end() - 1);
+    std::vector<int> inner(static_cast<std::size_t>(outer[rows])),
+        next(outer.begin(), outer.end() - 1);
     F.ext_source.assign(inner.size() - std::size_t(outer[nf]), 0);
     for (std::size_t k = 0; k < nf; ++k) {
       for (PetscInt p = F.diagonal.ia[k]; p < F.diagonal.ia[k + 1]; ++p) {
