@@ -12,7 +12,7 @@ namespace mcf::dist {
 
 namespace {
 
-/// Per column Σ_i u(i, c) v(i, c) over the owned rows of every rank, then the `extra` sums.
+/// Per column Σ_i u(i, c) v(i, c) over the owned rows of every rank, summed in rank order.
 std::array<double, 3> column_dots(const std::vector<double>& u, const std::vector<double>& v) {
   std::vector<double> partial(3, 0.0);
   for (std::size_t i = 0; i < u.size(); i += 4)

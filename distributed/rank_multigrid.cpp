@@ -533,13 +533,13 @@ RankMultigrid::~RankMultigrid() = default;
 
 void RankMultigrid::set_operator(Mat A) {
   Impl& s = *impl_;
+  // Patterns, diagonal positions and interface rows are made once: A's pattern (and with it
+  // every coarse level's) is the same at every call; only the values are refreshed below.
   if (!s.read_finest(A) || !s.symbolic_done) {
     for (std::size_t l = s.levels.size() - 1; l > 0; --l) s.galerkin_symbolic(l);
     for (auto& L : s.levels) s.find_diagonals(L);
     s.gather_symbolic();
     s.symbolic_done = true;
-  } else {
-    s.find_diagonals(s.levels.back());  // PETSc's arrays may have moved
   }
   for (std::size_t l = s.levels.size() - 1; l > 0; --l) s.galerkin_numeric(l);
   for (auto& L : s.levels) s.invert_diagonals(L);

@@ -98,6 +98,17 @@ double storage_bytes(Mat m) {
          double(rows + 1) * double(sizeof(PetscInt));
 }
 
+/// The KSP's type and its PC's type ("" where not set).
+std::pair<std::string, std::string> ksp_and_pc_types(KSP ksp) {
+  KSPType kt = nullptr;
+  PC pc = nullptr;
+  PCType pt = nullptr;
+  KSPGetType(ksp, &kt);
+  KSPGetPC(ksp, &pc);
+  PCGetType(pc, &pt);
+  return {kt ? kt : "", pt ? pt : ""};
+}
+
 /// Inserts `options` under `prefix` into PETSc's options database.
 void insert_options(const std::string& prefix, const std::string& options) {
   petsc_check(PetscOptionsPrefixPush(nullptr, prefix.c_str()), "PetscOptionsPrefixPush");
@@ -557,14 +568,9 @@ std::vector<std::pair<std::string, std::string>> RankSystem::settings() const {
                      "Cholesky (LDLT) of the gathered coarsest level on every rank");
     out.emplace_back("direct_fallback", "PETSc's Cholesky with MUMPS");
   } else {
-    KSPType kt = nullptr;
-    PC pc = nullptr;
-    PCType pt = nullptr;
-    KSPGetType(s.ksp, &kt);
-    KSPGetPC(s.ksp, &pc);
-    PCGetType(pc, &pt);
-    out.emplace_back("ksp_type", kt ? kt : "");
-    out.emplace_back("pc_type", pt ? pt : "");
+    const auto [kt, pt] = ksp_and_pc_types(s.ksp);
+    out.emplace_back("ksp_type", kt);
+    out.emplace_back("pc_type", pt);
     out.emplace_back("options_prefix", s.prefix);
     out.emplace_back("inserted_options", s.inserted);
     out.emplace_back("petsc_options", s.options.petsc_options);
@@ -577,13 +583,8 @@ std::string RankSystem::name() const {
   const Impl& s = *impl_;
   if (s.options.solver == "multigrid") return "distributed-multigrid";
   if (s.options.solver == "pcg") return "distributed-pcg-multigrid";
-  KSPType kt = nullptr;
-  PC pc = nullptr;
-  PCType pt = nullptr;
-  KSPGetType(s.ksp, &kt);
-  KSPGetPC(s.ksp, &pc);
-  PCGetType(pc, &pt);
-  return std::string("petsc-") + (kt ? kt : "?") + "-" + (pt ? pt : "?");
+  const auto [kt, pt] = ksp_and_pc_types(s.ksp);
+  return "petsc-" + (kt.empty() ? "?" : kt) + "-" + (pt.empty() ? "?" : pt);
 }
 
 int RankSystem::levels() const {
