@@ -3,6 +3,7 @@
 #include "distributed/comm.h"
 #include "distributed/rank_block_cg.h"
 #include "distributed/rank_multigrid.h"
+#include "solvers/multigrid_fallback.h"
 #include "solvers/petsc_runtime.h"
 #include "solvers/petsc_solver.h"
 
@@ -139,6 +140,7 @@ struct RankSystem::Impl {
   KSP ksp = nullptr, direct = nullptr;       // solver "petsc"; MUMPS, the guard's last step
   std::unique_ptr<RankMultigrid> multigrid;  // solvers "multigrid" and "pcg"
   bool guarded = false;                      // fixed multigrid cycles with a residual bound
+  double start_fit = -1;                     // the solve under way's (RankSystem::solve)
   bool prefer_direct = false;                // an earlier step needed the factorization
   int level_count = 1;
 
@@ -363,7 +365,10 @@ struct RankSystem::Impl {
       rel = relative_residuals(*multigrid, B.data(), X.data());
       iterations.fill(options.cycles);
       reasons.fill(guarded ? "cycles under the bound" : "fixed cycles");
-      if (guarded) guard(B, X, rel, iterations, reasons, status, report);
+      if (guarded && !options.bound_smooth_steps && start_fit >= kSmoothStartFit)
+        keep_smooth_step(rel, reasons, status, report);
+      else if (guarded)
+        guard(B, X, rel, iterations, reasons, status, report);
     }
     for (std::size_t c = 0; c < 3; ++c) {
       if (!std::isfinite(rel[c])) status[c] = SolveStatus::numerical_issue;
@@ -379,6 +384,26 @@ struct RankSystem::Impl {
     }
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < 3; ++c) Y(i, c) = X[4 * std::size_t(i) + std::size_t(c)];
+  }
+
+  /// A smooth step (its start fit the prediction: solvers/multigrid_fallback.h, "Smooth steps")
+  /// keeps its cycles in the coordinates above the bound, with status max_iterations and a note.
+  void keep_smooth_step(const std::array<double, 3>& rel, std::array<std::string, 3>& reasons,
+                        std::array<SolveStatus, 3>& status, SolveReport& report) const {
+    bool kept = false;
+    for (std::size_t c = 0; c < 3; ++c)
+      if (std::isfinite(rel[c]) && rel[c] > options.residual_bound) {
+        status[c] = SolveStatus::max_iterations;
+        reasons[c] = "cycles above the bound, kept: a smooth step";
+        kept = true;
+      }
+    if (!kept) return;
+    char note[128];
+    std::snprintf(note, sizeof note,
+                  "cycles ended above the residual bound %.3g; kept: a smooth step (the start "
+                  "fit the prediction at %.2f)",
+                  options.residual_bound, start_fit);
+    report.message = joined_messages(report.message, note);
   }
 
   /// Fixed cycles ended above the residual bound in some coordinates: CG preconditioned by the
@@ -505,8 +530,9 @@ Coefficients RankSystem::apply_stiffness(const Coefficients& owned) {
 }
 
 SolveReport RankSystem::solve(double a, double b, const Coefficients& R, const Coefficients& held,
-                              const Coefficients& warm, Coefficients& Y) {
+                              const Coefficients& warm, Coefficients& Y, double start_fit) {
   Impl& s = *impl_;
+  s.start_fit = start_fit;
   SolveReport report;
   const int n = s.mesh.owned;
   Y.resize(n, 3);

@@ -42,6 +42,9 @@ struct RankSolverOptions {
   /// preconditioned by the cycle to it, then a distributed factorization (MUMPS); 0 = no bound
   /// (solvers/multigrid_fallback.h is the one-process guard).
   double residual_bound = 1e-4;
+  /// Hold smooth steps (start fit >= kSmoothStartFit, solvers/multigrid_fallback.h) to the bound
+  /// too; by default such a step keeps its cycles above it and says so.
+  bool bound_smooth_steps = false;
   int direct_after = 10;
 };
 
@@ -61,9 +64,10 @@ class RankSystem {
   Coefficients apply_mass(const Coefficients& owned);
   Coefficients apply_stiffness(const Coefficients& owned);
   /// Solves (a M + b K) Y = R on the owned rows, from `warm`, with the held rows at `held`.
+  /// `start_fit`: how well `warm` fit a prediction (LinearSolver::set_start_fit; negative: none).
   /// Collective. The report is the same on every rank.
   SolveReport solve(double a, double b, const Coefficients& R, const Coefficients& held,
-                    const Coefficients& warm, Coefficients& Y);
+                    const Coefficients& warm, Coefficients& Y, double start_fit = -1);
 
   /// Owned functions held by the boundary (local numbers), and their count over all ranks.
   const std::vector<int>& held() const { return held_; }

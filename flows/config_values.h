@@ -46,6 +46,10 @@ struct SolverConfig {
   /// (solvers/multigrid_fallback.h: kDefaultResidualBound, which a test holds this to). 0 = no
   /// bound.
   double residual_bound = 1e-4;
+  /// multigrid: hold smooth steps (the start fit the integrator's prediction, the cycles
+  /// contracted) to residual_bound too; false = such a step keeps its fixed work above the bound
+  /// and says so (solvers/multigrid_fallback.h, "Smooth steps").
+  bool bound_smooth_steps = false;
   double fallback_tolerance = 1e-10;
   /// multigrid: the fallback CG's iterations after which (or on whose breakdown) CHOLMOD solves
   /// the step, and every later stalled step at once (solvers/multigrid_fallback.h). 0 = never.

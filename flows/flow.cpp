@@ -116,6 +116,7 @@ class FlowStepContext final : public StepContext {
       const SparseView M = basis_.mass(), K = basis_.stiffness();
       predicted_start(MatrixSum(a, M, b, K), R, fixed, warm, start_);
       start_.increment += fixed;  // the start itself
+      solver_.set_start_fit(start_.theta);
       Y = system_->solve(a, b, R, fixed, start_.increment);
     } else {
       Y = system_->solve(a, b, R, fixed, warm);

@@ -30,6 +30,7 @@ std::unique_ptr<LinearSolver> make_multigrid(const SolverConfig& c) {
   StallFallbackOptions f;
   f.stall_ratio = c.stall_ratio;
   f.residual_bound = c.residual_bound;
+  f.bound_smooth_steps = c.bound_smooth_steps;
   f.tolerance = c.fallback_tolerance;
   f.max_iterations = c.max_iterations;
   f.direct_after = c.direct_after;
@@ -57,6 +58,18 @@ void check(const SolverRow& row) {
   if (!row.memory)
     throw std::logic_error("solver \"" + row.name +
                            "\" registered without a memory model (flows/memory_model.h)");
+}
+
+OptionSpec bound_smooth_steps_option() {
+  OptionSpec o = bind(
+      option("bound_smooth_steps", OptionType::boolean, false, "--bound-smooth-steps",
+             "Multigrid: hold smooth steps to the residual bound too; by default "
+             "a step whose start fit the integrator's prediction (theta >= 0.5) "
+             "and whose cycles contracted keeps its fixed work above the bound "
+             "and says so"),
+      [](auto& c) -> auto& { return c.solver.bound_smooth_steps; });
+  o.flag_kind = FlagKind::set_true;
+  return o;
 }
 
 NamedTable<SolverRow> built_in() {
@@ -94,6 +107,7 @@ NamedTable<SolverRow> built_in() {
                         "preconditioned by the cycle, then the factorization; 0 = no bound"),
                  [](auto& c) -> auto& { return c.solver.residual_bound; }),
              0, 1),
+      bound_smooth_steps_option(),
       ranged(bind(
                  option("fallback_tolerance", OptionType::number, 1e-10, "--fallback-tolerance",
                         "Multigrid: the fallback CG never stops below this relative residual"),

@@ -117,14 +117,19 @@ SolveReport LinearSolver::solve(const ConstMatrixRef& B, MatrixRef X) {
     report.message = "warm start has " + std::to_string(X.rows()) + " x " +
                      std::to_string(X.cols()) + " entries, the right-hand side " +
                      std::to_string(B.rows()) + " x " + std::to_string(B.cols());
+    start_fit_ = -1;
     return report;
   }
-  return solve_in_place(B, X);
+  SolveReport report = solve_in_place(B, X);
+  start_fit_ = -1;  // a hint for one solve
+  return report;
 }
 
 SolveReport LinearSolver::solve(const ConstMatrixRef& B, Eigen::MatrixXd& X) {
   if (X.rows() != B.rows() || X.cols() != B.cols()) X.setZero(B.rows(), B.cols());
-  return solve_in_place(B, MatrixRef(X));
+  SolveReport report = solve_in_place(B, MatrixRef(X));
+  start_fit_ = -1;
+  return report;
 }
 
 }  // namespace mcf

@@ -223,11 +223,21 @@ class LinearSolver {
   /// The same for a resizable X: one of another shape than B's is first set to zero.
   SolveReport solve(const ConstMatrixRef& B, Eigen::MatrixXd& X);
 
+  /// How well the caller predicted the next solve's warm start: θ ∈ [0, 1], the part of an
+  /// extrapolated motion that fit the equations (flows/predicted_start.h); negative = no
+  /// prediction. It holds for the next solve only. A solver held to a residual bound may keep a
+  /// fixed-work answer above the bound where the start fit (FallbackMultigridSolver); the others
+  /// ignore it.
+  void set_start_fit(double theta) { start_fit_ = theta; }
+
  protected:
   /// What every solver implements: solve() with X already of B's shape.
   virtual SolveReport solve_in_place(const ConstMatrixRef& B, MatrixRef X) = 0;
+  /// The θ of set_start_fit for the solve under way (negative: none given).
+  double start_fit() const { return start_fit_; }
 
  private:
+  double start_fit_ = -1;
   SparseMatrix sum_;           // the default set_matrix_sum's a M + b K
   std::uint64_t sum_key_ = 0;  // pattern key of the last call
 };

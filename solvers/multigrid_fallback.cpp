@@ -119,6 +119,20 @@ SolveReport FallbackMultigridSolver::solve_in_place(const ConstMatrixRef& B, Mat
     if (bound > 0 || reached_floor) cycles.status = SolveStatus::converged;
     return cycles;
   }
+  const double fit = start_fit();
+  if (!stalled && !fallback_.bound_smooth_steps && fit >= kSmoothStartFit) {
+    // A smooth stretch of the flow: the start fit the extrapolated motion and the cycles
+    // contracted. The step keeps its fixed work, above the bound, and says so (the header's
+    // "Smooth steps").
+    char note[160];
+    std::snprintf(note, sizeof note,
+                  "cycles ended at %.3g, above the residual bound %.3g; kept: a smooth step (the "
+                  "start fit the prediction at %.2f)",
+                  cycles.relative_residual, bound, fit);
+    cycles.status = SolveStatus::max_iterations;
+    cycles.message = joined_messages(cycles.message, note);
+    return cycles;
+  }
   ++fallbacks_;
   char note[192];
   if (stalled)

@@ -31,6 +31,15 @@
 // pattern stays. Where the matrix is not positive definite to working precision either, the
 // factorization says so, and the step fails as a CHOLMOD flow's would.
 //
+// - Smooth steps: where the caller says the step's start fit its prediction
+//   (LinearSolver::set_start_fit, θ >= kSmoothStartFit: the motion continues as extrapolated)
+//   and the cycles contracted, the flow is in a smooth stretch: an error the cycles leave there
+//   is damped by the following steps, as the flow's diffusion damps any perturbation, where near
+//   a fold the operators change with the positions and a step's error grows. Such a step keeps
+//   its fixed work even above the bound and says so (`max_iterations`, with the residual and θ
+//   in the message), unless `bound_smooth_steps`. The first step (no prediction) and every step
+//   without a start fit are held to the bound.
+//
 // The guard costs nothing on a step whose cycles contract and end under the bound but one
 // residual pass (to know the contraction); CG and the factorization read the finest matrix in the
 // caller's numbering, which the multigrid lays out at the first step that needs them and
@@ -38,8 +47,8 @@
 //
 // Status: `converged` where the step ended at or below the bound (or, with no bound, where CG
 // reached its stall target), or the factorization solved it; `max_iterations` where the cycles
-// were not checked against a bound (residual_bound 0) or CG ran out with no factorization
-// allowed.
+// were not checked against a bound (residual_bound 0), a smooth step kept its fixed work above
+// it, or CG ran out with no factorization allowed.
 
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"
@@ -54,6 +63,12 @@ namespace mcf {
 /// measurements behind it).
 inline constexpr double kDefaultResidualBound = 1e-4;
 
+/// The start fit θ (LinearSolver::set_start_fit) from which a step counts as smooth. On the
+/// measured flows (docs/flow.md "Guarded cycles") steps approaching a fold fit at θ <= 0.06 (the
+/// extrapolation overshoots an accelerating motion) and steps of smooth stretches, scanned
+/// models' included, at θ >= 0.6 after the first two.
+inline constexpr double kSmoothStartFit = 0.5;
+
 /// Gauss-Seidel sweeps each way of the V-cycles that continue a contracting step that ended
 /// above the bound (fewer where the configured cycle has fewer).
 inline constexpr int kExtraCycleSweeps = 2;
@@ -65,6 +80,10 @@ struct StallFallbackOptions {
   /// A step ending above this relative residual continues (more cycles, CG, the factorization)
   /// until it is at or below it; 0 = no bound (the stall test alone).
   double residual_bound = kDefaultResidualBound;
+  /// Hold smooth steps to the bound too. By default a step whose start fit the caller's
+  /// prediction (start_fit() >= kSmoothStartFit) and whose cycles did not stall keeps its fixed
+  /// work above the bound, with status max_iterations and a note.
+  bool bound_smooth_steps = false;
   double tolerance = 1e-10;  ///< the fallback CG never stops below this relative residual
   int max_iterations = 1000;
   /// CG iterations after which a stalled step goes to the factorization (also at once on a

@@ -1523,6 +1523,54 @@ TEST(MultigridFallback, ContractingCyclesAboveTheBoundRunMoreCyclesToIt) {
   EXPECT_EQ(unbound.solve(B, Z).status, SolveStatus::max_iterations);
 }
 
+// A step whose start fit the caller's prediction (a smooth stretch of a flow) keeps its
+// contracting cycles' answer above the bound and says so; without a fit, with a poor one, or with
+// bound_smooth_steps it continues to the bound. The hint holds for one solve only.
+TEST(MultigridFallback, SmoothStepsKeepTheirCyclesAboveTheBoundAndSaySo) {
+  Problem pr = make_problem(4, 1, 0.05);
+  const Eigen::MatrixXd B = random_matrix(pr.A.rows(), 3, 24);
+  MultigridOptions o;  // one W-cycle from zero: contracting, far above 1e-8
+  mcf::StallFallbackOptions f;
+  f.residual_bound = 1e-8;
+  f.direct_after = 0;
+  mcf::FallbackMultigridSolver guarded(o, f);
+  ASSERT_TRUE(guarded.set_matrix(pr.A, pr.view()).ok());
+  MultigridSolver plain(o);
+  ASSERT_TRUE(plain.set_matrix(pr.A, pr.view()).ok());
+  Eigen::MatrixXd cycles = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  const mcf::SolveReport fixed = plain.solve(B, cycles);
+  ASSERT_GT(fixed.relative_residual, 1e3 * f.residual_bound);
+
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(pr.A.rows(), 3);
+  guarded.set_start_fit(mcf::kSmoothStartFit);
+  const mcf::SolveReport kept = guarded.solve(B, X);
+  EXPECT_EQ(kept.status, SolveStatus::max_iterations);  // not converged: above the bound
+  EXPECT_EQ(kept.relative_residual, fixed.relative_residual);
+  EXPECT_EQ(kept.iterations, 1);
+  EXPECT_EQ(kept.extra_cycles + kept.fallback_iterations, 0);
+  EXPECT_EQ(X, cycles);
+  EXPECT_NE(kept.message.find("kept: a smooth step"), std::string::npos) << kept.message;
+
+  // The next solve has no fit: held to the bound.
+  X.setZero();
+  const mcf::SolveReport held = guarded.solve(B, X);
+  EXPECT_EQ(held.status, SolveStatus::converged);
+  EXPECT_LE(held.relative_residual, f.residual_bound);
+  // A poor fit: held to the bound.
+  X.setZero();
+  guarded.set_start_fit(0.9 * mcf::kSmoothStartFit);
+  EXPECT_EQ(guarded.solve(B, X).status, SolveStatus::converged);
+  // bound_smooth_steps: every step held.
+  f.bound_smooth_steps = true;
+  mcf::FallbackMultigridSolver strict(o, f);
+  ASSERT_TRUE(strict.set_matrix(pr.A, pr.view()).ok());
+  X.setZero();
+  strict.set_start_fit(1.0);
+  const mcf::SolveReport all = strict.solve(B, X);
+  EXPECT_EQ(all.status, SolveStatus::converged);
+  EXPECT_LE(all.relative_residual, f.residual_bound);
+}
+
 // A bound a few cycles cannot reach goes to CG by the cycle, whose target is the bound (not the
 // stall target, nor the fallback tolerance below it).
 TEST(MultigridFallback, ABoundFarBelowTheCyclesIsReachedByCg) {
