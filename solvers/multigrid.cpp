@@ -381,71 +381,11 @@ struct MultigridSolver::Impl {
 
   // ---- cycle ----
 
-  /// A sweep's two passes over relaxation blocks (header, "Smoother ordering"): the blocks of one
-  /// parity (parity, parity + 2, ...) never couple, so each pass relaxes them in parallel.
-  template <class Relax>
-  static void relax_by_parity(int blocks, bool reverse, const Relax& relax_block) {
-    for (int pi = 0; pi < 2; ++pi) {
-      const int parity = block_parity(pi, reverse);
-      const int count = (blocks - parity + 1) / 2;
-      if (count <= 1) {
-        for (int j = 0; j < count; ++j) relax_block(parity + 2 * j);
-        continue;
-      }
-      tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
-                        [&](const tbb::blocked_range<int>& r) {
-                          for (int j = r.begin(); j < r.end(); ++j) relax_block(parity + 2 * j);
-                        });
-    }
-  }
-
+  /// One Gauss-Seidel sweep on level l (solvers/smoother.h, gauss_seidel_sweep).
   void sweep(int l, bool reverse) {
     Level& L = levels[std::size_t(l)];
-    const Csc A(L.A);
-    const double* id = L.inv_diag.data();
-    const int* dp = L.diag_pos.data();
-    const double* b = L.b.data();
-    double* x = L.x.data();
-    for (int o = 0; o < int(s); o += 4) {
-      if (L.coloured) {
-        const SmootherRows& S = L.smoother;
-        const auto relax_block = [&](int q) {
-          for_block_segments(L, q, reverse, [&](int r0, int r1) {
-            if (S.aligned) {
-              for (int r = r0; r < r1; ++r)
-                gs_row_aligned(A, S.offset.data(), dp, id, b, x, s, o, r);
-            } else if (!S.empty()) {
-              for (int r = r0; r < r1; ++r) gs_row_compact(S, S.single.data(), id, b, x, s, o, r);
-            } else {
-              for (int r = r0; r < r1; ++r) gs_row(A, dp, id, b, x, s, o, r);
-            }
-          });
-        };
-        relax_by_parity(L.blocks(), reverse, relax_block);
-      } else {
-        // Without colours: blocks of consecutive rows, each relaxed in row order (reverse: the
-        // exact reverse), even blocks in parallel, then odd ones (header, "Smoother ordering").
-        const SmootherRows& S = L.smoother;
-        const auto relax_block = [&](int q) {
-          const int first = L.block_first(q), last = L.block_last(q);
-          // Written out per kernel and direction: a generic row lambda here measured a few
-          // percent slower.
-          if (!S.empty()) {
-            if (!reverse)
-              for (int i = first; i < last; ++i)
-                gs_row_compact(S, S.single.data(), id, b, x, s, o, i);
-            else
-              for (int i = last - 1; i >= first; --i)
-                gs_row_compact(S, S.single.data(), id, b, x, s, o, i);
-          } else if (!reverse) {
-            for (int i = first; i < last; ++i) gs_row(A, dp, id, b, x, s, o, i);
-          } else {
-            for (int i = last - 1; i >= first; --i) gs_row(A, dp, id, b, x, s, o, i);
-          }
-        };
-        relax_by_parity(L.blocks(), reverse, relax_block);
-      }
-    }
+    gauss_seidel_sweep(L, Csc(L.A), L.smoother, L.diag_pos.data(), L.inv_diag.data(), L.b.data(),
+                       L.x.data(), s, reverse);
   }
 
   void residual(int l) {
