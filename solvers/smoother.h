@@ -10,7 +10,7 @@
 //   iterates. Nothing in them depends on threads: a sweep's result is fixed to the bit by the
 //   order in which its caller visits the rows.
 // - The kernels are in this header, force-inlined, because the sweeps (gauss_seidel_sweep,
-//   solvers/smoother.cpp) and the cycle's residual (solvers/multigrid.cpp) run at full speed
+//   solvers/smoother.cpp) and the cycle's residual (solvers/multigrid_cycle.cpp) run at full speed
 //   only with them inlined into their loops (below).
 // - gauss_seidel_sweep visits a level's rows in the one serial order that relaxation_order()
 //   lists (solvers/level_ordering.h), blocks of one parity in parallel, so its result is the same
