@@ -256,7 +256,7 @@ SolveReport MultigridState::solve(const ConstMatrixRef& B, MatrixRef X,
     return rep;
   }
   rep.status = SolveStatus::max_iterations;
-  for (int c = 0; c < std::max(options.cycles, 0); ++c) {
+  for (int c = 0; c < options.cycles; ++c) {
     if (mixed)
       correction_cycle(options, have_r);
     else
