@@ -1,7 +1,7 @@
 #pragma once
 // Sets of indices in compressed rows (set i's members are member[start[i] .. start[i + 1]), a
 // sparsity pattern without values), built in parallel: the coarse graphs of the surface hierarchy
-// (bases/surface_hierarchy.cpp) and the columns of its Galerkin patterns (galerkin_pattern).
+// (bases/surface_hierarchy.cpp) and the columns of a Galerkin pattern (core/galerkin_pattern.h).
 // Both functions give the same arrays for any number of threads.
 
 #include "core/parallel.h"

@@ -1,5 +1,7 @@
 #include "solvers/multigrid_state.h"
 
+#include "core/galerkin_pattern.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -46,7 +48,7 @@ void MultigridState::symbolic(const SparseRef& A, const std::vector<SparseMatrix
   }
   for (std::size_t l = nl - 1; l-- > 0;) {
     Level& C = levels[l];
-    C.A = symbolic_product(C.PT, symbolic_product(levels[l + 1].A, C.P));  // pattern of Pᵀ (A P)
+    C.A = galerkin_pattern(C.P, levels[l + 1].A);  // pattern of Pᵀ A P, sorted
     // Positions of transposed entries, to symmetrize the computed values exactly.
     C.transpose_pos = transpose_positions(C.A);
   }
