@@ -1,5 +1,7 @@
 #include "bases/surface_hierarchy.h"
 
+#include "core/compressed_sets.h"
+#include "core/galerkin_pattern.h"
 #include "core/parallel.h"
 #include "core/undirected_graph.h"
 
@@ -24,52 +26,6 @@ struct LevelMesh {
   std::vector<std::array<int, 3>> triangles;
   int size() const { return int(points.rows()); }
 };
-
-/// Sets over [0, universe) for the indices [0, n), in compressed rows, unsorted: body(i, mark,
-/// out) writes set i's members to out[0 ..) and returns their number, where bound(i) is at least
-/// that number and mark[x] == i says x is already written (`mark` is the calling thread's, never
-/// reset). Fixed chunks of indices, each written by one task, so the arrays are the same for any
-/// thread count.
-template <class Bound, class Body>
-void gather_sets(int n, int universe, Bound&& bound, Body&& body, std::vector<int>& start,
-                 std::vector<int>& member) {
-  constexpr int chunk = 1024;
-  const int chunks = (n + chunk - 1) / chunk;
-  std::vector<std::vector<int>> members(static_cast<std::size_t>(chunks));
-  start.assign(std::size_t(n) + 1, 0);
-  tbb::enumerable_thread_specific<std::vector<int>> marks(
-      [universe] { return std::vector<int>(std::size_t(universe), -1); });
-  parallel_for_chunks(n, chunk, [&](int c, int begin, int end) {
-    std::vector<int>& mark = marks.local();
-    std::vector<int>& out = members[std::size_t(c)];
-    for (int i = begin; i < end; ++i) {
-      const std::size_t first = out.size();
-      out.resize(first + std::size_t(bound(i)));
-      const int count = body(i, mark.data(), out.data() + first);
-      out.resize(first + std::size_t(count));
-      start[std::size_t(i) + 1] = count;
-    }
-  });
-  for (int i = 0; i < n; ++i) start[std::size_t(i) + 1] += start[std::size_t(i)];
-  member.resize(std::size_t(start.back()));
-  parallel_for_indices(chunks, 1, [&](int c) {
-    std::copy(members[std::size_t(c)].begin(), members[std::size_t(c)].end(),
-              member.begin() + start[std::size_t(c) * chunk]);
-  });
-}
-
-/// Sorts the sets of a symmetric relation in compressed rows (x in set y exactly when y is in set
-/// x): its transpose, taken by one counting pass over the sets in order, is the relation with each
-/// set ascending (set x's members are the sets that hold x).
-void sort_symmetric_sets(const std::vector<int>& start, std::vector<int>& member) {
-  std::vector<int> sorted(member.size());
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  const int n = int(start.size()) - 1;
-  for (int y = 0; y < n; ++y)
-    for (int e = start[std::size_t(y)]; e < start[std::size_t(y) + 1]; ++e)
-      sorted[std::size_t(fill[std::size_t(member[std::size_t(e)])]++)] = y;
-  member.swap(sorted);
-}
 
 /// CSR of the undirected graph of `pairs` (each given once or twice) on n vertices.
 void build_graph(int n, std::vector<std::pair<int, int>>& pairs, LevelMesh& level) {
@@ -478,77 +434,6 @@ std::vector<std::uint8_t> solver_colours(const SparseMatrix& pattern) {
 }
 
 }  // namespace
-
-SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A) {
-  const int n = int(P.rows()), nc = int(P.cols());
-  const int* Pouter = P.outerIndexPtr();
-  const int* Pinner = P.innerIndexPtr();
-  const int* Aouter = A.outerIndexPtr();
-  const int* Ainner = A.innerIndexPtr();
-  // P's rows: the coarse vertices each fine vertex takes values from (ascending).
-  std::vector<int> row_start(std::size_t(n) + 1, 0), row_coarse(std::size_t(P.nonZeros()));
-  for (int p = 0; p < Pouter[nc]; ++p) ++row_start[std::size_t(Pinner[p]) + 1];
-  for (int i = 0; i < n; ++i) row_start[std::size_t(i) + 1] += row_start[std::size_t(i)];
-  {
-    std::vector<int> fill(row_start.begin(), row_start.end() - 1);
-    for (int J = 0; J < nc; ++J)
-      for (int p = Pouter[J]; p < Pouter[J + 1]; ++p)
-        row_coarse[std::size_t(fill[std::size_t(Pinner[p])]++)] = J;
-  }
-  int longest_row = 0;
-  for (int i = 0; i < n; ++i)
-    longest_row = std::max(longest_row, row_start[std::size_t(i) + 1] - row_start[std::size_t(i)]);
-  // Two set products, as the numeric product takes them: first the coarse vertices next to each
-  // fine one (the pattern of P^T A, column j: every I with P(i, I) A(i, j) stored), then column J
-  // of the product: the union of those sets over the fine vertices of P's column J. Taking the
-  // union per fine vertex first does each repeated I once. (Members are written whether new or
-  // not and kept by the count: no branch on the mark.)
-  std::vector<int> near_start, near;
-  gather_sets(
-      n, nc, [&](int j) { return (Aouter[j + 1] - Aouter[j]) * longest_row; },
-      [&](int j, int* mark, int* out) {
-        int count = 0;
-        for (int a = Aouter[j]; a < Aouter[j + 1]; ++a) {
-          const int i = Ainner[a];
-          for (int r = row_start[std::size_t(i)]; r < row_start[std::size_t(i) + 1]; ++r) {
-            const int I = row_coarse[std::size_t(r)];
-            out[count] = I;
-            count += mark[I] != j;
-            mark[I] = j;
-          }
-        }
-        return count;
-      },
-      near_start, near);
-  int most_near = 0;
-  for (int j = 0; j < n; ++j)
-    most_near = std::max(most_near, near_start[std::size_t(j) + 1] - near_start[std::size_t(j)]);
-  std::vector<int> outer, inner;
-  gather_sets(
-      nc, nc, [&](int J) { return (Pouter[J + 1] - Pouter[J]) * most_near; },
-      [&](int J, int* mark, int* out) {
-        int count = 0;
-        for (int p = Pouter[J]; p < Pouter[J + 1]; ++p) {
-          const int j = Pinner[p];
-          for (int r = near_start[std::size_t(j)]; r < near_start[std::size_t(j) + 1]; ++r) {
-            const int I = near[std::size_t(r)];
-            out[count] = I;
-            count += mark[I] != J;
-            mark[I] = J;
-          }
-        }
-        return count;
-      },
-      outer, inner);
-  // The product is symmetric (A is).
-  sort_symmetric_sets(outer, inner);
-  SparseMatrix C(nc, nc);
-  C.resizeNonZeros(Eigen::Index(inner.size()));
-  std::copy(outer.begin(), outer.end(), C.outerIndexPtr());
-  std::copy(inner.begin(), inner.end(), C.innerIndexPtr());
-  std::fill(C.valuePtr(), C.valuePtr() + C.nonZeros(), 1.0);
-  return C;
-}
 
 std::vector<int> greedy_colouring(const SparseMatrix& A, int* count) {
   if (!A.isCompressed()) {

@@ -23,10 +23,10 @@
 // directly) or coarsening stops shrinking.
 //
 // Each level also gets a Gauss-Seidel colouring of the pattern its Galerkin matrix will have
-// (the finest: vertices sharing a triangle; coarser: P^T A P's), smallest-last greedy, so that
-// the multigrid can relax colour by colour in parallel; a level that needs more than the eight
-// colours the solver takes gets no colouring and is relaxed in blocks of consecutive rows
-// (solvers/multigrid.h, "Smoother ordering").
+// (the finest: vertices sharing a triangle; coarser: P^T A P's, core/galerkin_pattern.h),
+// smallest-last greedy, so that the multigrid can relax colour by colour in parallel; a level that
+// needs more than the eight colours the solver takes gets no colouring and is relaxed in blocks of
+// consecutive rows (solvers/multigrid.h, "Smoother ordering").
 //
 // Everything is deterministic: serial loops in fixed orders, ties broken by index, and parallel
 // loops whose iterations write disjoint outputs, over fixed chunks where they gather (the same
@@ -74,14 +74,6 @@ SurfaceHierarchy build_surface_hierarchy(const Positions& vertices, const Triang
 std::vector<int> graph_voronoi_cells(const std::vector<int>& start,
                                      const std::vector<int>& neighbour, const Positions& points,
                                      const std::vector<int>& sample);
-
-/// The pattern (ones, sorted row indices) of the Galerkin product P^T A P of a fine pattern A
-/// (square, symmetric — the result's rows are read off its columns —, compressed) and a
-/// prolongation P (fine x coarse, compressed): entry (I, J) wherever
-/// P(i, I) A(i, j) P(j, J) is stored for some i, j. The same pattern as Eigen's
-/// SparseMatrix(P^T) * A * P with positive values, in time linear in the triple products' terms,
-/// without values and in parallel over the coarse columns (deterministic).
-SparseMatrix galerkin_pattern(const SparseMatrix& P, const SparseMatrix& A);
 
 /// A smallest-last greedy colouring of a symmetric pattern (the pattern's diagonal is ignored):
 /// colours[i] differs from the colour of every j with A(i, j) stored, j != i. Returns the colours;

@@ -2,6 +2,7 @@
 
 #ifdef MCFBENCH_HAVE_PETSC
 
+#include "core/galerkin_pattern.h"
 #include "core/sparse.h"
 #include "core/vec4.h"
 #include "distributed/comm.h"
@@ -266,9 +267,7 @@ struct RankMultigrid::Impl {
     std::copy(outer.begin(), outer.end(), F.ext_A.outerIndexPtr());
     std::copy(inner.begin(), inner.end(), F.ext_A.innerIndexPtr());
     std::fill(F.ext_A.valuePtr(), F.ext_A.valuePtr() + inner.size(), 0.0);
-    const SparseMatrix PT = F.ext_P.transpose();
-    F.ext_C = multigrid_detail::symbolic_product(
-        PT, multigrid_detail::symbolic_product(F.ext_A, F.ext_P));
+    F.ext_C = galerkin_pattern(F.ext_P, F.ext_A);
     F.ext_transpose = multigrid_detail::transpose_positions(F.ext_C);
     F.plan = multigrid_detail::galerkin_plan(multigrid_detail::Csc(F.ext_A), F.ext_P, F.ext_C, {});
     // The coarse owned rows: Ĉ's first nc columns (rows by symmetry), owned rows first.

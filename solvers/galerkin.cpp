@@ -10,44 +10,6 @@
 
 namespace mcf::multigrid_detail {
 
-SparseMatrix symbolic_product(const SparseMatrix& Xm, const SparseMatrix& Ym) {
-  const Csc X(Xm), Y(Ym);
-  const int m = X.rows, q = Y.cols;
-  std::vector<std::vector<int>> cols(static_cast<std::size_t>(q));
-  tbb::enumerable_thread_specific<std::vector<int>> marks(
-      [m] { return std::vector<int>(std::size_t(m), -1); });
-  tbb::parallel_for(tbb::blocked_range<int>(0, q, 64), [&](const tbb::blocked_range<int>& r) {
-    auto& mark = marks.local();
-    for (int J = r.begin(); J < r.end(); ++J) {
-      auto& c = cols[std::size_t(J)];
-      for (int p = Y.outer[J]; p < Y.outer[J + 1]; ++p) {
-        const int t = Y.inner[p];
-        for (int a = X.outer[t]; a < X.outer[t + 1]; ++a) {
-          const int i = X.inner[a];
-          if (mark[std::size_t(i)] != J) {
-            mark[std::size_t(i)] = J;
-            c.push_back(i);
-          }
-        }
-      }
-      std::sort(c.begin(), c.end());
-    }
-  });
-  std::size_t nnz = 0;
-  for (const auto& c : cols) nnz += c.size();
-  SparseMatrix M(m, q);
-  M.resizeNonZeros(Eigen::Index(nnz));
-  int* outer = M.outerIndexPtr();
-  outer[0] = 0;
-  for (int J = 0; J < q; ++J) outer[J + 1] = outer[J] + int(cols[std::size_t(J)].size());
-  tbb::parallel_for(0, q, [&](int J) {
-    std::copy(cols[std::size_t(J)].begin(), cols[std::size_t(J)].end(),
-              M.innerIndexPtr() + outer[J]);
-  });
-  std::fill(M.valuePtr(), M.valuePtr() + nnz, 0.0);
-  return M;
-}
-
 std::vector<int> transpose_positions(const SparseMatrix& C) {
   const Csc M(C);
   std::vector<int> transpose_pos(std::size_t(C.nonZeros()), -1);

@@ -1,8 +1,8 @@
 #pragma once
 // The multigrid's sparse products on a precomputed pattern (header solvers/multigrid.h, "Layout
-// and cost"): the pattern of the Galerkin operator A_c = Pᵀ A P, built once per hierarchy
-// (symbolic_product, transpose_positions), and its values, recomputed on that pattern whenever A's
-// values change (galerkin_values).
+// and cost"): the pattern of the Galerkin operator A_c = Pᵀ A P is built once per hierarchy
+// (core/galerkin_pattern.h) with the positions of its transposed entries (transpose_positions),
+// and its values are recomputed on that pattern whenever A's values change (galerkin_values).
 //
 // Inputs are compressed column-major matrices (SparseMatrix); the outputs' row indices are sorted.
 // Determinism: every output entry is computed by one task in a fixed order, so the values are
@@ -20,9 +20,6 @@
 #include <vector>
 
 namespace mcf::multigrid_detail {
-
-/// Pattern of X * Y (sorted row indices, zero values). Parallel over the columns of Y.
-SparseMatrix symbolic_product(const SparseMatrix& Xm, const SparseMatrix& Ym);
 
 /// Positions of transposed entries of a matrix C with a symmetric, sorted pattern, to symmetrize
 /// the computed values exactly: entry e = (i, J) -> position of (J, i) (-1 if absent).
@@ -61,7 +58,7 @@ struct GalerkinPlan {
 };
 
 /// The plan of galerkin_values(A, P, C, ..., column_order) for A's, P's and C's patterns (C
-/// sorted, as symbolic_product makes it). Parallel over columns; deterministic.
+/// sorted, as galerkin_pattern makes it). Parallel over columns; deterministic.
 GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMatrix& Cm,
                            const std::vector<int>& column_order);
 

@@ -99,9 +99,10 @@ void check_colouring(LevelNumbering& L, const SparseMatrix& A,
 void find_blocks(LevelNumbering& L, const SparseMatrix& A);
 
 // The relaxation order (header, "Smoother ordering") in one place, for the sweep
-// (MultigridSolver::Impl::sweep) and relaxation_order(): a sweep is two passes, pass pi relaxing
-// the blocks of parity block_parity(pi, reverse); block q is relaxed colour by colour, tiles
-// ascending, and for_block_segments calls f(r0, r1) for each run of internal rows in that order.
+// (gauss_seidel_sweep, solvers/smoother.h) and relaxation_order(): a sweep is two passes, pass pi
+// relaxing the blocks of parity block_parity(pi, reverse); block q is relaxed colour by colour,
+// tiles ascending, and for_block_segments calls f(r0, r1) for each run of internal rows in that
+// order.
 inline int block_parity(int pi, bool reverse) {
   return reverse ? 1 - pi : pi;
 }

@@ -1,15 +1,20 @@
 #pragma once
 // The multigrid's Gauss-Seidel smoother (header solvers/multigrid.h, "Smoother matrix" and
-// "Layout and cost"): the row kernels that relax one row of an interleaved block, the compact rows
-// (SmootherRows) they read, and the set-up of those rows and of each level's diagonal positions.
+// "Layout and cost", "Smoother ordering"): the row kernels that relax one row of an interleaved
+// block, the compact rows (SmootherRows) they read, the set-up of those rows and of each level's
+// diagonal positions, and the sweep that relaxes a whole level in its relaxation order.
 //
 // - gather_sub and gather_sub_compact subtract a run of a row's terms from two accumulators,
 //   alternately, in the order of the stored entries; gs_row, gs_row_compact and gs_row_aligned
 //   relax one row i (its four columns o..o+3 of x, in place) from b and the neighbours' current
 //   iterates. Nothing in them depends on threads: a sweep's result is fixed to the bit by the
 //   order in which its caller visits the rows.
-// - The kernels are in this header, force-inlined, because the sweeps (solvers/multigrid.cpp) run
-//   at full speed only with them inlined into their loops (below).
+// - The kernels are in this header, force-inlined, because the sweeps (gauss_seidel_sweep,
+//   solvers/smoother.cpp) and the cycle's residual (solvers/multigrid_cycle.cpp) run at full speed
+//   only with them inlined into their loops (below).
+// - gauss_seidel_sweep visits a level's rows in the one serial order that relaxation_order()
+//   lists (solvers/level_ordering.h), blocks of one parity in parallel, so its result is the same
+//   for any number of threads.
 // - The set-up functions (solvers/smoother.cpp) are deterministic: parallel loops that each write
 //   disjoint entries.
 //
@@ -19,6 +24,7 @@
 #include "core/sparse.h"
 #include "core/vec4.h"
 #include "solvers/csc_view.h"
+#include "solvers/level_ordering.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -155,5 +161,20 @@ SmootherRows smoother_pattern(const SparseMatrix& A, const std::vector<int>& dia
 /// A coarse level's compact values from its matrix A (same order, diagonal skipped, rounded to
 /// single precision). The finest level's sweeps read the matrix's own values.
 void smoother_values(SmootherRows& S, const SparseMatrix& A, const std::vector<int>& diag_pos);
+
+// ---- the sweep -------------------------------------------------------------------------------
+
+/// One Gauss-Seidel sweep for A x = b on a level numbered by L (solvers/level_ordering.h), forward
+/// (pre-smoothing) or reverse (post-smoothing), in the order relaxation_order(L, n, reverse) lists
+/// (header solvers/multigrid.h, "Smoother ordering"): a coloured level block by block, colour by
+/// colour; a level without colours block by block in row order. Blocks of one parity are relaxed
+/// in parallel, which is exact because they never couple (find_blocks). Each row is relaxed by
+/// gs_row_aligned on the finest level's aligned rows, gs_row_compact on a coarse level's compact
+/// rows, gs_row on the CSC matrix where S is empty. A is the level's matrix (internal numbering),
+/// S its smoother rows, diag_pos and inv_diag its diagonal's positions and inverses; b and x are
+/// interleaved with row stride s (a multiple of 4), x updated in place.
+void gauss_seidel_sweep(const LevelNumbering& L, const Csc& A, const SmootherRows& S,
+                        const int* diag_pos, const double* inv_diag, const double* b, double* x,
+                        std::size_t s, bool reverse);
 
 }  // namespace mcf::multigrid_detail

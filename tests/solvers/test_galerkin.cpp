@@ -3,6 +3,7 @@
 // outgrow A is not made. PETSc's product (solvers/petsc_galerkin.h) gives the same values, also
 // after a refresh of A's values.
 
+#include "core/galerkin_pattern.h"
 #include "solvers/galerkin.h"
 #include "solvers/petsc_galerkin.h"
 #include "solvers/petsc_runtime.h"
@@ -66,7 +67,7 @@ Product make_product(int n, unsigned seed, int parents = 3) {
   g.P.makeCompressed();
   g.PT = SparseMatrix(g.P.transpose());
   g.PT.makeCompressed();
-  g.C = symbolic_product(g.PT, symbolic_product(g.A, g.P));
+  g.C = galerkin_pattern(g.P, g.A);
   g.transpose_pos = transpose_positions(g.C);
   g.order.resize(std::size_t(nc));
   std::iota(g.order.begin(), g.order.end(), 0);
