@@ -69,8 +69,8 @@ GalerkinPlan galerkin_plan(const Csc& A, const SparseMatrix& Pm, const SparseMat
 /// dot products are formed. Every entry is computed by one task in a fixed order: deterministic.
 /// Columns are visited in `column_order` (internal column of the caller's column jj; empty:
 /// identity), i.e. in grid order, so consecutive columns share most of their fine support and
-/// their accumulators stay in cache (a colour-major visit is slower: docs/benchmarks.md,
-/// "Measurements behind implementation choices").
+/// their accumulators stay in cache (a colour-major visit is slower:
+/// data/notes/implementation-choices.md).
 /// A is a view (its values may be one term's, on the level's pattern); the values are written to
 /// `Cval`, on Cm's pattern (Cm's own values when Cval is Cm.valuePtr()).
 /// With a non-empty `plan` (galerkin_plan of the same patterns and column_order), the columns

@@ -35,8 +35,7 @@ namespace mcf::multigrid_detail {
 // The kernels below cost a few instructions per matrix entry and run at full speed only when
 // inlined into their loops: out of line, the two accumulators passed by reference go through
 // memory on every entry. GCC stopped inlining gather_sub and gather_sub_compact once they had a
-// few more call sites (docs/benchmarks.md, "Measurements behind implementation choices"), so they
-// are forced.
+// few more call sites (data/notes/implementation-choices.md), so they are forced.
 #define MCF_KERNEL_INLINE inline __attribute__((always_inline))
 
 // The kernels below hold four right-hand-side columns of one row in one vector (core/vec4.h).

@@ -2,7 +2,7 @@
 // Y = A X for a symmetric sparse A, in parallel and deterministically.
 //
 // Why not Eigen's `A * X`: for column-major storage Eigen scatters column j times x_j into Y,
-// which is serial (docs/benchmarks.md, "Measurements behind implementation choices").
+// which is serial (data/notes/implementation-choices.md).
 // Because A is symmetric, column i of the column-major storage is row i, so every output entry is
 // an independent gather: parallel without write conflicts, each sum in the entry order whatever
 // the thread count. The flows use it for M X and K X, PCG for its products.
