@@ -107,8 +107,8 @@ class RankContext final : public StepContext {
       // (flows/predicted_start.h): F + θ (P - F), θ ∈ [0, 1] minimizing ||R - A (F + θ (P - F))||,
       // its two sums added over the ranks in a fixed order.
       const Coefficients D = warm - held;
-      const Coefficients r = R - (a * system_.apply_mass(held) + b * system_.apply_stiffness(held));
-      const Coefficients AD = a * system_.apply_mass(D) + b * system_.apply_stiffness(D);
+      const Coefficients r = R - system_.apply_sum(a, b, held);
+      const Coefficients AD = system_.apply_sum(a, b, D);
       const std::vector<double> sums =
           dist::ordered_sum({(r.array() * AD.array()).sum(), AD.squaredNorm()});
       fit = sums[1] > 0 && std::isfinite(sums[0] / sums[1])

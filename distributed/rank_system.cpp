@@ -529,6 +529,13 @@ Coefficients RankSystem::apply_stiffness(const Coefficients& owned) {
   return owned_product(impl_->basis.stiffness(), with_ghosts(owned), impl_->mesh.owned);
 }
 
+Coefficients RankSystem::apply_sum(double a, double b, const Coefficients& owned) {
+  const Positions X = with_ghosts(owned);
+  const int n = impl_->mesh.owned;
+  return a * owned_product(impl_->basis.mass(), X, n) +
+         b * owned_product(impl_->basis.stiffness(), X, n);
+}
+
 SolveReport RankSystem::solve(double a, double b, const Coefficients& R, const Coefficients& held,
                               const Coefficients& warm, Coefficients& Y, double start_fit) {
   Impl& s = *impl_;

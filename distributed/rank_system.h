@@ -63,6 +63,8 @@ class RankSystem {
   /// The owned rows of M X and K X: collective (X's ghost rows are exchanged first).
   Coefficients apply_mass(const Coefficients& owned);
   Coefficients apply_stiffness(const Coefficients& owned);
+  /// The owned rows of (a M + b K) X, with one ghost exchange: collective.
+  Coefficients apply_sum(double a, double b, const Coefficients& owned);
   /// Solves (a M + b K) Y = R on the owned rows, from `warm`, with the held rows at `held`.
   /// `start_fit`: how well `warm` fit a prediction (LinearSolver::set_start_fit; negative: none).
   /// Collective. The report is the same on every rank.
