@@ -2,7 +2,7 @@
 
 #include "api/detail.h"
 
-#include "flows/registry.h"
+#include "config/registry.h"
 
 namespace mcfbench {
 

@@ -6,8 +6,8 @@
 #include "mcfbench/mesh.h"
 #include "mcfbench/types.h"
 
+#include "config/flow_config.h"
 #include "datasets/mesh_spec.h"
-#include "flows/flow_config.h"
 
 #include <mutex>
 #include <optional>

@@ -1,7 +1,7 @@
 #include "api/detail.h"
 
+#include "config/config_reader.h"
 #include "datasets/mesh_error.h"
-#include "flows/config_reader.h"
 
 #include <exception>
 #include <stdexcept>

@@ -7,8 +7,8 @@
 
 #include "api/detail.h"
 
+#include "config/memory_estimate.h"
 #include "flows/flow.h"
-#include "flows/memory_estimate.h"
 #include "harness/memory_budget.h"
 #include "harness/progress.h"
 #include "harness/result_record.h"

@@ -5,8 +5,8 @@
 #include "api/detail.h"
 #include "mcfbench/flow.h"
 
-#include "flows/config_reader.h"
-#include "flows/config_schema.h"
+#include "config/config_reader.h"
+#include "config/config_schema.h"
 #include "harness/json_path.h"
 
 #include <nlohmann/json.hpp>

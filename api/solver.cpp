@@ -1,12 +1,12 @@
-// Solvers by name (the rows of flows/solver_registry.h) and solvers the caller defines: each
+// Solvers by name (the rows of config/solver_registry.h) and solvers the caller defines: each
 // definition becomes a row whose LinearSolver calls the caller's factory and solve.
 
 #include "mcfbench/solver.h"
 
 #include "api/detail.h"
 
-#include "flows/registry.h"
-#include "flows/solver_registry.h"
+#include "config/registry.h"
+#include "config/solver_registry.h"
 
 #include <map>
 #include <memory>

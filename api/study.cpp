@@ -5,7 +5,7 @@
 
 #include "api/detail.h"
 
-#include "flows/config_reader.h"
+#include "config/config_reader.h"
 #include "harness/run_with_progress.h"
 
 #include <nlohmann/json.hpp>

@@ -32,13 +32,13 @@
 #include "bases/tracked_octree_basis.h"
 #include "benchmarks/thread_counts.h"
 #include "datasets/mesh_spec.h"
-#include "flows/predicted_start.h"
-#include "flows/stabilization.h"
 #include "harness/environment.h"
 #include "solvers/blas_threads.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/multigrid.h"
 #include "solvers/symmetric_multiply.h"
+#include "steps/predicted_start.h"
+#include "steps/stabilization.h"
 
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
@@ -461,9 +461,9 @@ BENCHMARK(BM_Step_Tracked)
     ->UseRealTime()
     ->Iterations(5);
 
-// The stabilized tracked step (flows/stabilization.h) as a flow takes it: update, the system
+// The stabilized tracked step (steps/stabilization.h) as a flow takes it: update, the system
 // M + δK + ρS written into the solver (ρ from the traces), the start along the prediction and the
-// right-hand side -δ K x + ρ S Δ̂ (flows/predicted_start.h), one cycle from Δ̂, and the
+// right-hand side -δ K x + ρ S Δ̂ (steps/predicted_start.h), one cycle from Δ̂, and the
 // evaluation of x + Δ. range(0): TBB threads, range(1): 0 = W-cycle, 1 = V-cycle, range(2):
 // Gauss-Seidel sweeps before and after.
 TrackedFixture& stabilized_fixture() {

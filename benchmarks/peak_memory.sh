@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Peak resident memory against its estimate (flows/memory_estimate.h) over the bases, solvers,
+# Peak resident memory against its estimate (config/memory_estimate.h) over the bases, solvers,
 # depths and mesh sizes the estimate was fitted on: one one-step flow per row, written as CSV
 # (spec, basis, tracking, solver, depth, vertices, unknowns, estimate and peak in MiB, ratio).
 # Usage: benchmarks/peak_memory.sh [OUT.csv]   (default out/peak-memory.csv)

@@ -1,15 +1,15 @@
 #include "distributed/distributed_flow.h"
 
+#include "config/flow_registry.h"
+#include "config/solver_registry.h"
 #include "core/parallel.h"
 #include "distributed/comm.h"
 #include "distributed/rank_mesh.h"
 #include "distributed/rank_system.h"
-#include "flows/flow_registry.h"
-#include "flows/integrator.h"
-#include "flows/solver_registry.h"
 #include "flows/sphere_reference.h"
 #include "flows/surface_moments.h"
 #include "solvers/blas_threads.h"
+#include "steps/integrator.h"
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -73,7 +73,7 @@ struct Tally {
   double contraction = -1;  ///< the worst multigrid contraction of the step's solves (-1: none)
 };
 
-/// The StepContext of a rank: the integrators of flows/integrator.h run unchanged on the owned
+/// The StepContext of a rank: the integrators of steps/integrator.h run unchanged on the owned
 /// rows; every operator application exchanges the ghost ring first.
 class RankContext final : public StepContext {
  public:
@@ -104,7 +104,7 @@ class RankContext final : public StepContext {
     Coefficients start;
     if (iterative_ && warm.rows() == held.rows() && warm != held) {
       // The integrator's prediction, taken as far as it fits, as a one-process flow starts
-      // (flows/predicted_start.h): F + θ (P - F), θ ∈ [0, 1] minimizing ||R - A (F + θ (P - F))||,
+      // (steps/predicted_start.h): F + θ (P - F), θ ∈ [0, 1] minimizing ||R - A (F + θ (P - F))||,
       // its two sums added over the ranks in a fixed order.
       const Coefficients D = warm - held;
       const Coefficients r = R - system_.apply_sum(a, b, held);

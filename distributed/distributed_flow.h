@@ -1,7 +1,7 @@
 #pragma once
 // One flow divided across MPI ranks (docs/petsc.md, "Across MPI ranks"): rank 0 reads the mesh
 // and scatters it (distributed/rank_mesh.h), each rank assembles and solves its own rows
-// (distributed/rank_system.h), and the step — any integrator of flows/integrator.h, MCF, cMCF or
+// (distributed/rank_system.h), and the step — any integrator of steps/integrator.h, MCF, cMCF or
 // heat flow, lumped or consistent mass, a fixed boundary, unit-area normalisation — runs on the
 // owned rows, the ghost ring exchanged whenever the operators or a product need it. Every sum
 // over the surface (area, moments, step difference, radial error) is an ordered sum
@@ -12,9 +12,9 @@
 // cells, and a partition by cells is a different design), as do the solvers that do not run
 // across ranks.
 
+#include "config/flow_config.h"
 #include "datasets/mesh_spec.h"
 #include "flows/flow.h"
-#include "flows/flow_config.h"
 
 #include <functional>
 #include <string>

@@ -7,7 +7,7 @@
 // the ranks. No rank ever holds more than its own rows.
 //
 // Held functions (the vertices of an open boundary, docs/design.md "Conventions") are eliminated
-// symmetrically, as the one-process flow's reduced system does (flows/reduced_system.h): their
+// symmetrically, as the one-process flow's reduced system does (steps/reduced_system.h): their
 // values are moved to the right-hand side, their rows and columns replaced by the identity.
 //
 // Solvers: "petsc" — PETSc's KSP with the one-process solver's defaults (CG, GAMG, symmetric SOR

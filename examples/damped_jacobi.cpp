@@ -1,7 +1,7 @@
 #include "examples/damped_jacobi.h"
 
-#include "flows/option_spec.h"
-#include "flows/solver_registry.h"
+#include "config/option_spec.h"
+#include "config/solver_registry.h"
 
 namespace mcf::examples {
 

@@ -24,7 +24,7 @@ struct CylinderReference {
   double discrete = 1.0;           ///< semi-implicit recursion after the steps so far
   std::vector<Eigen::Index> ring;  ///< the input's vertices nearest to half height
 
-  /// The flow is given by the operators of t = 0 it keeps (flows/flow_registry.h).
+  /// The flow is given by the operators of t = 0 it keeps (config/flow_registry.h).
   CylinderReference(double radius, bool kept_mass, bool kept_stiffness, const Positions& X0)
       : r0(radius), keeps_mass(kept_mass), keeps_stiffness(kept_stiffness), discrete(radius) {
     const double zmid = 0.5 * (X0.col(2).minCoeff() + X0.col(2).maxCoeff());

@@ -1,21 +1,21 @@
 #include "flows/flow.h"
 
+#include "config/config_reader.h"
+#include "config/flow_registry.h"
+#include "config/registry.h"
+#include "config/solver_registry.h"
 #include "core/parallel.h"
 #include "datasets/face_order.h"
 #include "datasets/validate.h"
-#include "flows/config_reader.h"
 #include "flows/cylinder_reference.h"
-#include "flows/flow_registry.h"
-#include "flows/integrator.h"
 #include "flows/planted_slowdown.h"
-#include "flows/predicted_start.h"
-#include "flows/reduced_system.h"
-#include "flows/registry.h"
-#include "flows/solver_registry.h"
 #include "flows/sphere_reference.h"
-#include "flows/stabilization.h"
 #include "solvers/blas_threads.h"
 #include "solvers/symmetric_multiply.h"
+#include "steps/integrator.h"
+#include "steps/predicted_start.h"
+#include "steps/reduced_system.h"
+#include "steps/stabilization.h"
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -70,7 +70,7 @@ struct StepTally {
 class FlowStepContext final : public StepContext {
  public:
   /// With a stabilization weight every solve is one for the increment over its held values, with
-  /// the basis's normal-gradient term added (flows/stabilization.h).
+  /// the basis's normal-gradient term added (steps/stabilization.h).
   FlowStepContext(Basis& basis, LinearSolver& solver, const FlowRow& flow, double dt,
                   bool iterative, std::optional<double> stabilization_weight = std::nullopt)
       : basis_(basis),
@@ -112,7 +112,7 @@ class FlowStepContext final : public StepContext {
     if (stabilized_) {
       Y = stabilized_->solve(*system_, basis_, a, b, R, fixed, warm);
     } else if (iterative_ && warm != fixed) {
-      // The integrator's prediction, taken as far as it fits (flows/predicted_start.h).
+      // The integrator's prediction, taken as far as it fits (steps/predicted_start.h).
       const SparseView M = basis_.mass(), K = basis_.stiffness();
       predicted_start(MatrixSum(a, M, b, K), R, fixed, warm, start_);
       start_.increment += fixed;  // the start itself
@@ -328,7 +328,7 @@ FlowRun::FlowRun(const FlowConfig& config, const MeshSource& source, nlohmann::j
       basis.stabilization ? basis.stabilization(config) : std::nullopt;
   stabilized_ = stabilization.has_value();
   // The start is the stabilized solve's prediction too (StabilizedSolve::solve,
-  // flows/stabilization.h), so a direct solver needs X_{n-1} then as well.
+  // steps/stabilization.h), so a direct solver needs X_{n-1} then as well.
   const bool iterative = solver_row(config.solver.name).iterative;
   keeps_previous_for_start_ = stabilized_ || iterative;
   const FlowRow& flow = flow_row(config.flow);

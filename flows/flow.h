@@ -3,8 +3,8 @@
 // result.json needs. Stops cleanly when the flow turns singular (solver failure, non-finite
 // positions, collapsed area) and records the step and the reason.
 
+#include "config/flow_config.h"
 #include "datasets/mesh_spec.h"
-#include "flows/flow_config.h"
 #include "flows/surface_moments.h"
 
 #include <nlohmann/json.hpp>

@@ -3,7 +3,7 @@
 // refusal allowed; any other exception, a crash, a sanitizer report, a hang or unbounded memory
 // is a finding. Nothing is run: a cell's mesh spec is a string here.
 
-#include "flows/config_reader.h"
+#include "config/config_reader.h"
 #include "fuzz/fuzz_file.h"
 #include "harness/experiment_config.h"
 

@@ -1,7 +1,7 @@
 #include "harness/collect.h"
 
+#include "config/config_reader.h"
 #include "core/atomic_file.h"
-#include "flows/config_reader.h"
 #include "harness/experiment_config.h"
 #include "harness/runner.h"
 

@@ -1,7 +1,7 @@
 #include "harness/experiment_config.h"
 
-#include "flows/config_reader.h"
-#include "flows/config_schema.h"
+#include "config/config_reader.h"
+#include "config/config_schema.h"
 
 #include <algorithm>
 #include <filesystem>

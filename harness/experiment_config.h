@@ -17,7 +17,7 @@
 // one more dimension; repetitions innermost), so a cell's index — and hence `--shard i/n` —
 // means the same thing in every process that reads the same file.
 
-#include "flows/flow_config.h"
+#include "config/flow_config.h"
 #include "harness/json_path.h"
 
 #include <nlohmann/json.hpp>

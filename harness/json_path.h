@@ -1,6 +1,6 @@
 #pragma once
 // Dotted paths into JSON objects ("solver.cycles"): how flow configs, experiment cells and result
-// files name a value. The flow config's own keys are flow_config_keys (flows/config_schema.h).
+// files name a value. The flow config's own keys are flow_config_keys (config/config_schema.h).
 
 #include <nlohmann/json.hpp>
 

@@ -1,14 +1,14 @@
 #pragma once
 // How much memory a flow may use, and the check that refuses one whose estimated peak
-// (flows/memory_estimate.h) does not fit, before its mesh is generated or its basis built.
+// (config/memory_estimate.h) does not fit, before its mesh is generated or its basis built.
 //
 // By default the budget is the memory available now: the kernel's MemAvailable, or less where the
 // process's control group (a Slurm job's `--mem`, a container's limit) has less room left. A
 // `--max-memory SIZE` budget replaces it (a node shared by agreement, an estimate known to be
 // pessimistic); `--max-memory none` turns the check off.
 
-#include "flows/flow_config.h"
-#include "flows/memory_estimate.h"
+#include "config/flow_config.h"
+#include "config/memory_estimate.h"
 
 #include <nlohmann/json.hpp>
 

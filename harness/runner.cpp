@@ -1,8 +1,8 @@
 #include "harness/runner.h"
 
+#include "config/config_reader.h"
 #include "core/atomic_file.h"
 #include "datasets/mesh_io.h"
-#include "flows/config_reader.h"
 #include "flows/flow.h"
 #include "harness/cell_hash.h"
 #include "harness/environment.h"

@@ -1,9 +1,9 @@
 // `mcfbench flow`: the flags of one flow, written to OUT/result.json and OUT/final.ply (+ frames)
 // by harness/flow_folder.h. Every flag but --config, --max-memory and --out is an option of the
-// flow config's schema (flows/config_schema.h), made from it with its help.
+// flow config's schema (config/config_schema.h), made from it with its help.
 
+#include "config/config_schema.h"
 #include "datasets/mesh_spec.h"
-#include "flows/config_schema.h"
 #include "harness/flow_folder.h"
 #include "tools/commands.h"
 

@@ -2,8 +2,8 @@
 
 #include "tools/commands.h"
 
+#include "config/config_reader.h"
 #include "distributed/comm.h"
-#include "flows/config_reader.h"
 #include "solvers/petsc_runtime.h"
 
 #include <cstdio>

@@ -1,9 +1,9 @@
 #pragma once
 // Runs flows from a JSON config inside tests.
 
+#include "config/flow_config.h"
 #include "datasets/mesh_spec.h"
 #include "flows/flow.h"
-#include "flows/flow_config.h"
 
 #include <nlohmann/json.hpp>
 

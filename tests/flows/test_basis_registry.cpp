@@ -1,8 +1,8 @@
 // register_basis from the outside: a row added at run time is a value of `basis` that flows run
 // with, and a row the table cannot take is refused.
 
+#include "config/basis_registry.h"
 #include "flow_test_util.h"
-#include "flows/basis_registry.h"
 
 #include <gtest/gtest.h>
 

@@ -5,10 +5,10 @@
 // basis; unit-area normalisation of an open surface is refused saying what to run instead.
 
 #include "../core/temp_dir.h"
+#include "config/config_reader.h"
+#include "config/flow_config.h"
 #include "datasets/mesh_spec.h"
-#include "flows/config_reader.h"
 #include "flows/flow.h"
-#include "flows/flow_config.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

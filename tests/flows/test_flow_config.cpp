@@ -1,9 +1,9 @@
+#include "config/config_reader.h"
+#include "config/config_schema.h"
+#include "config/flow_config.h"
 #include "core/parallel.h"
 #include "datasets/mesh_spec.h"
-#include "flows/config_reader.h"
-#include "flows/config_schema.h"
 #include "flows/flow.h"
-#include "flows/flow_config.h"
 #include "solvers/blas_threads.h"
 #include "solvers/multigrid_fallback.h"
 

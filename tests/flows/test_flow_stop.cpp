@@ -2,9 +2,9 @@
 // flow as it stood after that step, recorded as a stop by the caller, not as a failure, and the
 // steps before it are the steps an uninterrupted flow makes.
 
+#include "config/flow_config.h"
 #include "datasets/mesh_spec.h"
 #include "flows/flow.h"
-#include "flows/flow_config.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -3,8 +3,8 @@
 
 #include "flow_test_util.h"
 
-#include "flows/config_reader.h"
-#include "flows/registry.h"
+#include "config/config_reader.h"
+#include "config/registry.h"
 #include "solvers/petsc_runtime.h"
 
 #include <gtest/gtest.h>

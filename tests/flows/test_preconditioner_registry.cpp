@@ -1,8 +1,8 @@
 // register_preconditioner from the outside: a row added at run time is a value of
 // `solver.preconditioner` that CG runs with, and a row the table cannot take is refused.
 
+#include "config/preconditioner_registry.h"
 #include "flow_test_util.h"
-#include "flows/preconditioner_registry.h"
 
 #include <gtest/gtest.h>
 

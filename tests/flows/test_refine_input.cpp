@@ -2,8 +2,8 @@
 // vertices, is exactly the hat flow of the 1-to-4 split mesh restricted to its first vertices.
 #include "flow_test_util.h"
 
+#include "config/flow_config.h"
 #include "datasets/subdivide.h"
-#include "flows/flow_config.h"
 
 #include <gtest/gtest.h>
 

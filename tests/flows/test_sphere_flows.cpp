@@ -3,8 +3,8 @@
 
 #include "flow_test_util.h"
 
+#include "config/config_reader.h"
 #include "datasets/validate.h"
-#include "flows/config_reader.h"
 
 #include <gtest/gtest.h>
 

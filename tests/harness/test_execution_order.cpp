@@ -1,5 +1,5 @@
 // The order `run` walks the cells in: repetitions interleaved in seeded shuffled rounds.
-#include "flows/config_reader.h"
+#include "config/config_reader.h"
 #include "harness/runner.h"
 
 #include <gtest/gtest.h>

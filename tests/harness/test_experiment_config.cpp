@@ -1,7 +1,7 @@
 // Experiment matrix expansion (axes, zip, exclude, repetitions, quick), strict config errors
 // naming the file and the key path, shard partition, cell key/hash stability.
 
-#include "flows/config_reader.h"
+#include "config/config_reader.h"
 #include "harness/cell_hash.h"
 #include "harness/experiment_config.h"
 #include "harness/runner.h"

@@ -3,7 +3,7 @@
 // deleted file, after SIGKILL, after SIGTERM and SIGINT, shards + collect, collect on a run that
 // finished nothing, config errors that write nothing).
 
-#include "flows/config_reader.h"
+#include "config/config_reader.h"
 #include "harness/environment.h"
 #include "harness/memory_budget.h"
 #include "harness/runner.h"

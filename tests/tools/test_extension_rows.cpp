@@ -1,11 +1,11 @@
 // The extension rows from the outside: the example solver of examples/ runs through `flow`, `run`
-// and `expand` without an edit to flows/, harness/ or tools/, and the option table of docs/flow.md,
+// and `expand` without an edit to config/, flows/, harness/ or tools/, and the option table of docs/flow.md,
 // `mcfbench flow --help` and the config reader agree with the schema they are made from.
 
+#include "config/config_reader.h"
+#include "config/config_schema.h"
+#include "config/flow_config.h"
 #include "datasets/mesh_io.h"
-#include "flows/config_reader.h"
-#include "flows/config_schema.h"
-#include "flows/flow_config.h"
 
 #include <gtest/gtest.h>
 
@@ -68,7 +68,7 @@ TEST(ExampleSolver, DampedJacobiFlowMatchesCholmod) {
 }
 
 // The example's own options (examples/damped_jacobi.cpp: solver.omega, solver.check_every), kept
-// in SolverConfig::params with nothing in flows/ naming them: taken, recorded where the solver
+// in SolverConfig::params with nothing in config/ naming them: taken, recorded where the solver
 // runs, at their one default otherwise, and refused under another solver.
 TEST(ExampleSolver, OwnOptionsAreTakenRecordedAndRefusedElsewhere) {
   const std::string flow =
