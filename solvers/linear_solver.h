@@ -224,7 +224,7 @@ class LinearSolver {
   SolveReport solve(const ConstMatrixRef& B, Eigen::MatrixXd& X);
 
   /// How well the caller predicted the next solve's warm start: θ ∈ [0, 1], the part of an
-  /// extrapolated motion that fit the equations (flows/predicted_start.h); negative = no
+  /// extrapolated motion that fit the equations (steps/predicted_start.h); negative = no
   /// prediction. It holds for the next solve only. A solver held to a residual bound may keep a
   /// fixed-work answer above the bound where the start fit (FallbackMultigridSolver); the others
   /// ignore it.
