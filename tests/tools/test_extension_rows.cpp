@@ -1,6 +1,7 @@
 // The extension rows from the outside: the example solver of examples/ runs through `flow`, `run`
-// and `expand` without an edit to config/, flows/, harness/ or tools/, and the option table of docs/flow.md,
-// `mcfbench flow --help` and the config reader agree with the schema they are made from.
+// and `expand` without an edit to config/, flows/, harness/ or tools/, and the option table of
+// docs/flow.md, `mcfbench flow --help` and the config reader agree with the schema they are made
+// from.
 
 #include "config/config_reader.h"
 #include "config/config_schema.h"
