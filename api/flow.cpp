@@ -7,9 +7,8 @@
 
 #include "api/detail.h"
 
-#include "config/memory_estimate.h"
 #include "flows/flow.h"
-#include "harness/memory_budget.h"
+#include "harness/flow_plan.h"
 #include "harness/progress.h"
 #include "harness/result_record.h"
 #include "solvers/petsc_runtime.h"
@@ -31,11 +30,12 @@ void check_single_process(const mcf::FlowConfig& config, const std::string& sour
                      " MPI ranks; a flow called from a program runs in one process");
 }
 
-FlowResult run(const mcf::FlowConfig& config, const mcf::MeshSource& mesh,
+/// The plan's load check and run (harness/flow_plan.h) on `mesh`.
+FlowResult run(const mcf::FlowPlan& plan, const mcf::MeshSource& mesh,
                const mcf::MemoryBudget& budget, const Options& options,
                const StepCallback& on_step) {
-  const mcf::MemoryEstimate memory = mcf::checked_memory_estimate(
-      config, mcf::mesh_sizes(config, mesh.mesh, mesh.analytic), budget, config.mesh);
+  const mcf::FlowConfig& config = plan.config;
+  const mcf::MemoryEstimate memory = mcf::check_loaded_flow(plan, mesh, budget);
   const double line_seconds = options.progress ? mcf::progress_line_seconds() : 0;
   if (options.progress)
     for (const std::string& note : mesh.notes)
@@ -83,28 +83,30 @@ mcf::MemoryBudget budget_of(const Options& options) {
 
 FlowResult flow(const Options& options, const StepCallback& on_step) {
   const detail::RunScope one_at_a_time(options.name);
-  mcf::FlowConfig config;
+  mcf::FlowPlan plan;
   mcf::MemoryBudget budget;
   mcf::MeshSource mesh;
   detail::translated([&] {
-    config = detail::flow_config(options);
-    check_single_process(config, options.name);
+    plan = mcf::prepare_flow(detail::flow_config(options));
+    check_single_process(plan.config, options.name);
     budget = budget_of(options);
     // Before a generated mesh is built (a spec's size is known from the spec), as the command
     // line checks it.
-    mcf::checked_memory_estimate(config, mcf::spec_sizes(mcf::parse_mesh_spec(config.mesh)), budget,
-                                 config.mesh);
-    mesh = mcf::load_mesh_spec(config.mesh, mcf::mesh_load_options(config));
+    mcf::estimate_flow(plan, budget);
+    mesh = mcf::load_flow_mesh(plan);
   });
-  return detail::translated([&] { return run(config, mesh, budget, options, on_step); });
+  return detail::translated([&] { return run(plan, mesh, budget, options, on_step); });
 }
 
 FlowResult flow(const Mesh& mesh, const Options& options, const StepCallback& on_step) {
   const detail::RunScope one_at_a_time(options.name);
-  mcf::FlowConfig config;
+  // The mesh is loaded already: the plan's spec is not parsed (a mesh of arrays has a name only).
+  mcf::FlowPlan plan;
   mcf::MemoryBudget budget;
   detail::translated([&] {
-    config = detail::flow_config(options, mesh.spec());
+    plan.config = detail::flow_config(options, mesh.spec());
+    plan.what = plan.config.mesh;
+    const mcf::FlowConfig& config = plan.config;
     check_single_process(config, options.name);
     budget = budget_of(options);
     const mcf::MeshSource& source = mesh.impl().source;
@@ -119,7 +121,7 @@ FlowResult flow(const Mesh& mesh, const Options& options, const StepCallback& on
                        "repair_degenerate)");
   });
   return detail::translated(
-      [&] { return run(config, mesh.impl().source, budget, options, on_step); });
+      [&] { return run(plan, mesh.impl().source, budget, options, on_step); });
 }
 
 }  // namespace mcfbench

@@ -283,11 +283,10 @@ const Generator& find_generator(const std::string& spec, const std::string& name
   return *g;
 }
 
-/// A generated mesh ("NAME[:key=value,...]", `given` when the colon is there) into `src`.
-void load_generated(const std::string& spec, const std::string& name, const std::string& args,
-                    bool given, MeshSource& src) {
-  const Generator& g = find_generator(spec, name);
-  const Values values = generator_values(spec, g, args, given);
+/// The mesh generator `g` builds from `values` (parse_mesh_spec's) into `src`; errors name `spec`.
+void load_generated(const std::string& spec, const Generator& g, const Values& values,
+                    MeshSource& src) {
+  const std::string& name = g.name;
   src.kind = name;
   src.analytic = true;
   try {
@@ -329,6 +328,7 @@ void subdivide_source(MeshSource& src, long long target_faces) {
 
 MeshSpecRequest parse_mesh_spec(const std::string& spec) {
   MeshSpecRequest r;
+  r.spec = spec;
   std::string head;
   r.target_faces = split_face_target(spec, head);
   if (head.empty()) fail(spec, "empty mesh spec");
@@ -346,10 +346,11 @@ MeshSpecRequest parse_mesh_spec(const std::string& spec) {
     return r;
   }
   const Generator& g = find_generator(spec, r.kind);
-  const Values values = generator_values(spec, g, args, colon != std::string::npos);
+  r.parameters = generator_values(spec, g, args, colon != std::string::npos);
   // Negative values the generator refuses make nothing (icosphere's level 0 makes 20 faces).
-  if (std::all_of(values.begin(), values.end(), [](const auto& kv) { return kv.second >= 0; }))
-    r.generated_faces = g.faces(values);
+  if (std::all_of(r.parameters.begin(), r.parameters.end(),
+                  [](const auto& kv) { return kv.second >= 0; }))
+    r.generated_faces = g.faces(r.parameters);
   return r;
 }
 
@@ -412,37 +413,32 @@ void finish_loading(MeshSource& src, long long reoriented_faces, const MeshLoadO
 }  // namespace
 
 MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& options) {
-  MeshSource src;
-  src.spec = spec;
-  std::string head;
-  const long long target_faces = split_face_target(spec, head);
-  if (head.empty()) fail(spec, "empty mesh spec");
+  return load_mesh_spec(parse_mesh_spec(spec), options);
+}
 
-  std::string validate_name = spec;
+MeshSource load_mesh_spec(const MeshSpecRequest& request, const MeshLoadOptions& options) {
+  MeshSource src;
+  src.spec = request.spec;
+  std::string validate_name = request.spec;
   ReadReport read;
-  if (looks_like_file(head)) {
+  if (request.kind == "file") {
     src.kind = "file";
-    src.mesh = read_mesh(head, &read);  // its errors name the file
+    src.mesh = read_mesh(request.target, &read);  // its errors name the file
     fit_unit_cube(src.mesh);
-    validate_name = head;
-  } else {
-    const auto colon = head.find(':');
-    const std::string name = head.substr(0, colon);
-    const std::string args = colon == std::string::npos ? "" : head.substr(colon + 1);
-    if (name == "cgal") {
-      src.kind = "cgal";
-      if (args.empty()) fail(spec, "cgal needs a model name, e.g. cgal:armadillo");
-      try {
-        src.mesh = read_mesh(catalogue_path(args), &read);
-      } catch (const MeshError& e) {
-        fail(spec, e.what());
-      }
-      fit_unit_cube(src.mesh);
-    } else {
-      load_generated(spec, name, args, colon != std::string::npos, src);
+    validate_name = request.target;
+  } else if (request.kind == "cgal") {
+    src.kind = "cgal";
+    try {
+      src.mesh = read_mesh(catalogue_path(request.target), &read);
+    } catch (const MeshError& e) {
+      fail(request.spec, e.what());
     }
+    fit_unit_cube(src.mesh);
+  } else {
+    load_generated(request.spec, find_generator(request.spec, request.kind), request.parameters,
+                   src);
   }
-  finish_loading(src, read.reoriented_faces, options, validate_name, target_faces);
+  finish_loading(src, read.reoriented_faces, options, validate_name, request.target_faces);
   return src;
 }
 

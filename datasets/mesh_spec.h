@@ -11,6 +11,7 @@
 #include "datasets/mesh.h"
 #include "datasets/validate.h"
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,12 +48,15 @@ struct MeshLoadOptions {
 
 /// What a spec asks for, as load_mesh_spec reads it, before anything is built or read.
 struct MeshSpecRequest {
+  std::string spec;            ///< as given
   std::string kind;            ///< a generator's name, "cgal" or "file"
   std::string target;          ///< the file's path or the cgal model's name ("" for a generator)
   long long target_faces = 0;  ///< N of "@faces=N"; 0 without it
   double generated_faces = 0;  ///< a generator's upper estimate of the faces it makes (before
                                ///< @faces); 0 for files and cgal models, whose size is their
                                ///< own, and for negative values, which the generator refuses
+  /// A generator's parameters, every one (the spec's values, the others' defaults).
+  std::map<std::string, double> parameters;
 };
 
 /// Parses and checks the spec as load_mesh_spec does (the same MeshError on a malformed spec, an
@@ -65,6 +69,8 @@ MeshSpecRequest parse_mesh_spec(const std::string& spec);
 /// validates. Throws MeshError naming the spec (and file) on any problem, including an unknown
 /// generator or parameter.
 MeshSource load_mesh_spec(const std::string& spec, const MeshLoadOptions& options = {});
+/// The same from a spec parse_mesh_spec has read: nothing of it is parsed again.
+MeshSource load_mesh_spec(const MeshSpecRequest& request, const MeshLoadOptions& options = {});
 
 /// A mesh given as arrays (a library caller's, docs/library.md), loaded as a file is — every
 /// face's corners checked, the faces oriented consistently, zero-area faces treated as `options`

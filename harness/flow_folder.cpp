@@ -1,6 +1,5 @@
 #include "harness/flow_folder.h"
 
-#include "config/memory_estimate.h"
 #include "config/registry.h"
 #include "config/solver_registry.h"
 #include "distributed/comm.h"
@@ -14,6 +13,7 @@
 #include "datasets/mesh_spec.h"
 #include "flows/flow.h"
 #include "harness/experiment_config.h"
+#include "harness/flow_plan.h"
 #include "harness/memory_budget.h"
 #include "harness/progress.h"
 #include "harness/result_record.h"
@@ -130,7 +130,8 @@ MemoryEstimate rank_share(MemoryEstimate e, int ranks) {
 /// output folder; every rank runs its share of the flow. A failure before the flow (a missing
 /// file, a mesh the flow refuses, memory) is rank 0's to report: the other ranks exit with it
 /// silently (dist::RankFailure).
-int run_distributed_into_folder(const FlowConfig& config, const FlowRequest& request) {
+int run_distributed_into_folder(const FlowPlan& plan, const FlowRequest& request) {
+  const FlowConfig& config = plan.config;
   // PETSc's options checked by a trial solve on every rank, before anything is read or written
   // (solvers/petsc_solver.h): the same error on every rank, said once (tools/main.cpp).
   if (config.solver.name == "petsc") make_solver(config.solver);
@@ -146,16 +147,15 @@ int run_distributed_into_folder(const FlowConfig& config, const FlowRequest& req
   if (me == 0) {
     try {
       budget = memory_budget(request.max_memory);
-      checked_memory_estimate(config, spec_sizes(parse_mesh_spec(config.mesh)), budget,
-                              config.mesh);
-      mesh = load_mesh_spec(config.mesh, mesh_load_options(config));
+      estimate_flow(plan, budget);
+      mesh = load_flow_mesh(plan);
       for (const std::string& note : mesh.notes)
         std::fprintf(stderr, "mcfbench flow: %s: %s\n", config.mesh.c_str(), note.c_str());
-      validate_flow_mesh(config, mesh.report, config.mesh);
+      validate_flow_mesh(config, mesh.report, plan.what);
       memory = rank_share(estimate_flow_memory(config, mesh_sizes(config, mesh.mesh, mesh.analytic),
                                                resident_memory_bytes()),
                           P);
-      check_memory(memory, budget, config, config.mesh);
+      check_memory(memory, budget, config, plan.what);
       line_seconds = progress_line_seconds();
       staging = make_staging(out, created);
     } catch (const std::exception& e) {
@@ -239,21 +239,21 @@ int run_flow_into_folder(const FlowRequest& request) {
   if (launched_ranks() > 1) {
     if (const std::string why = dist::distributed_refusal(config, launched_ranks()); !why.empty())
       throw ConfigError(why);
-    return run_distributed_into_folder(config, request);
+    return run_distributed_into_folder(prepare_flow(config), request);
   }
   // PETSc's options are checked (a trial solve, solvers/petsc_solver.h), and a build without
   // PETSc refuses, before anything is read or written.
   if (config.solver.name == "petsc") make_solver(config.solver);
   const MemoryBudget budget = memory_budget(request.max_memory);
   // Before the mesh is generated or read (a generator's size is known from its spec), then with
-  // the mesh's own sizes before the basis is built.
-  checked_memory_estimate(config, spec_sizes(parse_mesh_spec(config.mesh)), budget, config.mesh);
+  // the mesh's own sizes before the basis is built (harness/flow_plan.h).
+  const FlowPlan plan = prepare_flow(config);
+  estimate_flow(plan, budget);
   // Throws naming the file: nothing written.
-  const MeshSource mesh = load_mesh_spec(config.mesh, mesh_load_options(config));
+  const MeshSource mesh = load_flow_mesh(plan);
   for (const std::string& note : mesh.notes)
     std::fprintf(stderr, "mcfbench flow: %s: %s\n", config.mesh.c_str(), note.c_str());
-  const MemoryEstimate memory = checked_memory_estimate(
-      config, mesh_sizes(config, mesh.mesh, mesh.analytic), budget, config.mesh);
+  const MemoryEstimate memory = check_loaded_flow(plan, mesh, budget);
   const double line_seconds = progress_line_seconds();  // a bad MCFBENCH_PROGRESS_SECONDS too
 
   const fs::path out(request.out);

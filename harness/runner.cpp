@@ -6,6 +6,7 @@
 #include "flows/flow.h"
 #include "harness/cell_hash.h"
 #include "harness/environment.h"
+#include "harness/flow_plan.h"
 #include "harness/memory_budget.h"
 #include "harness/metrics.h"
 #include "harness/result_record.h"
@@ -498,14 +499,13 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   // With distances_only no cell runs, so none is checked.
   for (const Cell& c : e.cells) {
     if (o.distances_only || !in_shard(c.index, o.shard_index, o.shard_count)) continue;
-    MeshSpecRequest request;
+    FlowPlan plan;
     try {
-      request = parse_mesh_spec(c.flow.mesh);
+      plan = prepare_flow(c.flow, cell_name(c) + ", mesh " + c.flow.mesh);
     } catch (const std::exception&) {
       continue;
     }
-    checked_memory_estimate(c.flow, spec_sizes(request), budget,
-                            cell_name(c) + ", mesh " + c.flow.mesh);
+    estimate_flow(plan, budget);
   }
   MeshCache meshes;
   // Every mesh this shard needs is loaded (and every cell named) before anything is written,

@@ -105,6 +105,34 @@ TEST(MeshSpec, ParseWithoutBuilding) {
   EXPECT_THROW(parse_mesh_spec("@faces=10"), MeshError);
 }
 
+// Loading a parsed request is loading the spec: the same mesh bit for bit, the same record.
+TEST(MeshSpec, ARequestLoadsAsItsSpecDoes) {
+  test::TempDir dir;
+  const auto path = dir.file("torus.off");
+  write_mesh(path, make_torus(1.0, 0.3, 12, 6));
+  for (const std::string& spec :
+       {std::string("torus:R=0.9,n_major=20"), std::string("icosphere:level=2@faces=500"),
+        std::string("open_cylinder"), path + "@faces=300"}) {
+    const MeshSpecRequest request = parse_mesh_spec(spec);
+    EXPECT_EQ(request.spec, spec);
+    const MeshSource a = load_mesh_spec(spec);
+    const MeshSource b = load_mesh_spec(request);
+    EXPECT_EQ(a.spec, b.spec);
+    EXPECT_EQ(a.kind, b.kind) << spec;
+    EXPECT_EQ(a.analytic, b.analytic) << spec;
+    EXPECT_EQ(a.sphere_radius, b.sphere_radius) << spec;
+    EXPECT_EQ(a.cylinder_radius, b.cylinder_radius) << spec;
+    EXPECT_EQ(a.report.faces, b.report.faces) << spec;
+    EXPECT_EQ(a.notes, b.notes) << spec;
+    EXPECT_TRUE(a.mesh.faces == b.mesh.faces) << spec;
+    EXPECT_TRUE(a.mesh.vertices == b.mesh.vertices) << spec;  // bitwise: the same arithmetic
+  }
+  // Every parameter of the generator is in the request, the spec's and the defaults.
+  const MeshSpecRequest t = parse_mesh_spec("torus:R=0.9");
+  EXPECT_EQ(t.parameters.at("R"), 0.9);
+  EXPECT_EQ(t.parameters.count("r"), 1u);
+}
+
 TEST(MeshSpec, Sphere) {
   const MeshSource s = load_mesh_spec("sphere:vertices=1000,radius=2");
   EXPECT_EQ(s.kind, "sphere");
