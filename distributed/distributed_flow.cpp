@@ -212,6 +212,170 @@ std::uint8_t broadcast_word(std::uint8_t word) {
   return broadcast_bytes(std::vector<std::uint8_t>{word})[0];
 }
 
+/// The rank system's solver options from the config's solver keys.
+RankSolverOptions rank_solver_options(const SolverConfig& c) {
+  RankSolverOptions solver;
+  solver.solver = c.name;
+  solver.petsc_options = c.petsc_options;
+  solver.tolerance = c.tolerance;
+  solver.max_iterations = c.max_iterations;
+  solver.cycle = c.cycle;
+  solver.cycles = c.cycles;
+  solver.smooth = c.smooth;
+  solver.residual_bound = c.residual_bound;
+  solver.bound_smooth_steps = c.bound_smooth_steps;
+  solver.direct_after = c.direct_after;
+  return solver;
+}
+
+/// A step's solves as its record's "solver" object (the one-process flow's keys).
+nlohmann::json solver_record(const Tally& tally) {
+  const SolveReport& worst = tally.worst;
+  nlohmann::json r = {
+      {"iterations", tally.iterations},
+      {"solves", tally.solves},
+      {"residuals", tally.residuals_per_solve.empty() ? std::vector<double>{}
+                                                      : tally.residuals_per_solve.back()},
+      {"relative_residual", worst.relative_residual},
+      {"status", to_string(worst.status)},
+      {"rhs_per_solve", tally.columns_per_solve}};
+  if (tally.solves > 1) r["residuals_per_solve"] = tally.residuals_per_solve;
+  if (tally.fallbacks > 0)
+    r["fallback"] = {{"solves", tally.fallbacks},
+                     {"extra_cycles", 0},
+                     {"iterations", tally.fallback_iterations},
+                     {"direct_solves", tally.direct_solves}};
+  if (!worst.message.empty()) r["message"] = worst.message;
+  if (tally.contraction >= 0) r["contraction"] = tally.contraction;
+  return r;
+}
+
+/// The owned vertices' distances from the sphere's radii at time `t` (the semi-implicit
+/// recursion's and the continuous one's), reduced over the ranks: collective.
+nlohmann::json radial_error(const Coefficients& x, const RankMesh& mesh,
+                            const SphereReference& sphere, double t) {
+  double d2 = 0, d2c = 0, dmax = 0, dmaxc = 0, radius = 0;
+  const double rc = sphere.continuous(t);
+  for (int i = 0; i < mesh.owned; ++i) {
+    const double norm = x.row(i).norm();
+    const double d = std::abs(norm - sphere.discrete), dc = std::abs(norm - rc);
+    d2 += d * d;
+    d2c += dc * dc;
+    dmax = std::max(dmax, d);
+    dmaxc = std::max(dmaxc, dc);
+    radius += norm;
+  }
+  const std::vector<double> s = ordered_sum(std::vector<double>{d2, d2c, radius});
+  const double N = double(mesh.global_vertices);
+  return {{"rms", std::sqrt(s[0] / N)},
+          {"max", max_over_ranks(dmax)},
+          {"rms_continuous", std::sqrt(s[1] / N)},
+          {"max_continuous", max_over_ranks(dmaxc)},
+          {"mean_radius", s[2] / N},
+          {"radius_semi_implicit", sphere.discrete},
+          {"radius_continuous", rc}};
+}
+
+/// A completed step's phases into its record: the slowest rank's seconds and the imbalance
+/// (collective).
+void record_seconds(nlohmann::json& record, const Tally& tally, double evaluate_seconds,
+                    double total) {
+  const nlohmann::json u = phase_json(tally.update_seconds), s = phase_json(tally.solve_seconds),
+                       e = phase_json(evaluate_seconds), w = phase_json(total);
+  record["seconds"] = {
+      {"update", u["max"]}, {"solve", s["max"]}, {"evaluate", e["max"]}, {"total", w["max"]}};
+  record["imbalance"] = {{"update", u["imbalance"]},
+                         {"solve", s["imbalance"]},
+                         {"evaluate", e["imbalance"]},
+                         {"total", w["imbalance"]}};
+}
+
+/// What every rank held, and `phases` (collective: every rank calls it).
+nlohmann::json distribution_json(const RankMesh& mesh, const RankSystem& system,
+                                 nlohmann::json phases) {
+  return {{"ranks", mesh.ranks},
+          {"partitioner", mesh.partitioner},
+          {"owned_vertices", all_values((long long)mesh.owned)},
+          {"ghost_vertices", all_values((long long)mesh.ghosts())},
+          {"local_faces", all_values((long long)mesh.faces.rows())},
+          {"matrix_bytes", all_values(system.matrix_bytes())},
+          {"preconditioner_bytes", all_values(system.preconditioner_bytes())},
+          {"peak_memory_bytes", all_values(peak_memory_bytes())},
+          {"phase_seconds", std::move(phases)}};
+}
+
+/// result.json's "system" of the hat basis across ranks, with the one-process flow's keys.
+nlohmann::json system_json(const RankMesh& mesh, const RankSystem& system, double setup_seconds) {
+  return {{"dimension", mesh.global_vertices},
+          {"free_functions", mesh.global_vertices - system.held_global()},
+          {"split_triangles", mesh.global_faces},
+          {"cubature_points", 0},
+          {"levels", system.levels()},
+          {"bytes_per_cubature_point", 0},
+          {"setup_seconds", {{"total", setup_seconds}}}};
+}
+
+/// The faces whose area this rank counts (each face once over all ranks).
+Triangles counted_faces(const RankMesh& mesh) {
+  Triangles counted(Eigen::Index(std::count(mesh.counted.begin(), mesh.counted.end(), 1)), 3);
+  for (Eigen::Index f = 0, k = 0; f < mesh.faces.rows(); ++f)
+    if (mesh.counted[std::size_t(f)]) counted.row(k++) = mesh.faces.row(f);
+  return counted;
+}
+
+/// The sphere's reference radii where the input is a sphere and the area is not normalised, on
+/// every rank (the reference's sums are collective; only rank 0 holds `source`).
+std::optional<SphereReference> sphere_reference(const FlowConfig& config, const MeshSource* source,
+                                                const FlowRow& flow) {
+  std::optional<SphereReference> sphere;
+  if (source && source->sphere_radius && !config.normalize_area)
+    sphere.emplace(*source->sphere_radius, flow.keeps_mass);
+  const bool sphere_flag = broadcast_word(sphere ? 1 : 0) != 0;
+  const double sphere_radius = ordered_sum(sphere ? *source->sphere_radius : 0.0);
+  if (sphere_flag && !sphere) sphere.emplace(sphere_radius, flow.keeps_mass);
+  return sphere;
+}
+
+/// The input's area and the previous step's, against which a step's area is judged.
+struct Areas {
+  double initial = 0, previous = 0;
+};
+
+/// Why the step that solved with `worst` into `x_new` ends the flow, or "" where it does not:
+/// the solve failed, a position is not finite, the area collapsed or grew by over 5% (an
+/// unstable step). `m`: the new surface's moments where they were computed; `record` gets the
+/// area of a step that fails on it. Collective.
+std::string step_failure(const SolveReport& worst, const Coefficients& x_new, RankSystem& system,
+                         const Triangles& counted, const Areas& areas, SurfaceMoments& m,
+                         nlohmann::json& record) {
+  if (!worst.ok())
+    return std::string("solver: ") + to_string(worst.status) +
+           (worst.message.empty() ? "" : " (" + worst.message + ")");
+  if (any_rank(!x_new.allFinite())) return "non-finite vertex positions";
+  m = moments(system.with_ghosts(x_new), counted);
+  if (!(m.area > 1e-12 * areas.initial)) {
+    record["area"] = m.area;
+    return "collapsed area (" + std::to_string(m.area) + ")";
+  }
+  if (m.area > 1.05 * areas.previous) {
+    record["area"] = m.area;
+    return "diverged: the area grew by " +
+           std::to_string(int(std::lround(100 * (m.area / areas.previous - 1)))) +
+           "% in one step (unstable time step)";
+  }
+  return "";
+}
+
+/// result.json's "solver_settings": the rank system's, and how the flow was divided.
+nlohmann::json solver_settings(const RankSystem& system, int ranks) {
+  nlohmann::json settings = nlohmann::json::object();
+  for (const auto& [key, text] : system.settings()) settings[key] = text;
+  settings["ranks"] = std::to_string(ranks);
+  settings["distribution"] =
+      "the flow divided: each rank its vertices, their triangles and one ring of ghosts";
+  return settings;
+}
+
 }  // namespace
 
 FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* source,
@@ -235,21 +399,9 @@ FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* sou
   OutputMap output;
   const RankMesh mesh = scatter_mesh(whole, me == 0 ? &output : nullptr);
   whole = TriangleMesh{};
-  Triangles counted(Eigen::Index(std::count(mesh.counted.begin(), mesh.counted.end(), 1)), 3);
-  for (Eigen::Index f = 0, k = 0; f < mesh.faces.rows(); ++f)
-    if (mesh.counted[std::size_t(f)]) counted.row(k++) = mesh.faces.row(f);
+  const Triangles counted = counted_faces(mesh);
 
-  RankSolverOptions solver;
-  solver.solver = config.solver.name;
-  solver.petsc_options = config.solver.petsc_options;
-  solver.tolerance = config.solver.tolerance;
-  solver.max_iterations = config.solver.max_iterations;
-  solver.cycle = config.solver.cycle;
-  solver.cycles = config.solver.cycles;
-  solver.smooth = config.solver.smooth;
-  solver.residual_bound = config.solver.residual_bound;
-  solver.bound_smooth_steps = config.solver.bound_smooth_steps;
-  solver.direct_after = config.solver.direct_after;
+  const RankSolverOptions solver = rank_solver_options(config.solver);
   const MassKind mass = config.mass == "lumped" ? MassKind::lumped : MassKind::consistent;
   RankSystem system(mesh, mass, solver);
   const double setup_seconds = seconds_since(setup_start);
@@ -261,13 +413,7 @@ FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* sou
   bool has_prev = false;
   const double area0 = moments(mesh.vertices, counted).area;
   double previous_area = area0;
-  std::optional<SphereReference> sphere;
-  if (source && source->sphere_radius && !config.normalize_area)
-    sphere.emplace(*source->sphere_radius, flow.keeps_mass);
-  // Every rank knows whether the input is a sphere (the reference's sums are collective).
-  const bool sphere_flag = broadcast_word(sphere ? 1 : 0) != 0;
-  const double sphere_radius = ordered_sum(sphere ? *source->sphere_radius : 0.0);
-  if (sphere_flag && !sphere) sphere.emplace(sphere_radius, flow.keeps_mass);
+  std::optional<SphereReference> sphere = sphere_reference(config, source, flow);
 
   nlohmann::json steps = nlohmann::json::array();
   nlohmann::json stop;
@@ -296,52 +442,17 @@ FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* sou
   };
   report_step(0);
 
-  const int P = mesh.ranks;
   for (int step = 1; step <= config.steps; ++step) {
     const auto step_start = Clock::now();
     const double t = step * config.dt;
     ctx.begin_step(x, has_prev ? &x_prev : nullptr);
     Coefficients x_new = integrator->step(ctx);
     const Tally& tally = ctx.tally();
-    const SolveReport& worst = tally.worst;
-    nlohmann::json record = {{"step", step}, {"t", t}};
-    record["solver"] = {
-        {"iterations", tally.iterations},
-        {"solves", tally.solves},
-        {"residuals", tally.residuals_per_solve.empty() ? std::vector<double>{}
-                                                        : tally.residuals_per_solve.back()},
-        {"relative_residual", worst.relative_residual},
-        {"status", to_string(worst.status)},
-        {"rhs_per_solve", tally.columns_per_solve}};
-    if (tally.solves > 1) record["solver"]["residuals_per_solve"] = tally.residuals_per_solve;
-    if (tally.fallbacks > 0)
-      record["solver"]["fallback"] = {{"solves", tally.fallbacks},
-                                      {"extra_cycles", 0},
-                                      {"iterations", tally.fallback_iterations},
-                                      {"direct_solves", tally.direct_solves}};
-    if (!worst.message.empty()) record["solver"]["message"] = worst.message;
-    if (tally.contraction >= 0) record["solver"]["contraction"] = tally.contraction;
-
-    std::string reason;
-    if (!worst.ok()) {
-      reason = std::string("solver: ") + to_string(worst.status) +
-               (worst.message.empty() ? "" : " (" + worst.message + ")");
-    }
+    nlohmann::json record = {{"step", step}, {"t", t}, {"solver", solver_record(tally)}};
     const auto eval_start = Clock::now();
     SurfaceMoments m;
-    if (reason.empty() && any_rank(!x_new.allFinite())) reason = "non-finite vertex positions";
-    if (reason.empty()) {
-      m = moments(system.with_ghosts(x_new), counted);
-      if (!(m.area > 1e-12 * area0)) {
-        record["area"] = m.area;
-        reason = "collapsed area (" + std::to_string(m.area) + ")";
-      } else if (m.area > 1.05 * previous_area) {
-        record["area"] = m.area;
-        reason = "diverged: the area grew by " +
-                 std::to_string(int(std::lround(100 * (m.area / previous_area - 1)))) +
-                 "% in one step (unstable time step)";
-      }
-    }
+    const std::string reason =
+        step_failure(tally.worst, x_new, system, counted, {area0, previous_area}, m, record);
     if (!reason.empty()) {
       record["seconds"] = {{"update", tally.update_seconds},
                            {"solve", tally.solve_seconds},
@@ -364,26 +475,7 @@ FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* sou
     record["step_difference"] = step_difference;
     if (sphere) {
       sphere->advance(config.dt);
-      double d2 = 0, d2c = 0, dmax = 0, dmaxc = 0, radius = 0;
-      const double rc = sphere->continuous(t);
-      for (int i = 0; i < mesh.owned; ++i) {
-        const double norm = x_new.row(i).norm();
-        const double d = std::abs(norm - sphere->discrete), dc = std::abs(norm - rc);
-        d2 += d * d;
-        d2c += dc * dc;
-        dmax = std::max(dmax, d);
-        dmaxc = std::max(dmaxc, dc);
-        radius += norm;
-      }
-      const std::vector<double> s = ordered_sum(std::vector<double>{d2, d2c, radius});
-      const double N = double(mesh.global_vertices);
-      record["radial_error"] = {{"rms", std::sqrt(s[0] / N)},
-                                {"max", max_over_ranks(dmax)},
-                                {"rms_continuous", std::sqrt(s[1] / N)},
-                                {"max_continuous", max_over_ranks(dmaxc)},
-                                {"mean_radius", s[2] / N},
-                                {"radius_semi_implicit", sphere->discrete},
-                                {"radius_continuous", rc}};
+      record["radial_error"] = radial_error(x_new, mesh, *sphere, t);
     }
     if (integrator->uses_previous() || solver_row(config.solver.name).iterative) {
       x_prev = std::move(x);
@@ -396,35 +488,19 @@ FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* sou
     solve_total += tally.solve_seconds;
     evaluate_total += evaluate_seconds;
     step_total += total;
-    const nlohmann::json u = phase_json(tally.update_seconds), s = phase_json(tally.solve_seconds),
-                         e = phase_json(evaluate_seconds), w = phase_json(total);
-    record["seconds"] = {
-        {"update", u["max"]}, {"solve", s["max"]}, {"evaluate", e["max"]}, {"total", w["max"]}};
-    record["imbalance"] = {{"update", u["imbalance"]},
-                           {"solve", s["imbalance"]},
-                           {"evaluate", e["imbalance"]},
-                           {"total", w["imbalance"]}};
+    record_seconds(record, tally, evaluate_seconds, total);
     steps.push_back(std::move(record));
     report_step(step);
   }
 
   // The final surface and what every rank held, on rank 0.
   Positions final_vertices = gather_vertices(mesh, output, x);
-  const nlohmann::json distribution = {
-      {"ranks", P},
-      {"partitioner", mesh.partitioner},
-      {"owned_vertices", all_values((long long)mesh.owned)},
-      {"ghost_vertices", all_values((long long)mesh.ghosts())},
-      {"local_faces", all_values((long long)mesh.faces.rows())},
-      {"matrix_bytes", all_values(system.matrix_bytes())},
-      {"preconditioner_bytes", all_values(system.preconditioner_bytes())},
-      {"peak_memory_bytes", all_values(peak_memory_bytes())},
-      {"phase_seconds",
-       {{"setup", phase_json(setup_seconds)},
-        {"update", phase_json(update_total)},
-        {"solve", phase_json(solve_total)},
-        {"evaluate", phase_json(evaluate_total)},
-        {"steps", phase_json(step_total)}}}};
+  const nlohmann::json distribution = distribution_json(mesh, system,
+                                                        {{"setup", phase_json(setup_seconds)},
+                                                         {"update", phase_json(update_total)},
+                                                         {"solve", phase_json(solve_total)},
+                                                         {"evaluate", phase_json(evaluate_total)},
+                                                         {"steps", phase_json(step_total)}});
   if (me != 0) return out;
 
   nlohmann::json& result = out.result;
@@ -433,23 +509,13 @@ FlowOutcome run_distributed_flow(const FlowConfig& config, const MeshSource* sou
   result["config"] = to_json(config);
   result["mesh"] = mesh_json(*source);
   if (!source->notes.empty()) result["mesh"]["notes"] = source->notes;
-  const std::int64_t free = mesh.global_vertices - system.held_global();
-  result["system"] = {{"dimension", mesh.global_vertices},
-                      {"free_functions", free},
-                      {"split_triangles", mesh.global_faces},
-                      {"cubature_points", 0},
-                      {"levels", system.levels()},
-                      {"bytes_per_cubature_point", 0},
-                      {"setup_seconds", {{"total", setup_seconds}}}};
+  result["system"] = system_json(mesh, system, setup_seconds);
   result["solver_name"] = system.name();
   result["distribution"] = distribution;
   if (stop.is_null()) stop = {{"step", int(steps.size())}, {"reason", "completed"}};
   result["stop"] = stop;
   result["steps"] = std::move(steps);
-  for (const auto& [key, text] : system.settings()) result["solver_settings"][key] = text;
-  result["solver_settings"]["ranks"] = std::to_string(P);
-  result["solver_settings"]["distribution"] =
-      "the flow divided: each rank its vertices, their triangles and one ring of ghosts";
+  result["solver_settings"] = solver_settings(system, mesh.ranks);
   out.final_mesh = TriangleMesh{std::move(final_vertices), std::move(output.faces)};
   return out;
 }
