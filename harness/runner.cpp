@@ -338,12 +338,14 @@ RunStopped::RunStopped(int signal_number, const RunSummary& run_summary, int cel
       summary(run_summary),
       done(cells_done) {}
 
-const MeshSource& MeshCache::get(const std::string& spec, const MeshLoadOptions& options) {
+const MeshSource& MeshCache::get(const FlowConfig& flow) {
   // The hint only words the refusal: the treatment of zero-area faces makes the mesh.
-  const std::string key = spec + "\n" + std::to_string(static_cast<int>(options.degenerate));
+  const std::string key =
+      flow.mesh + "\n" + std::to_string(static_cast<int>(mesh_load_options(flow).degenerate));
   auto it = meshes_.find(key);
   if (it == meshes_.end())
-    it = meshes_.emplace(key, std::make_shared<MeshSource>(load_mesh_spec(spec, options))).first;
+    it = meshes_.emplace(key, std::make_shared<MeshSource>(load_flow_mesh(prepare_flow(flow))))
+             .first;
   return *it->second;
 }
 
@@ -497,15 +499,15 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   // A cell too large for the memory is refused from its spec's sizes before any mesh is built.
   // A spec that does not parse is left to plan_cells, which names the config and the cell.
   // With distances_only no cell runs, so none is checked.
+  std::map<int, FlowPlan> flow_plans;  // by cell index
   for (const Cell& c : e.cells) {
     if (o.distances_only || !in_shard(c.index, o.shard_index, o.shard_count)) continue;
-    FlowPlan plan;
     try {
-      plan = prepare_flow(c.flow, cell_name(c) + ", mesh " + c.flow.mesh);
+      flow_plans[c.index] = prepare_flow(c.flow, cell_name(c) + ", mesh " + c.flow.mesh);
     } catch (const std::exception&) {
       continue;
     }
-    estimate_flow(plan, budget);
+    estimate_flow(flow_plans[c.index], budget);
   }
   MeshCache meshes;
   // Every mesh this shard needs is loaded (and every cell named) before anything is written,
@@ -519,9 +521,9 @@ RunSummary run_experiment(const ExperimentConfig& e, const RunOptions& o) {
   for (const CellPlan& p : plans)
     if (!o.distances_only && in_shard(p.cell.index, o.shard_index, o.shard_count) &&
         (o.force || !cell_finished(p.file))) {
-      const MeshSource& source = meshes.get(p.cell.flow);
-      checked_memory_estimate(p.cell.flow, mesh_sizes(p.cell.flow, source.mesh, source.analytic),
-                              budget, cell_name(p.cell) + ", mesh " + p.cell.flow.mesh);
+      FlowPlan& plan = flow_plans.at(p.cell.index);
+      plan.config = p.cell.flow;  // with the run's threads
+      check_loaded_flow(plan, meshes.get(p.cell.flow), budget);
     }
 
   RunSummary s;

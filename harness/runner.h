@@ -30,9 +30,10 @@ struct CellPlan {
 /// the loaded mesh's bytes).
 class MeshCache {
  public:
-  const MeshSource& get(const std::string& spec, const MeshLoadOptions& options = {});
-  /// The mesh of a flow, loaded as that flow loads it (mesh_load_options).
-  const MeshSource& get(const FlowConfig& flow) { return get(flow.mesh, mesh_load_options(flow)); }
+  /// The mesh of a flow, loaded as that flow loads it: prepare_flow and load_flow_mesh
+  /// (harness/flow_plan.h) the first time, the same mesh for every later flow of its spec and
+  /// treatment of zero-area faces (mesh_load_options).
+  const MeshSource& get(const FlowConfig& flow);
 
  private:
   std::map<std::string, std::shared_ptr<MeshSource>> meshes_;
