@@ -65,7 +65,7 @@ std::vector<OptionSpec> tail_options() {
       [](auto& c) -> auto& { return c.integrator; });
   integrator.choices = [] {
     std::vector<Choice> c;
-    for (const std::string& name : integrator_names()) c.emplace_back(name, "");
+    for (const IntegratorRow& row : integrator_table()) c.emplace_back(row.name, row.help);
     return c;
   };
   OptionSpec extrapolate = bind(
@@ -75,7 +75,11 @@ std::vector<OptionSpec> tail_options() {
       [](auto& c) -> auto& { return c.extrapolate; });
   extrapolate.flag_kind = FlagKind::set_false;
   extrapolate.refused_elsewhere = true;
-  extrapolate.owner_text = "the two-step integrators (crank-nicolson, bdf2)";
+  extrapolate.owner_text = "the two-step integrators (";
+  for (const IntegratorRow& row : integrator_table())
+    if (row.reads_extrapolate)
+      extrapolate.owner_text += (extrapolate.owner_text.back() == '(' ? "" : ", ") + row.name;
+  extrapolate.owner_text += ")";
   extrapolate.selected = [](const FlowConfig& c) {
     return integrator_reads_extrapolate(c.integrator);
   };

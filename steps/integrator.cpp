@@ -106,24 +106,53 @@ class Series2 final : public Integrator {
 
 }  // namespace
 
+const std::vector<IntegratorRow>& integrator_table() {
+  static const std::vector<IntegratorRow> table = {
+      {"explicit-euler", "forward Euler, M X' = M X_n - δ K X_n: stable only for δ of order h²",
+       false, [](bool) { return std::make_unique<ExplicitEuler>(); }},
+      {"semi-implicit",
+       "backward Euler with the operators at X_n, (M + δK) X' = M X_n: first order", false,
+       [](bool) { return std::make_unique<SemiImplicitEuler>(); }},
+      {"crank-nicolson",
+       "the trapezoidal rule, (M + δ/2 K) X' = (M - δ/2 K) X_n with the operators at the "
+       "extrapolated midpoint X*: second order",
+       true, [](bool extrapolate) { return std::make_unique<CrankNicolson>(extrapolate); }},
+      {"bdf2",
+       "the two-step backward difference, (3/2 M + δK) X' = M (2X_n - X_{n-1}/2) with the "
+       "operators at X* = 2X_n - X_{n-1}: second order",
+       true, [](bool extrapolate) { return std::make_unique<Bdf2>(extrapolate); }},
+      {"taylor2", "X' = X_n + δ A X_n + δ²/2 A² X_n with A = -M⁻¹K: second order on heat flow only",
+       false, [](bool) { return std::make_unique<Series2>("taylor2", 0.5); }},
+      {"neumann2",
+       "backward Euler's series cut after δ², X' = X_n + δ A X_n + δ² A² X_n: first order", false,
+       [](bool) { return std::make_unique<Series2>("neumann2", 1.0); }},
+  };
+  return table;
+}
+
+const IntegratorRow& integrator_row(const std::string& name) {
+  for (const IntegratorRow& row : integrator_table())
+    if (row.name == name) return row;
+  throw std::invalid_argument("unknown integrator \"" + name + "\"");
+}
+
 const std::vector<std::string>& integrator_names() {
-  static const std::vector<std::string> names = {
-      "explicit-euler", "semi-implicit", "crank-nicolson", "bdf2", "taylor2", "neumann2"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const IntegratorRow& row : integrator_table()) n.push_back(row.name);
+    return n;
+  }();
   return names;
 }
 
 bool integrator_reads_extrapolate(const std::string& name) {
-  return name == "crank-nicolson" || name == "bdf2";
+  for (const IntegratorRow& row : integrator_table())
+    if (row.name == name) return row.reads_extrapolate;
+  return false;
 }
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, bool extrapolate) {
-  if (name == "explicit-euler") return std::make_unique<ExplicitEuler>();
-  if (name == "semi-implicit") return std::make_unique<SemiImplicitEuler>();
-  if (name == "crank-nicolson") return std::make_unique<CrankNicolson>(extrapolate);
-  if (name == "bdf2") return std::make_unique<Bdf2>(extrapolate);
-  if (name == "taylor2") return std::make_unique<Series2>("taylor2", 0.5);
-  if (name == "neumann2") return std::make_unique<Series2>("neumann2", 1.0);
-  throw std::invalid_argument("unknown integrator \"" + name + "\"");
+  return integrator_row(name).make(extrapolate);
 }
 
 }  // namespace mcf

@@ -90,3 +90,31 @@ TEST(Integrators, UnknownNameThrows) {
 
 }  // namespace
 }  // namespace mcf
+
+namespace mcf {
+namespace {
+
+// The table is the only list of integrators: each row makes the scheme of its name, and the rows
+// that take `extrapolate` are exactly the two-step schemes (those that read X_{n-1}).
+TEST(IntegratorTable, EachRowMakesItsSchemeAndOnlyTwoStepOnesReadExtrapolate) {
+  ASSERT_EQ(integrator_table().size(), integrator_names().size());
+  for (const IntegratorRow& row : integrator_table()) {
+    EXPECT_FALSE(row.help.empty()) << row.name;
+    for (bool extrapolate : {true, false}) {
+      const std::unique_ptr<Integrator> integrator = make_integrator(row.name, extrapolate);
+      EXPECT_EQ(integrator->name(), row.name);
+      EXPECT_EQ(row.reads_extrapolate, integrator->uses_previous()) << row.name;
+    }
+    EXPECT_EQ(integrator_reads_extrapolate(row.name), row.reads_extrapolate);
+  }
+  EXPECT_FALSE(integrator_reads_extrapolate("rk4"));
+  try {
+    integrator_row("rk4");
+    ADD_FAILURE() << "rk4 taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("\"rk4\""), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mcf
