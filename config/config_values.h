@@ -34,45 +34,15 @@ struct SolverConfig {
       -1;  ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
   int max_iterations = 1000;              ///< PCG iteration cap (petsc: 3000, the paper's)
   std::string preconditioner = "jacobi";  ///< PCG: none | jacobi | ichol | multigrid
-  std::string cycle = "W";                ///< multigrid: V | W
-  int cycles = 1;                         ///< multigrid cycles per solve
-  int smooth = 5;                         ///< Gauss–Seidel sweeps before and after (each)
-  /// multigrid: k cycles promise to reduce the step's initial residual by stall_ratio^k; where they
-  /// reduce it by less per cycle, CG preconditioned by the cycle takes over until they have
-  /// (never below `fallback_tolerance`; solvers/multigrid_fallback.h). 0 = never.
-  double stall_ratio = 0.2;
-  /// multigrid: a step is converged only at or below this relative residual; one whose cycles end
-  /// above it continues (more cycles, CG by the cycle, the factorization) until it is
-  /// (solvers/multigrid_fallback.h: kDefaultResidualBound, which a test holds this to). 0 = no
-  /// bound.
-  double residual_bound = 1e-4;
-  /// multigrid: hold smooth steps (the start fit the integrator's prediction, the cycles
-  /// contracted) to residual_bound too; false = such a step keeps its fixed work above the bound
-  /// and says so (solvers/multigrid_fallback.h, "Smooth steps").
-  bool bound_smooth_steps = false;
-  double fallback_tolerance = 1e-10;
-  /// multigrid: the fallback CG's iterations after which (or on whose breakdown) CHOLMOD solves
-  /// the step, and every later stalled step at once (solvers/multigrid_fallback.h). 0 = never.
-  int direct_after = 10;
-  /// multigrid (also as PCG's preconditioner): refresh the coarse operators term by term,
-  /// recomputing only the terms whose values changed (MultigridOptions::galerkin_by_term).
-  bool galerkin_by_term = false;
-  /// multigrid: double | mixed (the finest sweeps in single precision inside a double-precision
-  /// residual correction; MultigridOptions::mixed_precision).
-  std::string precision = "double";
-  /// multigrid: recompute the coarse operators on every k-th set_matrix of a pattern only
-  /// (MultigridOptions::galerkin_refresh); 1 = every step.
-  int galerkin_refresh = 1;
-  /// petsc: PETSc options ("-pc_type hypre -pc_hypre_type boomeramg") over the defaults (CG +
-  /// GAMG, solvers/petsc_solver.h), kept verbatim in result.json.
-  std::string petsc_options;
   /// cholmod: OpenBLAS threads while it factorizes and solves, 0 = auto (auto_blas_threads,
   /// solvers/blas_threads.h), else this many, at most the flow's `threads`. Config key
   /// "blas_threads" (top level, as before it belonged to the solver).
   int blas_threads = 0;
-  /// The values of solver rows' own options that have no field above (solver_param,
-  /// config/option_spec.h: a solver added outside config/, as examples/damped_jacobi.cpp), by key
-  /// ("omega"); the config reader fills every registered row's, each with its one default.
+  /// The values of the solvers' own options, by key within "solver" ("cycles", "stall_ratio",
+  /// "petsc_options", a solver added outside config/'s "omega"): each component declares its
+  /// options with solver_param (config/option_spec.h) and its default once, and reads them back
+  /// with param_value (the multigrid's: config/multigrid_params.h). The config reader fills every
+  /// registered row's; a key left out of a config built in code means its default.
   nlohmann::json params = nlohmann::json::object();
 };
 

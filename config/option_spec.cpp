@@ -22,14 +22,19 @@ OptionSpec ranged(OptionSpec o, double min, double max) {
 }
 
 OptionSpec solver_param(OptionSpec o) {
-  const std::string key = o.key;
+  const std::string leaf = split_key(o.key).second;
   const nlohmann::json fallback = o.fallback;
-  o.get = [key, fallback](const FlowConfig& c) {
-    const auto it = c.solver.params.find(key);
+  o.get = [leaf, fallback](const FlowConfig& c) {
+    const auto it = c.solver.params.find(leaf);
     return it != c.solver.params.end() ? *it : fallback;
   };
-  o.set = [key](FlowConfig& c, const nlohmann::json& v) { c.solver.params[key] = v; };
+  o.set = [leaf](FlowConfig& c, const nlohmann::json& v) { c.solver.params[leaf] = v; };
   return o;
+}
+
+nlohmann::json param_value(const SolverConfig& config, const OptionSpec& option) {
+  const auto it = config.params.find(split_key(option.key).second);
+  return it != config.params.end() ? *it : option.fallback;
 }
 
 std::pair<std::string, std::string> split_key(const std::string& key) {

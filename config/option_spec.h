@@ -101,9 +101,12 @@ OptionSpec bind(OptionSpec o, Ref ref) {
 
 /// A solver row's own option `o` (its key the row-local leaf, "omega") kept in
 /// SolverConfig::params instead of a field of its own, so that a solver with options is its file
-/// pair alone. The row's factory reads it as `c.params.at("omega")`, set by the reader to the
-/// config's value or `o.fallback`.
+/// pair alone; `o.key` may be dotted ("solver.cycle"), the params keep its leaf. The row's factory
+/// reads it with param_value.
 OptionSpec solver_param(OptionSpec o);
+/// The value of the solver_param option `option` in `config`: the config's, else its default
+/// (a config built in code holds only what it set).
+nlohmann::json param_value(const SolverConfig& config, const OptionSpec& option);
 
 /// The object ("solver", or "" at the top) and the key within it of a dotted key.
 std::pair<std::string, std::string> split_key(const std::string& key);

@@ -1,6 +1,6 @@
 #include "config/preconditioner_registry.h"
 
-#include "config/multigrid_options.h"
+#include "config/multigrid_params.h"
 #include "solvers/multigrid_pcg.h"
 
 #include <stdexcept>

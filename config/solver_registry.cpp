@@ -1,6 +1,7 @@
 #include "config/solver_registry.h"
 
 #include "config/config_reader.h"
+#include "config/multigrid_params.h"
 #include "config/preconditioner_registry.h"
 #include "solvers/cholmod_solver.h"
 #include "solvers/dense_reference.h"
@@ -25,22 +26,28 @@ constexpr double kPetscBytesPerNonzero = 12 + 12.0 / kPetscMatrixCopies;
 constexpr double kPetscVectorBytesPerUnknown = 16 * 8;
 
 std::unique_ptr<LinearSolver> make_multigrid(const SolverConfig& c) {
-  if (c.stall_ratio <= 0 && c.residual_bound <= 0)
+  const StallFallbackOptions f = stall_fallback_options(c);
+  if (f.stall_ratio <= 0 && f.residual_bound <= 0)
     return std::make_unique<MultigridSolver>(multigrid_options(c));
-  StallFallbackOptions f;
-  f.stall_ratio = c.stall_ratio;
-  f.residual_bound = c.residual_bound;
-  f.bound_smooth_steps = c.bound_smooth_steps;
-  f.tolerance = c.fallback_tolerance;
-  f.max_iterations = c.max_iterations;
-  f.direct_after = c.direct_after;
-  f.direct_blas_threads = c.blas_threads;
   return std::make_unique<FallbackMultigridSolver>(multigrid_options(c), f);
+}
+
+/// petsc's own option: PETSc's options over the defaults (PetscSolverOptions::options).
+const OptionSpec& petsc_options_option() {
+  static const OptionSpec o = [] {
+    OptionSpec p = solver_param(
+        option("petsc_options", OptionType::string, PetscSolverOptions{}.options, "--petsc-options",
+               "petsc: PETSc options over the defaults, e.g. \"-pc_type hypre -pc_hypre_type "
+               "boomeramg\" (docs/petsc.md)"));
+    p.refused_elsewhere = true;
+    return p;
+  }();
+  return o;
 }
 
 std::unique_ptr<LinearSolver> make_petsc(const SolverConfig& c) {
   PetscSolverOptions o;
-  o.options = c.petsc_options;
+  o.options = param_value(c, petsc_options_option()).get<std::string>();
   o.relative_tolerance = c.tolerance;
   o.max_iterations = c.max_iterations;
   return std::make_unique<PetscSolver>(o);  // checks the options: invalid_argument naming one
@@ -58,18 +65,6 @@ void check(const SolverRow& row) {
   if (!row.memory)
     throw std::logic_error("solver \"" + row.name +
                            "\" registered without a memory model (config/memory_model.h)");
-}
-
-OptionSpec bound_smooth_steps_option() {
-  OptionSpec o = bind(
-      option("bound_smooth_steps", OptionType::boolean, false, "--bound-smooth-steps",
-             "Multigrid: hold smooth steps to the residual bound too; by default "
-             "a step whose start fit the integrator's prediction (theta >= 0.5) "
-             "and whose cycles contracted keeps its fixed work above the bound "
-             "and says so"),
-      [](auto& c) -> auto& { return c.solver.bound_smooth_steps; });
-  o.flag_kind = FlagKind::set_true;
-  return o;
 }
 
 NamedTable<SolverRow> built_in() {
@@ -91,36 +86,7 @@ NamedTable<SolverRow> built_in() {
                       make_multigrid, [](const SolverConfig&, const SystemFigures& s) {
                         return s.hierarchy_bytes_per_unknown * s.dimension;
                       }};
-  multigrid.options = {
-      ranged(bind(
-                 option("stall_ratio", OptionType::number, 0.2, "--stall-ratio",
-                        "Multigrid: where the cycles reduce the residual by less than this per "
-                        "cycle, CG preconditioned by the cycle takes over until they have reached "
-                        "what this ratio promises (or the residual bound); 0 = never"),
-                 [](auto& c) -> auto& { return c.solver.stall_ratio; }),
-             0, 1),
-      ranged(bind(
-                 option("residual_bound", OptionType::number, kDefaultResidualBound,
-                        "--residual-bound",
-                        "Multigrid: a step is converged only at or below this relative residual; "
-                        "one whose cycles end above it continues with more cycles, then CG "
-                        "preconditioned by the cycle, then the factorization; 0 = no bound"),
-                 [](auto& c) -> auto& { return c.solver.residual_bound; }),
-             0, 1),
-      bound_smooth_steps_option(),
-      ranged(bind(
-                 option("fallback_tolerance", OptionType::number, 1e-10, "--fallback-tolerance",
-                        "Multigrid: the fallback CG never stops below this relative residual"),
-                 [](auto& c) -> auto& { return c.solver.fallback_tolerance; }),
-             1e-300, 1),
-      ranged(bind(
-                 option("direct_after", OptionType::integer, 10, "--direct-after",
-                        "Multigrid: when the fallback CG has not reached its target after this "
-                        "many iterations, or breaks down, a sparse Cholesky factorization solves "
-                        "the step, and later steps that need more than their cycles at once; "
-                        "0 = never"),
-                 [](auto& c) -> auto& { return c.solver.direct_after; }),
-             0, 1000000)};
+  multigrid.options = stall_guard_options();
   multigrid.iterative = multigrid.needs_hierarchy = multigrid.distributed = true;
   multigrid.default_tolerance = 0;  // run `cycles` cycles
   SolverRow petsc{"petsc", "PETSc's KSP, default CG + GAMG (docs/petsc.md)", make_petsc,
@@ -129,13 +95,7 @@ NamedTable<SolverRow> built_in() {
                             kPetscVectorBytesPerUnknown) *
                            s.dimension;
                   }};
-  OptionSpec petsc_options = bind(
-      option("petsc_options", OptionType::string, "", "--petsc-options",
-             "petsc: PETSc options over the defaults, e.g. \"-pc_type hypre -pc_hypre_type "
-             "boomeramg\" (docs/petsc.md)"),
-      [](auto& c) -> auto& { return c.solver.petsc_options; });
-  petsc_options.refused_elsewhere = true;
-  petsc.options = {petsc_options};
+  petsc.options = {petsc_options_option()};
   petsc.iterative = petsc.distributed = true;
   petsc.default_max_iterations = 3000;  // the paper's baseline: CG + AMG stopped at 3000
   SolverRow dense{"dense", "LLT of the dense matrix: a reference for small meshes",
@@ -189,60 +149,23 @@ std::vector<OptionSpec> shared_options() {
     o.selected = [](const FlowConfig& c) { return needs_hierarchy(c.solver); };
     return o;
   };
-  OptionSpec cycle = bind(
-      option("solver.cycle", OptionType::string, "W", "--cycle",
-             "Multigrid cycle (solver and preconditioner)"),
-      [](auto& c) -> auto& { return c.solver.cycle; });
-  cycle.choices = [] { return std::vector<Choice>{{"V", ""}, {"W", ""}}; };
-  cycle = cycle_option(cycle);
-  OptionSpec cycles = ranged(
-      bind(
-          option("solver.cycles", OptionType::integer, 1, "--cycles", "Multigrid cycles per solve"),
-          [](auto& c) -> auto& { return c.solver.cycles; }),
-      1, 10000);
-  // CG preconditioned by the multigrid applies one cycle an iteration, whatever this says.
-  cycles.refused_elsewhere = true;
-  cycles.owner_text = "solver \"multigrid\" (CG's multigrid preconditioner is one cycle)";
-  cycles.selected = [](const FlowConfig& c) { return solver_row(c.solver.name).needs_hierarchy; };
-  OptionSpec smooth =
-      cycle_option(ranged(bind(
-                              option("solver.smooth", OptionType::integer, 5, "--smooth",
-                                     "Gauss-Seidel sweeps before and after each coarse correction"),
-                              [](auto& c) -> auto& { return c.solver.smooth; }),
-                          0, 1000));
-  // The multigrid's options added later, recorded only when set (cells of earlier runs lack
-  // them), refused where no multigrid runs as the cycle's are.
-  const auto multigrid_option = [&](OptionSpec o) {
-    o = cycle_option(std::move(o));
-    o.recorded = Recorded::when_set;
-    return o;
-  };
-  OptionSpec by_term = multigrid_option(bind(
-      option("solver.galerkin_by_term", OptionType::boolean, false, "--galerkin-by-term",
-             "Multigrid: refresh the coarse operators term by term, only the terms whose "
-             "values changed (cMCF: the mass alone); equal to the sum's products up to "
-             "rounding"),
-      [](auto& c) -> auto& { return c.solver.galerkin_by_term; }));
-  by_term.flag_kind = FlagKind::set_true;
-  OptionSpec precision = multigrid_option(bind(
-      option("solver.precision", OptionType::string, "double", "--precision",
-             "Multigrid: the finest level's sweeps in double or in single precision inside "
-             "a double-precision residual correction (same solution, fewer bytes a sweep)"),
-      [](auto& c) -> auto& { return c.solver.precision; }));
-  precision.choices = [] {
-    return std::vector<Choice>{{"double", "every sweep in double precision"},
-                               {"mixed", "the finest sweeps read a single-precision copy"}};
-  };
-  OptionSpec refresh = multigrid_option(
-      ranged(bind(
-                 option("solver.galerkin_refresh", OptionType::integer, 1, "--galerkin-refresh",
-                        "Multigrid: recompute the coarse operators on every k-th step only (the "
-                        "finest level, hence the solution, stays exact; the coarse corrections use "
-                        "operators up to k - 1 steps old)"),
-                 [](auto& c) -> auto& { return c.solver.galerkin_refresh; }),
-             1, 1000));
-  return {name,   tolerance, max_iterations, preconditioner, cycle,
-          cycles, smooth,    by_term,        precision,      refresh};
+  // The multigrid's options added later (all but cycle, cycles and smooth), recorded only when
+  // set (cells of earlier runs lack them), refused where no multigrid runs as the cycle's are.
+  std::vector<OptionSpec> options = {name, tolerance, max_iterations, preconditioner};
+  for (OptionSpec o : multigrid_cycle_options()) {
+    const std::string leaf = split_key(o.key).second;
+    if (leaf == "cycles") {
+      // CG preconditioned by the multigrid applies one cycle an iteration, whatever this says.
+      o.refused_elsewhere = true;
+      o.owner_text = "solver \"multigrid\" (CG's multigrid preconditioner is one cycle)";
+      o.selected = [](const FlowConfig& c) { return solver_row(c.solver.name).needs_hierarchy; };
+    } else {
+      o = cycle_option(std::move(o));
+      if (leaf != "cycle" && leaf != "smooth") o.recorded = Recorded::when_set;
+    }
+    options.push_back(std::move(o));
+  }
+  return options;
 }
 
 NamedTable<SolverRow>& table() {
@@ -267,6 +190,15 @@ const SolverRow& solver_row(const std::string& name) {
 const std::vector<OptionSpec>& solver_options() {
   static const std::vector<OptionSpec> options = shared_options();
   return options;
+}
+
+const OptionSpec& solver_option(const std::string& leaf) {
+  for (const OptionSpec& o : solver_options())
+    if (split_key(o.key).second == leaf) return o;
+  for (const SolverRow& row : solver_table().rows())
+    for (const OptionSpec& o : row.options)
+      if (split_key(o.key).second == leaf) return o;
+  throw std::logic_error("no solver option \"" + leaf + "\"");
 }
 
 bool needs_hierarchy(const SolverConfig& config) {

@@ -5,7 +5,6 @@
 
 #include "config/config_values.h"
 #include "config/memory_model.h"
-#include "config/multigrid_options.h"
 #include "config/named_table.h"
 #include "config/option_spec.h"
 #include "solvers/linear_solver.h"
@@ -66,6 +65,9 @@ const SolverRow& solver_row(const std::string& name);
 /// "solver.max_iterations", "solver.preconditioner", "solver.cycle", "solver.cycles",
 /// "solver.smooth"); result.json records them for every solver.
 const std::vector<OptionSpec>& solver_options();
+/// The solver option whose key within "solver" is `leaf` ("cycles", "petsc_options"): a shared
+/// one or a row's own; std::logic_error if there is none.
+const OptionSpec& solver_option(const std::string& leaf);
 /// Whether the config's solver (or its preconditioner) needs the basis's geometric hierarchy.
 bool needs_hierarchy(const SolverConfig& config);
 /// Whether the config's solver runs one flow divided across MPI ranks (distributed/): a row

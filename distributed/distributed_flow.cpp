@@ -1,6 +1,7 @@
 #include "distributed/distributed_flow.h"
 
 #include "config/flow_registry.h"
+#include "config/multigrid_params.h"
 #include "config/solver_registry.h"
 #include "core/parallel.h"
 #include "distributed/comm.h"
@@ -214,17 +215,19 @@ std::uint8_t broadcast_word(std::uint8_t word) {
 
 /// The rank system's solver options from the config's solver keys.
 RankSolverOptions rank_solver_options(const SolverConfig& c) {
+  const MultigridOptions cycle = multigrid_options(c);
+  const StallFallbackOptions guard = stall_fallback_options(c);
   RankSolverOptions solver;
   solver.solver = c.name;
-  solver.petsc_options = c.petsc_options;
+  solver.petsc_options = param_value(c, solver_option("petsc_options")).get<std::string>();
   solver.tolerance = c.tolerance;
   solver.max_iterations = c.max_iterations;
-  solver.cycle = c.cycle;
-  solver.cycles = c.cycles;
-  solver.smooth = c.smooth;
-  solver.residual_bound = c.residual_bound;
-  solver.bound_smooth_steps = c.bound_smooth_steps;
-  solver.direct_after = c.direct_after;
+  solver.cycle = to_string(cycle.cycle);
+  solver.cycles = cycle.cycles;
+  solver.smooth = cycle.pre_smooth;
+  solver.residual_bound = guard.residual_bound;
+  solver.bound_smooth_steps = guard.bound_smooth_steps;
+  solver.direct_after = guard.direct_after;
   return solver;
 }
 

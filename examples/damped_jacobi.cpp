@@ -46,9 +46,9 @@ const bool registered = [] {
   row.name = "damped-jacobi";
   row.help = "damped Jacobi iteration (examples/damped_jacobi.h)";
   row.make = [](const SolverConfig& c) -> std::unique_ptr<LinearSolver> {
-    return std::make_unique<DampedJacobiSolver>(c.tolerance, c.max_iterations,
-                                                c.params.at("omega").get<double>(),
-                                                c.params.at("check_every").get<int>());
+    return std::make_unique<DampedJacobiSolver>(
+        c.tolerance, c.max_iterations, param_value(c, solver_option("omega")).get<double>(),
+        param_value(c, solver_option("check_every")).get<int>());
   };
   // Its own options, config keys solver.omega and solver.check_every (flags --omega and
   // --check-every), each with its one default; refused under any other solver.

@@ -156,7 +156,7 @@ TEST(PetscFlows, ConfigChecks) {
     return;
   }
   SolverConfig bad = c.solver;
-  bad.petsc_options = "-ksp_typo cg";
+  bad.params["petsc_options"] = "-ksp_typo cg";
   EXPECT_THROW(make_solver(bad), std::invalid_argument);
 }
 

@@ -2,6 +2,7 @@
 // naming the file and the key path, shard partition, cell key/hash stability.
 
 #include "config/config_reader.h"
+#include "config/multigrid_params.h"
 #include "harness/cell_hash.h"
 #include "harness/experiment_config.h"
 #include "harness/runner.h"
@@ -86,8 +87,8 @@ TEST(ExperimentConfig, DefaultsApplyWhereTheyAreReadAndAxisValuesStrictly) {
   EXPECT_EQ(multigrid["preconditioner"], "jacobi");
   EXPECT_EQ(pcg["preconditioner"], "ichol");
   EXPECT_EQ(pcg["cycles"], 1);
-  EXPECT_EQ(e.cells[1].flow.solver.cycles, 2);
-  EXPECT_EQ(e.cells[0].flow.solver.cycles, 1);
+  EXPECT_EQ(multigrid_options(e.cells[1].flow.solver).cycles, 2);
+  EXPECT_EQ(multigrid_options(e.cells[0].flow.solver).cycles, 1);
 
   // null in a zip row: the defaults' value, applied where it is read.
   const auto z = expand(
