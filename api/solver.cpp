@@ -167,8 +167,6 @@ void register_solver(SolverDefinition definition) {
       return (12 * s.nonzeros_per_row + s.factor_bytes_per_unknown) * s.dimension;  // A, a factor
     };
   row.iterative = iterative;
-  row.default_stabilization_weight =
-      iterative ? row.default_stabilization_weight : mcf::kDefiniteStabilizationWeight;
   mcf::register_solver(std::move(row));
 }
 

@@ -18,6 +18,13 @@ namespace {
 // that those cells keep their config keys (harness/cell_hash.h). It changes nothing there.
 constexpr double kInertStabilizationWeight = 0.5;
 
+// octree.stabilization_weight where the config leaves it out, by how the solver solves. The
+// iterative solvers converge faster the larger the weight (the cycles need about 0.3: 0.5); a
+// direct solver needs only a definite system, which 1e-6 gives where faces parallel to the grid
+// planes leave the paper's system singular, while moving its surface by about 1e-5 relative
+// (docs/octree-multigrid.md, "Stabilization").
+constexpr double kIterativeStabilizationWeight = 0.5;
+
 // Bytes per input vertex and per octree function, least-squares fits (relative error) to the peak
 // resident memory of one-step flows on the armadillo at 52k, 208k and 832k faces and a 200k-face
 // sphere, octree depths 6 to 9 (docs/benchmarks.md "Peak memory and set-up"). Each fit was within
@@ -174,7 +181,9 @@ BasisRow octree_row() {
   octree.stabilization = [](const FlowConfig& config) -> std::optional<double> {
     if (!octree_options(config.octree, false).normal_gradient) return std::nullopt;
     const double c = config.octree.stabilization_weight;  // < 0 in a config not read from JSON
-    return c >= 0 ? c : solver_row(config.solver.name).default_stabilization_weight;
+    if (c >= 0) return c;
+    return solver_row(config.solver.name).iterative ? kIterativeStabilizationWeight
+                                                    : kDefiniteStabilizationWeight;
   };
   octree.describe = [](const FlowConfig& config) {
     return " depth " + std::to_string(config.octree.depth);

@@ -18,6 +18,11 @@
 
 namespace mcf {
 
+/// The octree's normal-gradient weight under a direct solver: the paper's system made definite
+/// where faces parallel to the grid planes leave it singular, its surface unchanged to about 1e-5
+/// relative.
+inline constexpr double kDefiniteStabilizationWeight = 1e-6;
+
 struct BasisRow {
   std::string name;
   std::string help;
@@ -73,8 +78,8 @@ const TrackingRow& tracking_row(const std::string& name);
 OctreeOptions octree_options(const OctreeConfig& c, bool analytic);
 
 /// Fills in `octree.stabilization_weight` left to the solver (< 0) once the whole config is read,
-/// so that result.json records the weight that ran: the solver row's
-/// default_stabilization_weight where the system carries the term, else 0.5 (inert: the value
+/// so that result.json records the weight that ran where the system carries the term: 0.5 under an
+/// iterative solver, kDefiniteStabilizationWeight under a direct one; else 0.5 (inert: the value
 /// such configs recorded before, so their config keys stay). A weight set stays.
 void resolve_stabilization_weight(FlowConfig& c);
 

@@ -76,7 +76,6 @@ NamedTable<SolverRow> built_in() {
         return s.factor_bytes_per_unknown * s.dimension;
       }};
   cholmod.uses_blas_threads = true;
-  cholmod.default_stabilization_weight = kDefiniteStabilizationWeight;
   SolverRow pcg{"pcg", "conjugate gradients with solver.preconditioner", make_pcg,
                 [](const SolverConfig& c, const SystemFigures& s) {
                   return preconditioner_row(c.preconditioner).memory(s);
@@ -103,7 +102,6 @@ NamedTable<SolverRow> built_in() {
                   [](const SolverConfig&, const SystemFigures& s) {
                     return kDensePerUnknown2 * s.dimension * s.dimension;
                   }};
-  dense.default_stabilization_weight = kDefiniteStabilizationWeight;
   for (SolverRow* row : {&cholmod, &pcg, &multigrid, &petsc, &dense}) t.add(std::move(*row));
   return t;
 }

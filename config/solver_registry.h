@@ -16,10 +16,6 @@
 
 namespace mcf {
 
-/// The normal-gradient weight of the direct solvers: the paper's system made definite where faces
-/// parallel to the grid planes leave it singular, its surface unchanged to about 1e-5 relative.
-inline constexpr double kDefiniteStabilizationWeight = 1e-6;
-
 struct SolverRow {
   std::string name;
   std::string help;  ///< one line for --help and docs/flow.md
@@ -34,7 +30,8 @@ struct SolverRow {
   /// where this solver runs, so that the other solvers' cells keep the config keys
   /// (harness/cell_hash.h) they had before the option existed.
   std::vector<OptionSpec> options{};
-  /// Starts from the warm start (the integrator's prediction) instead of solving exactly.
+  /// Starts from the warm start (the integrator's prediction) instead of solving exactly. Also
+  /// what the octree basis sets its normal-gradient weight by (config/basis_registry.h).
   bool iterative = false;
   /// Uses solver.preconditioner (config/preconditioner_registry.h).
   bool uses_preconditioner = false;
@@ -44,12 +41,7 @@ struct SolverRow {
   bool uses_blas_threads = false;
   /// Runs on every MPI rank the harness was launched on (the others run on rank 0 alone).
   bool distributed = false;
-  double default_tolerance = 1e-10;  ///< solver.tolerance when the config leaves it out
-  /// octree.stabilization_weight when the config leaves it out. The iterative solvers converge
-  /// faster the larger the weight (the cycles need about 0.3); a direct solver needs only a
-  /// definite system, which kDefiniteStabilizationWeight gives while leaving the paper's surface
-  /// (docs/octree-multigrid.md, "Stabilization").
-  double default_stabilization_weight = 0.5;
+  double default_tolerance = 1e-10;   ///< solver.tolerance when the config leaves it out
   int default_max_iterations = 1000;  ///< solver.max_iterations when the config leaves it out
 };
 
