@@ -32,17 +32,17 @@ struct SolverConfig {
   std::string name = "cholmod";  ///< cholmod | pcg | multigrid | petsc | dense (LLT reference)
   double tolerance =
       -1;  ///< relative residual; -1 = solver default (pcg 1e-10, multigrid 0 = run `cycles`)
-  int max_iterations = 1000;              ///< PCG iteration cap (petsc: 3000, the paper's)
-  std::string preconditioner = "jacobi";  ///< PCG: none | jacobi | ichol | multigrid
+  int max_iterations = 1000;  ///< PCG iteration cap (petsc: 3000, the paper's)
   /// cholmod: OpenBLAS threads while it factorizes and solves, 0 = auto (auto_blas_threads,
   /// solvers/blas_threads.h), else this many, at most the flow's `threads`. Config key
   /// "blas_threads" (top level, as before it belonged to the solver).
   int blas_threads = 0;
-  /// The values of the solvers' own options, by key within "solver" ("cycles", "stall_ratio",
-  /// "petsc_options", a solver added outside config/'s "omega"): each component declares its
-  /// options with solver_param (config/option_spec.h) and its default once, and reads them back
-  /// with param_value (the multigrid's: config/multigrid_params.h). The config reader fills every
-  /// registered row's; a key left out of a config built in code means its default.
+  /// The values of the solvers' own options, by key within "solver" (CG's "preconditioner", the
+  /// multigrid's "cycles", PETSc's "petsc_options", a solver added outside config/'s "omega"): each
+  /// component declares its options with solver_param (config/option_spec.h) and its default once,
+  /// and reads them back with param_value (the multigrid's: config/multigrid_params.h). The config
+  /// reader fills every registered row's; a key left out of a config built in code means its
+  /// default.
   nlohmann::json params = nlohmann::json::object();
 };
 

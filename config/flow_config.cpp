@@ -80,7 +80,7 @@ void validate_flow_config(const FlowConfig& c, const std::string& source) {
   // without a word).
   std::string in_use = "\"" + c.solver.name + "\"";
   if (solver_row(c.solver.name).uses_preconditioner)
-    in_use += " with preconditioner \"" + c.solver.preconditioner + "\"";
+    in_use += " with preconditioner \"" + preconditioner_name(c.solver) + "\"";
   for (const OptionSpec& o : flow_config_schema())
     if (inapplicable(o, c))
       fail(o.key, (o.type == OptionType::string ? "\"" + o.get(c).get<std::string>() + "\" " : "") +

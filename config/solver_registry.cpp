@@ -57,7 +57,7 @@ std::unique_ptr<LinearSolver> make_pcg(const SolverConfig& c) {
   PcgOptions o;
   o.relative_tolerance = c.tolerance;
   o.max_iterations = c.max_iterations;
-  return preconditioner_row(c.preconditioner).make(c, o);
+  return preconditioner_row(preconditioner_name(c)).make(c, o);
 }
 
 void check(const SolverRow& row) {
@@ -78,7 +78,7 @@ NamedTable<SolverRow> built_in() {
   cholmod.uses_blas_threads = true;
   SolverRow pcg{"pcg", "conjugate gradients with solver.preconditioner", make_pcg,
                 [](const SolverConfig& c, const SystemFigures& s) {
-                  return preconditioner_row(c.preconditioner).memory(s);
+                  return preconditioner_row(preconditioner_name(c)).memory(s);
                 }};
   pcg.iterative = pcg.uses_preconditioner = true;
   SolverRow multigrid{"multigrid", "the basis's geometric multigrid, solver.cycles cycles",
@@ -128,10 +128,9 @@ std::vector<OptionSpec> shared_options() {
                  [](auto& c) -> auto& { return c.solver.max_iterations; }),
              1, 100000000);
   max_iterations.default_text = "the solver's (1000; petsc 3000)";
-  OptionSpec preconditioner = bind(
-      option("solver.preconditioner", OptionType::string, "jacobi", "--preconditioner",
-             "PCG preconditioner"),
-      [](auto& c) -> auto& { return c.solver.preconditioner; });
+  OptionSpec preconditioner =
+      solver_param(option("solver.preconditioner", OptionType::string, "jacobi", "--preconditioner",
+                          "PCG preconditioner"));
   preconditioner.choices = [] { return preconditioner_table().choices(); };
   preconditioner.refused_elsewhere = true;
   preconditioner.owner_text = "solver \"pcg\"";
@@ -199,15 +198,20 @@ const OptionSpec& solver_option(const std::string& leaf) {
   throw std::logic_error("no solver option \"" + leaf + "\"");
 }
 
+std::string preconditioner_name(const SolverConfig& config) {
+  static const OptionSpec& option = solver_option("preconditioner");
+  return param_value(config, option).get<std::string>();
+}
+
 bool needs_hierarchy(const SolverConfig& config) {
   const SolverRow& row = solver_row(config.name);
-  return row.needs_hierarchy ||
-         (row.uses_preconditioner && preconditioner_row(config.preconditioner).needs_hierarchy);
+  return row.needs_hierarchy || (row.uses_preconditioner &&
+                                 preconditioner_row(preconditioner_name(config)).needs_hierarchy);
 }
 
 bool runs_across_ranks(const SolverConfig& config) {
   const SolverRow& row = solver_row(config.name);
-  return row.distributed || (row.uses_preconditioner && config.preconditioner == "multigrid");
+  return row.distributed || (row.uses_preconditioner && preconditioner_name(config) == "multigrid");
 }
 
 }  // namespace mcf

@@ -60,6 +60,9 @@ const std::vector<OptionSpec>& solver_options();
 /// The solver option whose key within "solver" is `leaf` ("cycles", "petsc_options"): a shared
 /// one or a row's own; std::logic_error if there is none.
 const OptionSpec& solver_option(const std::string& leaf);
+/// CG's preconditioner in `config` ("jacobi" where it sets none): a row of
+/// config/preconditioner_registry.h, read where the solver row says uses_preconditioner.
+std::string preconditioner_name(const SolverConfig& config);
 /// Whether the config's solver (or its preconditioner) needs the basis's geometric hierarchy.
 bool needs_hierarchy(const SolverConfig& config);
 /// Whether the config's solver runs one flow divided across MPI ranks (distributed/): a row

@@ -34,7 +34,7 @@ std::string distributed_refusal(const FlowConfig& config, int ranks) {
   if (!runs_across_ranks(config.solver))
     return "solver.name: \"" + config.solver.name +
            (config.solver.name == "pcg"
-                ? "\" with preconditioner \"" + config.solver.preconditioner + "\""
+                ? "\" with preconditioner \"" + preconditioner_name(config.solver) + "\""
                 : "\"") +
            " runs in one process; \"petsc\", \"multigrid\" and \"pcg\" with the multigrid "
            "preconditioner run" +
