@@ -317,9 +317,10 @@ TEST(SurfaceHierarchy, GraphVoronoiCellsAreDijkstras) {
       std::vector<int> moved = cells;
       const int first = int(std::find(sample.begin(), sample.end(), 0) - sample.begin());
       moved[std::size_t(first)] = *std::max_element(sample.begin(), sample.end());
-      if (moved[std::size_t(first)] != 0)
+      if (moved[std::size_t(first)] != 0) {
         EXPECT_FALSE(are_voronoi_cells(moved, reference, start, neighbour, c.mesh.vertices, sample))
             << c.name << " stride " << stride;
+      }
       tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
       EXPECT_EQ(graph_voronoi_cells(start, neighbour, c.mesh.vertices, sample), cells)
           << c.name << " stride " << stride << ", one thread";

@@ -296,8 +296,9 @@ TEST(MeshIo, RandomSoupsLoadAsTheirFansOrNameTheRefusedFace) {
         const bool as_listed =
             m.faces.row(t) == Eigen::RowVector3i(fans[t][0], fans[t][1], fans[t][2]);
         reversed += !as_listed;
-        if (!as_listed)
+        if (!as_listed) {
           ASSERT_EQ(m.faces.row(t), Eigen::RowVector3i(fans[t][0], fans[t][2], fans[t][1])) << off;
+        }
       }
       ASSERT_EQ(report.reoriented_faces, reversed) << off;
       ASSERT_EQ(validate_mesh(m, path, {true, ""}).misoriented_edges, 0) << off;
