@@ -43,6 +43,9 @@ std::vector<OptionSpec> cycle_options() {
                         "finest level, hence the solution, stays exact; the coarse corrections use "
                         "operators up to k - 1 steps old)")),
              1, 1000);
+  // Added after the first results: recorded only when set, so that cells of earlier runs keep
+  // their config keys (harness/cell_hash.h).
+  for (OptionSpec* later : {&by_term, &precision, &refresh}) later->recorded = Recorded::when_set;
   return {cycle, cycles, smooth, by_term, precision, refresh};
 }
 
@@ -81,16 +84,12 @@ std::vector<OptionSpec> guard_options() {
              0, 1000000)};
 }
 
-/// The option of `options` whose leaf is `leaf` (a name this file defines).
-const OptionSpec& find(const std::vector<OptionSpec>& options, const std::string& leaf) {
-  for (const OptionSpec& o : options)
-    if (split_key(o.key).second == leaf) return o;
-  throw std::logic_error("multigrid_params: no option \"" + leaf + "\"");
-}
-
+/// The value in `c` of the option of `options` called `leaf` (a name this file defines).
 template <class T>
 T value(const SolverConfig& c, const std::vector<OptionSpec>& options, const std::string& leaf) {
-  return param_value(c, find(options, leaf)).get<T>();
+  const OptionSpec* o = find_option(options, leaf);
+  if (!o) throw std::logic_error("multigrid_params: no option \"" + leaf + "\"");
+  return param_value(c, *o).get<T>();
 }
 
 }  // namespace

@@ -43,6 +43,12 @@ std::pair<std::string, std::string> split_key(const std::string& key) {
   return {key.substr(0, dot), key.substr(dot + 1)};
 }
 
+const OptionSpec* find_option(const std::vector<OptionSpec>& options, const std::string& leaf) {
+  for (const OptionSpec& o : options)
+    if (split_key(o.key).second == leaf) return &o;
+  return nullptr;
+}
+
 void read_option(ConfigReader& reader, const OptionSpec& option, FlowConfig& config) {
   const std::string leaf = split_key(option.key).second;
   const nlohmann::json current = option.get(config);

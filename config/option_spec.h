@@ -110,6 +110,8 @@ nlohmann::json param_value(const SolverConfig& config, const OptionSpec& option)
 
 /// The object ("solver", or "" at the top) and the key within it of a dotted key.
 std::pair<std::string, std::string> split_key(const std::string& key);
+/// The option of `options` whose key within its object is `leaf` ("cycles"), or nullptr.
+const OptionSpec* find_option(const std::vector<OptionSpec>& options, const std::string& leaf);
 
 /// Reads `option` from `reader` (its object's reader) into `config`, whose current value is the
 /// default, with the reader's strict checks of type, range and allowed values.

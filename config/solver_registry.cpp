@@ -137,28 +137,19 @@ std::vector<OptionSpec> shared_options() {
   preconditioner.selected = [](const FlowConfig& c) {
     return solver_row(c.solver.name).uses_preconditioner;
   };
-  // The multigrid's cycle wherever it runs (as the solver or as PCG's preconditioner); recorded
-  // always (the cells of every earlier run record them), refused where no multigrid runs.
-  const auto cycle_option = [](OptionSpec o) {
-    o.refused_elsewhere = true;
-    o.owner_text =
-        "a multigrid (solver \"multigrid\", or \"pcg\" with preconditioner \"multigrid\")";
-    o.selected = [](const FlowConfig& c) { return needs_hierarchy(c.solver); };
-    return o;
-  };
-  // The multigrid's options added later (all but cycle, cycles and smooth), recorded only when
-  // set (cells of earlier runs lack them), refused where no multigrid runs as the cycle's are.
+  // The multigrid's cycle options, refused where no multigrid runs (as the solver or as CG's
+  // preconditioner); when they are recorded is their declaration's (config/multigrid_params.cpp).
   std::vector<OptionSpec> options = {name, tolerance, max_iterations, preconditioner};
   for (OptionSpec o : multigrid_cycle_options()) {
-    const std::string leaf = split_key(o.key).second;
-    if (leaf == "cycles") {
+    o.refused_elsewhere = true;
+    if (split_key(o.key).second == "cycles") {
       // CG preconditioned by the multigrid applies one cycle an iteration, whatever this says.
-      o.refused_elsewhere = true;
       o.owner_text = "solver \"multigrid\" (CG's multigrid preconditioner is one cycle)";
       o.selected = [](const FlowConfig& c) { return solver_row(c.solver.name).needs_hierarchy; };
     } else {
-      o = cycle_option(std::move(o));
-      if (leaf != "cycle" && leaf != "smooth") o.recorded = Recorded::when_set;
+      o.owner_text =
+          "a multigrid (solver \"multigrid\", or \"pcg\" with preconditioner \"multigrid\")";
+      o.selected = [](const FlowConfig& c) { return needs_hierarchy(c.solver); };
     }
     options.push_back(std::move(o));
   }
@@ -190,11 +181,9 @@ const std::vector<OptionSpec>& solver_options() {
 }
 
 const OptionSpec& solver_option(const std::string& leaf) {
-  for (const OptionSpec& o : solver_options())
-    if (split_key(o.key).second == leaf) return o;
+  if (const OptionSpec* o = find_option(solver_options(), leaf)) return *o;
   for (const SolverRow& row : solver_table().rows())
-    for (const OptionSpec& o : row.options)
-      if (split_key(o.key).second == leaf) return o;
+    if (const OptionSpec* o = find_option(row.options, leaf)) return *o;
   throw std::logic_error("no solver option \"" + leaf + "\"");
 }
 

@@ -76,6 +76,21 @@ TEST(MultigridParams, ReadBackWhatTheConfigSets) {
   for (const auto& [key, value] : solver.items()) EXPECT_EQ(recorded.at(key), value) << key;
 }
 
+// A config that sets none of them records the keys every earlier result has, so that its cells
+// keep their config keys: the cycle's first three under every solver, the guard's under the
+// multigrid only, the options added later (by_term, precision, refresh) nowhere.
+TEST(MultigridParams, ADefaultRecordKeepsTheKeysOfEarlierResults) {
+  for (const char* name : {"multigrid", "cholmod"}) {
+    const json recorded = to_json(
+        flow_config_from_json(json{{"mesh", "x"}, {"solver", {{"name", name}}}}, "t"))["solver"];
+    for (const char* key : {"cycle", "cycles", "smooth"})
+      EXPECT_TRUE(recorded.contains(key)) << name << " " << key;
+    for (const char* key : {"galerkin_by_term", "precision", "galerkin_refresh"})
+      EXPECT_FALSE(recorded.contains(key)) << name << " " << key;
+    EXPECT_EQ(recorded.contains("stall_ratio"), std::string(name) == "multigrid") << name;
+  }
+}
+
 // Every solver option a component reads through param_value is found by its leaf.
 TEST(MultigridParams, EveryOptionIsASolverOption) {
   for (const auto* options : {&multigrid_cycle_options(), &stall_guard_options()})
