@@ -130,9 +130,18 @@ const std::vector<IntegratorRow>& integrator_table() {
   return table;
 }
 
-const IntegratorRow& integrator_row(const std::string& name) {
+namespace {
+
+const IntegratorRow* find_row(const std::string& name) {
   for (const IntegratorRow& row : integrator_table())
-    if (row.name == name) return row;
+    if (row.name == name) return &row;
+  return nullptr;
+}
+
+}  // namespace
+
+const IntegratorRow& integrator_row(const std::string& name) {
+  if (const IntegratorRow* row = find_row(name)) return *row;
   throw std::invalid_argument("unknown integrator \"" + name + "\"");
 }
 
@@ -146,9 +155,8 @@ const std::vector<std::string>& integrator_names() {
 }
 
 bool integrator_reads_extrapolate(const std::string& name) {
-  for (const IntegratorRow& row : integrator_table())
-    if (row.name == name) return row.reads_extrapolate;
-  return false;
+  const IntegratorRow* row = find_row(name);
+  return row && row->reads_extrapolate;
 }
 
 std::unique_ptr<Integrator> make_integrator(const std::string& name, bool extrapolate) {
